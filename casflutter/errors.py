@@ -1,0 +1,63 @@
+"""One small exception hierarchy; every class also subclasses a builtin.
+
+Catch :class:`CasflutterError` to catch anything the package raises on purpose,
+or the builtin (``ValueError``, ``RuntimeError``) when that is more natural.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "CasflutterError",
+    "DataError",
+    "OrderError",
+    "DimensionError",
+    "ConfigError",
+    "ConvergenceError",
+    "SynthesisError",
+]
+
+
+class CasflutterError(Exception):
+    """Base class of every error raised on purpose by casflutter."""
+
+
+class DataError(CasflutterError, ValueError):
+    """Input--output data that cannot be used (NaN/inf, length mismatch, too short,
+    not exciting enough)."""
+
+
+class OrderError(CasflutterError, ValueError):
+    """Model orders out of range or inconsistent with the data."""
+
+
+class DimensionError(CasflutterError, ValueError):
+    """Systems or matrices whose dimensions do not fit together."""
+
+
+class ConfigError(CasflutterError, ValueError):
+    """A configuration key, type or value that is not allowed."""
+
+
+class ConvergenceError(CasflutterError, RuntimeError):
+    """A numerical solve that did not converge.
+
+    The (non-converged) result object is attached as ``.result`` so that a caller
+    can inspect it; it is never returned as if it were a result.
+    """
+
+    def __init__(self, message: str, result=None):
+        super().__init__(message)
+        self.result = result
+
+
+class SynthesisError(CasflutterError, RuntimeError):
+    """Fixed-order synthesis found no stabilising controller.
+
+    ``.best_spectral_abscissa`` holds the smallest closed-loop spectral abscissa
+    reached over all starts.
+    """
+
+    def __init__(self, message: str, best_spectral_abscissa: float | None = None, result=None):
+        super().__init__(message)
+        self.best_spectral_abscissa = best_spectral_abscissa
+        self.result = result
