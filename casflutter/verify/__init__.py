@@ -1,0 +1,28 @@
+"""Independent verification of controllers (Lum et al., ACC 2016, eq. 10-16).
+
+Closed-loop poles, the exact H∞ norm with its peak frequency (SLICOT ``AB13DD`` via
+slycot, or a numpy/scipy Hamiltonian implementation), the small-gain speed interval
+and the exact speed interval of closed-loop stability (bialternate-sum guardian map).
+Uses python-control, slycot, numpy and scipy only; shares no code with
+:mod:`casflutter.design`, whose results it re-checks.
+"""
+
+from ._common import IllPosedError, NotHurwitzError
+from ._hinf import HinfNorm, hinf_norm, sigma_max, slycot_available
+from ._interval import (StabilityInterval, bialternate_sum, small_gain_interval,
+                        speed_interval, stability_interval)
+from ._io import (PlantData, controller_from_json, controller_to_json, load_controller,
+                  load_plant, plant_from_json, plant_to_json, save_json)
+from ._lft import lft_closed_loop, partition_plant
+from ._report import VerificationReport, delta_family, verify_controller
+
+__all__ = [
+    "IllPosedError", "NotHurwitzError",
+    "HinfNorm", "hinf_norm", "sigma_max", "slycot_available",
+    "StabilityInterval", "bialternate_sum", "small_gain_interval", "speed_interval",
+    "stability_interval",
+    "PlantData", "controller_from_json", "controller_to_json", "load_controller", "load_plant",
+    "plant_from_json", "plant_to_json", "save_json",
+    "lft_closed_loop", "partition_plant",
+    "VerificationReport", "delta_family", "verify_controller",
+]

@@ -1,0 +1,206 @@
+"""Intervals of the speed parameter on which the closed loop is certified stable.
+
+* :func:`small_gain_interval`: the small-gain certificate of Lum et al. (2016),
+  eq. (10) and (16): stable for ``|ΔV| < 1/γ`` with ``V² = Vf² + ΔV``.
+* :func:`stability_interval`: the *exact* maximal interval of ``δ`` around a nominal
+  value on which ``A(δ) = A0 + δ A1`` is Hurwitz (guardian maps: Fu & Barmish 1988;
+  Saydy, Tits & Abed 1990).  An eigenvalue crosses the imaginary axis only where
+  ``det(2A(δ) ⊙ I) = 0`` (a complex pair, λ_i + λ_j = 0) or ``det A(δ) = 0`` (a real
+  eigenvalue through 0).  ``2A ⊙ I`` (the bialternate sum, order n(n-1)/2) is linear in
+  ``A``, so the candidates are eigenvalues of two generalised pencils.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ConfigError, DimensionError
+from ._common import NotHurwitzError, is_hurwitz, spectral_abscissa
+
+__all__ = ["small_gain_interval", "StabilityInterval", "stability_interval",
+           "bialternate_sum", "speed_interval"]
+
+
+def small_gain_interval(gamma: float, Vf: float) -> tuple[float, float]:
+    """Speed-index interval certified by the small-gain theorem, eq. (10), (16).
+
+    With ``V² = Vf² + ΔV`` and stability for ``|ΔV| < 1/γ``:
+    ``V ∈ (sqrt(max(0, Vf² - 1/γ)), sqrt(Vf² + 1/γ))``.
+
+    Parameters
+    ----------
+    gamma : float
+        H∞ norm of the closed loop seen by the ΔV channel (``γ ≥ 0``; ``inf`` gives the
+        empty interval ``(Vf, Vf)``, ``0`` gives ``(0, inf)``).
+    Vf : float
+        Nominal (flutter) speed index, ``Vf ≥ 0``.
+
+    Returns
+    -------
+    (V_lo, V_hi) : tuple of float
+    """
+    if not gamma >= 0 or not Vf >= 0:
+        raise ConfigError(f"need gamma >= 0 and Vf >= 0, got gamma={gamma!r}, Vf={Vf!r}")
+    r = math.inf if gamma == 0 else 1.0 / gamma
+    return speed_interval(-r, r, Vf)
+
+
+def speed_interval(dv_lo: float, dv_hi: float, Vf: float) -> tuple[float, float]:
+    """Map a ΔV interval to the speed-index interval, ``V = sqrt(Vf² + ΔV) ≥ 0`` (eq. 10).
+
+    A lower end ``Vf² + ΔV ≤ 0`` gives ``V_lo = 0``.
+    """
+    lo = math.sqrt(max(0.0, Vf**2 + dv_lo))
+    hi = math.inf if math.isinf(dv_hi) else math.sqrt(max(0.0, Vf**2 + dv_hi))
+    return lo, hi
+
+
+def bialternate_sum(A: np.ndarray) -> np.ndarray:
+    """The bialternate sum ``2A ⊙ I`` of order ``n(n-1)/2``.
+
+    It is ``A ⊗ I + I ⊗ A`` restricted to the antisymmetric matrices
+    (``X ↦ A X + X Aᵀ``) in the orthonormal basis ``(e_p e_qᵀ - e_q e_pᵀ)/√2``,
+    ``p > q``; its eigenvalues are ``λ_i + λ_j``, ``i < j``.  Linear in ``A``.
+    """
+    A = np.asarray(A, dtype=float)
+    n = A.shape[0]
+    p_idx, q_idx = np.tril_indices(n, -1)
+    N = p_idx.size
+    M = np.zeros((N, N))
+    for k in range(N):
+        r, s = p_idx[k], q_idx[k]
+        # With E = e_r e_sᵀ - e_s e_rᵀ: A E + E Aᵀ = X - Xᵀ, X = A E (E is antisymmetric);
+        # its coordinate on the unit basis element of (p, q) is (X - Xᵀ)[p, q].
+        X = np.zeros((n, n))
+        X[:, s] = A[:, r]
+        X[:, r] -= A[:, s]
+        Y = X - X.T
+        M[:, k] = Y[p_idx, q_idx]
+    return M
+
+
+@dataclass(frozen=True)
+class StabilityInterval:
+    """Maximal open interval ``(lower, upper)`` of δ around ``nominal`` on which
+    ``A0 + δ A1`` is Hurwitz.
+
+    Attributes
+    ----------
+    lower, upper : float
+        Ends of the interval (``-inf``/``inf`` when no crossing exists on that side).
+    nominal : float
+        The δ the interval was grown from.
+    method : str
+        ``"bialternate"`` (pencils of ``2A ⊙ I`` and ``A``).
+    candidates : tuple of float
+        All real candidate values of δ found (sorted), genuine or spurious.
+    abscissa_lower, abscissa_upper : float
+        Spectral abscissa of ``A(δ)`` at each finite end (≈ 0: the check that the
+        end is a genuine crossing); ``nan`` for an infinite end.
+    crossing_lower, crossing_upper : str
+        ``"complex pair"``, ``"real through 0"`` or ``"none"``.
+    """
+
+    lower: float
+    upper: float
+    nominal: float
+    method: str
+    candidates: tuple[float, ...]
+    abscissa_lower: float
+    abscissa_upper: float
+    crossing_lower: str
+    crossing_upper: str
+
+    def contains(self, delta: float) -> bool:
+        """True when ``lower < delta < upper``."""
+        return self.lower < delta < self.upper
+
+    @property
+    def width(self) -> float:
+        """``upper - lower``."""
+        return self.upper - self.lower
+
+
+def _pencil_roots(M0: np.ndarray, M1: np.ndarray, imag_tol: float) -> np.ndarray:
+    """Real finite δ with ``det(M0 + δ M1) = 0``, ``M0`` nonsingular.
+
+    Uses ``μ = eig(-M0⁻¹ M1)``, ``δ = 1/μ`` (infinite roots map to μ = 0).
+    """
+    if M0.shape[0] == 0:
+        return np.zeros(0)
+    mu = np.linalg.eigvals(-np.linalg.solve(M0, M1))
+    scale = max(1.0, float(np.max(np.abs(mu)))) if mu.size else 1.0
+    mu = mu[np.abs(mu) > 1e-13 * scale]
+    real = np.abs(mu.imag) <= imag_tol * np.abs(mu)
+    return np.sort(1.0 / mu[real].real)
+
+
+def stability_interval(A0: np.ndarray, A1: np.ndarray, *, nominal: float = 0.0,
+                       imag_tol: float = 1e-6, check_tol: float = 1e-6
+                       ) -> StabilityInterval:
+    """Exact maximal open interval of δ containing ``nominal`` with ``A0 + δ A1`` Hurwitz.
+
+    Parameters
+    ----------
+    A0, A1 : (n, n) array_like
+        The affine family ``A(δ) = A0 + δ A1``; for the closed loop of eq. (14)-(15),
+        ``A0 = Acl`` and ``A1 = -B_wf C_zf`` (δ = ΔV).
+    nominal : float
+        A value with ``A(nominal)`` Hurwitz.
+    imag_tol : float
+        A pencil eigenvalue μ counts as real when ``|Im μ| ≤ imag_tol |μ|``.
+    check_tol : float
+        An end is accepted when the spectral abscissa of ``A(δ)`` there is within
+        ``check_tol · max(1, ||A(δ)||)`` of 0; otherwise the next candidate is tried.
+
+    Returns
+    -------
+    StabilityInterval
+
+    Raises
+    ------
+    DimensionError
+        If ``A0`` and ``A1`` are not square of the same size.
+    NotHurwitzError
+        If ``A(nominal)`` is not Hurwitz (no interval around it exists).
+    """
+    A0 = np.atleast_2d(np.asarray(A0, dtype=float))
+    A1 = np.atleast_2d(np.asarray(A1, dtype=float))
+    if A0.ndim != 2 or A0.shape[0] != A0.shape[1] or A0.shape != A1.shape:
+        raise DimensionError(f"A0 and A1 must be square of equal size, got {A0.shape} "
+                             f"and {A1.shape}")
+    An = A0 + nominal * A1
+    stable, alpha = is_hurwitz(An)
+    if not stable:
+        raise NotHurwitzError(
+            f"A0 + nominal*A1 (nominal={nominal}) is not Hurwitz (spectral abscissa "
+            f"{alpha:.6g} >= 0): there is no stability interval around it; pick a "
+            "stabilising controller / a nominal value where the loop is stable")
+    # δ measured from the nominal value: A(nominal + t) = An + t A1.
+    t_cplx = _pencil_roots(bialternate_sum(An), bialternate_sum(A1), imag_tol)
+    t_real = _pencil_roots(An, A1, imag_tol)
+    kinds = {float(t): "complex pair" for t in t_cplx}
+    kinds.update({float(t): "real through 0" for t in t_real})
+    cands = np.array(sorted(kinds))
+
+    def accept(t: float) -> tuple[bool, float]:
+        At = An + t * A1
+        a = spectral_abscissa(At)
+        return abs(a) <= check_tol * max(1.0, float(np.linalg.norm(At))), a
+
+    ends = {}
+    for side, pool in (("upper", cands[cands > 0]), ("lower", cands[cands < 0][::-1])):
+        ends[side] = (math.inf if side == "upper" else -math.inf, math.nan, "none")
+        for t in pool:
+            ok, a = accept(float(t))
+            if ok:
+                ends[side] = (float(t), a, kinds[float(t)])
+                break
+    (tu, au, ku), (tl, al, kl) = ends["upper"], ends["lower"]
+    return StabilityInterval(
+        lower=nominal + tl, upper=nominal + tu, nominal=float(nominal),
+        method="bialternate", candidates=tuple(float(nominal + c) for c in cands),
+        abscissa_lower=al, abscissa_upper=au, crossing_lower=kl, crossing_upper=ku)
