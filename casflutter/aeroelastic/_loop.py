@@ -1,0 +1,227 @@
+"""The linear aeroelastic loop ΣAE(V) (paper eq. 8-9).
+
+Σf (eq. 5) is the continuous linearised aerodynamic ROM,
+
+    ẋf = Af xf + Bf u + bf v,     y = Cf xf + Df u + df v,
+
+given as a continuous ``control.StateSpace`` with N outputs ``y`` and inputs
+``[u_1..u_N, v]`` (the flap column may be absent).  Closing it with Σs (eq. 7) gives
+
+    Â(V)  = [[As + V² Bs Df Cs, V² Bs Cf], [Bf Cs, Af]]       (eq. 8a)
+    B̂1    = [Bs; 0],   B̂2(V) = [V² Bs df; bf]
+    zm    = C2(V) x + D21 w + D22(V) v                          (eq. 8b, 9)
+
+where for state sensors ``C2 = [Hs 0]`` and ``D21 = D22 = 0`` exactly as in the paper;
+for accelerometers the zm rows carry the aerodynamic and disturbance feed-through
+(see :mod:`._structure`).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+from ..errors import DimensionError
+from ._structure import ModalStructure
+
+__all__ = ["AeroelasticSystem", "AeroelasticLoop", "aeroelastic_loop", "split_sigma_f"]
+
+
+def split_sigma_f(sigma_f, n_modes: int | None = None):
+    """Split Σf into ``(Af, Bf, bf, Cf, Df, df)`` following eq. 5.
+
+    Parameters
+    ----------
+    sigma_f : control.StateSpace
+        Continuous Σf with N outputs and N or N+1 inputs ``[u, v]``.
+    n_modes : int, optional
+        Expected N (from Σs); a mismatch raises :class:`DimensionError` naming both.
+
+    Returns
+    -------
+    tuple of ndarray
+        ``Af (nf, nf), Bf (nf, N), bf (nf,), Cf (N, nf), Df (N, N), df (N,)``; ``bf`` and
+        ``df`` are zero when Σf has no flap column.
+    """
+    A, B, C, D = (np.atleast_2d(np.asarray(M, dtype=float)) for M in
+                  (sigma_f.A, sigma_f.B, sigma_f.C, sigma_f.D))
+    dt = getattr(sigma_f, "dt", 0)
+    if dt not in (0, None) and dt is not False:
+        raise DimensionError(
+            f"Σf must be continuous-time (dt=0) but has dt={dt}; convert the discrete ROM with "
+            "Tustin's transform (casflutter.realize) first")
+    nf = A.shape[0] if A.size else 0
+    N = C.shape[0]
+    if n_modes is not None and N != n_modes:
+        raise DimensionError(
+            f"Σf has {N} outputs (generalised forces) but Σs has {n_modes} modes; "
+            "they must be equal: identify the ROM on the same modes as the structure")
+    m = D.shape[1]
+    if m not in (N, N + 1):
+        raise DimensionError(
+            f"Σf has {m} inputs but {N} outputs; inputs must be the N={N} modal displacements, "
+            "optionally followed by the flap v")
+    if nf == 0:
+        A = np.zeros((0, 0))
+        B = np.zeros((0, m))
+        C = np.zeros((N, 0))
+    Bf, Df = B[:, :N], D[:, :N]
+    bf = B[:, N] if m == N + 1 else np.zeros(nf)
+    df = D[:, N] if m == N + 1 else np.zeros(N)
+    return A, Bf, bf, C, Df, df
+
+
+@dataclass(frozen=True)
+class AeroelasticLoop:
+    """ΣAE at one speed index V (eq. 9): ``ẋ = A x + B1 w + B2 v``, ``zm = C2 x + D21 w + D22 v``.
+
+    Attributes
+    ----------
+    V : float
+        Speed index.
+    A, B1, B2, C2, D21, D22 : ndarray
+        Â(V), B̂1, B̂2(V), and the sensor rows (D21, D22 zero for state sensors).
+    Cu : ndarray
+        Modal displacement rows ``u = Cu x``.
+    n_modes, n_f : int
+        N and the order of Σf; the state is ``x = (x_s, x_f)``.
+    """
+
+    V: float
+    A: np.ndarray
+    B1: np.ndarray
+    B2: np.ndarray
+    C2: np.ndarray
+    D21: np.ndarray
+    D22: np.ndarray
+    Cu: np.ndarray
+    n_modes: int
+    n_f: int
+
+    def statespace(self, include_modal: bool = False) -> control.StateSpace:
+        """ΣAE as ``control.StateSpace`` with inputs ``[w_1..w_N, v]`` and outputs ``zm``
+        (followed by the modal displacements ``u`` when ``include_modal``)."""
+        C, D = self.C2, np.hstack([self.D21, self.D22[:, None]])
+        outs = [f"zm[{j}]" for j in range(C.shape[0])]
+        if include_modal:
+            C = np.vstack([C, self.Cu])
+            D = np.vstack([D, np.zeros((self.n_modes, D.shape[1]))])
+            outs += [f"u[{i}]" for i in range(self.n_modes)]
+        return control.ss(self.A, np.hstack([self.B1, self.B2[:, None]]), C, D,
+                          inputs=[f"w[{i}]" for i in range(self.n_modes)] + ["v"],
+                          outputs=outs, name=f"Sigma_AE(V={self.V:g})")
+
+    def poles(self) -> np.ndarray:
+        """Eigenvalues of Â(V)."""
+        return np.linalg.eigvals(self.A)
+
+
+@dataclass(frozen=True)
+class AeroelasticSystem:
+    """Σf and Σs together, giving ΣAE(V) at any speed index (eq. 8-9).
+
+    Use :func:`AeroelasticSystem.from_parts` (or :func:`aeroelastic_loop`) to build it
+    from a ``control.StateSpace`` Σf and a :class:`ModalStructure`.
+
+    Attributes
+    ----------
+    structure : ModalStructure
+        Σs.
+    Af, Bf, bf, Cf, Df, df : ndarray
+        The blocks of Σf (eq. 5).
+    """
+
+    structure: ModalStructure
+    Af: np.ndarray
+    Bf: np.ndarray
+    bf: np.ndarray
+    Cf: np.ndarray
+    Df: np.ndarray
+    df: np.ndarray
+
+    @classmethod
+    def from_parts(cls, sigma_f, structure: ModalStructure, *, warn_unstable: bool = True
+                   ) -> "AeroelasticSystem":
+        """Build from Σf (continuous ``control.StateSpace``) and Σs.
+
+        Raises
+        ------
+        DimensionError
+            When Σf's outputs do not match Σs's modes (both named) or Σf is discrete.
+
+        Warns
+        -----
+        RuntimeWarning
+            When Σf (the ROM) is unstable on its own, i.e. ΣAE is unstable at V = 0.
+        """
+        parts = split_sigma_f(sigma_f, structure.n_modes)
+        sys = cls(structure, *parts)
+        if warn_unstable and not sys.rom_stable:
+            warnings.warn(
+                f"Σf is unstable on its own (spectral abscissa {sys.rom_spectral_abscissa:.3g} > 0), "
+                "so ΣAE is unstable already at V = 0; flutter results are meaningless until the "
+                "ROM is re-identified or stabilised", RuntimeWarning, stacklevel=2)
+        return sys
+
+    @property
+    def n_modes(self) -> int:
+        """N."""
+        return self.structure.n_modes
+
+    @property
+    def n_f(self) -> int:
+        """Order of Σf."""
+        return self.Af.shape[0]
+
+    @property
+    def n_states(self) -> int:
+        """Order of ΣAE, 2N + nf."""
+        return self.structure.n_states + self.n_f
+
+    @property
+    def rom_spectral_abscissa(self) -> float:
+        """max Re λ(Af) (−inf for a static Σf)."""
+        return float(np.max(np.linalg.eigvals(self.Af).real)) if self.n_f else -np.inf
+
+    @property
+    def rom_stable(self) -> bool:
+        """True when Σf alone is asymptotically stable."""
+        return self.rom_spectral_abscissa < 0.0
+
+    @property
+    def mode_states(self) -> list[np.ndarray]:
+        """State indices ``[u_i, u̇_i]`` of each structural mode (for eigenvector participation)."""
+        return [np.array([2 * i, 2 * i + 1]) for i in range(self.n_modes)]
+
+    def state_matrix(self, V: float) -> np.ndarray:
+        """Â(V) of eq. 8a."""
+        s = self.structure
+        V2 = float(V) ** 2
+        As, Bs, Cs = s.As, s.Bs, s.Cs
+        top = np.hstack([As + V2 * Bs @ self.Df @ Cs, V2 * Bs @ self.Cf])
+        bot = np.hstack([self.Bf @ Cs, self.Af])
+        return np.vstack([top, bot])
+
+    def loop(self, V: float) -> AeroelasticLoop:
+        """ΣAE at speed index V (eq. 8-9), with flap input v and disturbance w."""
+        s = self.structure
+        V2 = float(V) ** 2
+        nf = self.n_f
+        Bs, Cs = s.Bs, s.Cs
+        A = self.state_matrix(V)
+        B1 = np.vstack([Bs, np.zeros((nf, s.n_modes))])
+        B2 = np.concatenate([V2 * Bs @ self.df, self.bf])
+        Hx, Hf = s.sensor_rows()
+        C2 = np.hstack([Hx + V2 * Hf @ self.Df @ Cs, V2 * Hf @ self.Cf])
+        D21 = Hf.copy()
+        D22 = V2 * Hf @ self.df
+        Cu = np.hstack([Cs, np.zeros((s.n_modes, nf))])
+        return AeroelasticLoop(float(V), A, B1, B2, C2, D21, D22, Cu, s.n_modes, nf)
+
+
+def aeroelastic_loop(sigma_f, structure: ModalStructure, V: float) -> AeroelasticLoop:
+    """ΣAE(V) (eq. 8-9) from Σf and Σs; see :class:`AeroelasticSystem`."""
+    return AeroelasticSystem.from_parts(sigma_f, structure).loop(V)

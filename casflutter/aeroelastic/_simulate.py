@@ -1,0 +1,348 @@
+"""Nonlinear aeroelastic loop: the discrete HWL ROM in feedback with the continuous Σs.
+
+Coupling (sampled-data, exact for the structure)
+-----------------------------------------------
+The ROM is discrete with sample time ``dt``; Σs (eq. 6-7) is continuous.  At each
+sample ``t_k = k dt``:
+
+1. the modal displacements ``u_k = Cs x_s(t_k)`` are sampled;
+2. the sensors are read, ``zm_k = Hx x_s(t_k) + Hf F_{k-1}`` — for accelerometers the
+   forcing term is the value held just before ``t_k`` (left limit), so the measurement
+   never depends on the flap command it produces (no algebraic loop);
+3. the controller (if any) gives ``v_k = v_ext(t_k) + g(t_k) · K_d(zm)_k``;
+4. the ROM gives ``y_k = rom.step(y_hist, u_hist, v_hist)`` (rows: time k, k−1, …);
+5. the structural forcing ``F_k = V² y_k + w(t_k)`` is held constant (ZOH) on
+   ``[t_k, t_{k+1})`` and Σs is propagated exactly,
+   ``x_s(t_{k+1}) = Ad x_s(t_k) + Bd F_k`` with ``[Ad Bd] = expm([[As, Bs], [0, 0]] dt)``.
+
+The controller ``K`` (continuous ``control.StateSpace``, inputs zm, output v) is
+discretised with ZOH at the same ``dt``, consistent with the held flap command; its
+state evolves whatever the gain ``g(t)`` (paper Fig. 11 ramps g from 0 to 1).
+
+Classification
+--------------
+From the envelope (peaks of |x|) of the last ``window`` fraction of the record:
+the growth rate σ is the slope of log-envelope against time; with ``r = σ T_window``,
+``r < −tol`` is a decay, ``r > tol`` a divergence, otherwise a limit-cycle oscillation
+(LCO).  A non-finite or blown-up record is a divergence; a record that has fallen
+below ``floor`` is a decay.  LCO amplitudes are half the peak-to-peak value over the
+window, per mode and per sensor; the fundamental frequency is the FFT peak (Hann
+window) refined by parabolic interpolation of the log magnitude (paper Fig. 9).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import control
+import numpy as np
+from scipy.linalg import expm
+from scipy.signal import find_peaks
+
+from ..errors import ConfigError, DimensionError
+from ._structure import ModalStructure
+
+__all__ = ["ResponseAnalysis", "LoopSimulation", "simulate_loop", "analyze_response",
+           "envelope_growth_rate", "dominant_frequency"]
+
+
+@dataclass(frozen=True)
+class ResponseAnalysis:
+    """Decay / LCO / divergence classification of a record (see module docstring).
+
+    Attributes
+    ----------
+    kind : str
+        ``"decay"``, ``"lco"`` or ``"divergence"``.
+    growth_rate : float
+        Envelope growth rate σ [1/s] of the dominant channel over the window.
+    amplitude : ndarray
+        Half peak-to-peak amplitude per channel over the window.
+    frequency_hz : float
+        Fundamental frequency [Hz] of the dominant channel (FFT peak, parabolic
+        interpolation); ``nan`` when the window holds too few samples.
+    omega : float
+        ``2π frequency_hz`` [rad/s].
+    dominant : int
+        Channel with the largest window amplitude.
+    spectrum_freq_hz, spectrum : ndarray
+        One-sided amplitude spectrum of the dominant channel over the window.
+    window : tuple of float
+        Start and end time of the analysed window.
+    """
+
+    kind: str
+    growth_rate: float
+    amplitude: np.ndarray
+    frequency_hz: float
+    omega: float
+    dominant: int
+    spectrum_freq_hz: np.ndarray
+    spectrum: np.ndarray
+    window: tuple
+
+
+@dataclass(frozen=True)
+class LoopSimulation:
+    """Record of :func:`simulate_loop` (samples at ``t_k``).
+
+    Attributes
+    ----------
+    timepts : ndarray (n,)
+    xs : ndarray (n, 2N)
+        Structural states.
+    u, y : ndarray (n, N)
+        Modal displacements and generalised forces.
+    zm : ndarray (n, m)
+        Sensor outputs (see module docstring).
+    v : ndarray (n,)
+        Flap command.
+    w : ndarray (n, N)
+        Disturbance.
+    gain : ndarray (n,)
+        Controller gain schedule g(t_k) (zeros without controller).
+    V, dt : float
+    stopped_early : bool
+        True when the record blew up (non-finite or above ``blowup``) and was truncated.
+    modes : ResponseAnalysis
+        Classification / LCO analysis of the modal displacements.
+    sensors : ResponseAnalysis or None
+        The same for the sensors.
+    """
+
+    timepts: np.ndarray
+    xs: np.ndarray
+    u: np.ndarray
+    y: np.ndarray
+    zm: np.ndarray
+    v: np.ndarray
+    w: np.ndarray
+    gain: np.ndarray
+    V: float
+    dt: float
+    stopped_early: bool
+    modes: ResponseAnalysis
+    sensors: ResponseAnalysis | None
+
+    @property
+    def kind(self) -> str:
+        """``"decay"``, ``"lco"`` or ``"divergence"`` (from the modal displacements)."""
+        return self.modes.kind
+
+
+def _signal(sig, n: int, dt: float, width: int | None, name: str) -> np.ndarray:
+    """Sample a signal given as None, callable t -> value, or array (n, width)/(n,)."""
+    shape = (n,) if width is None else (n, width)
+    if sig is None:
+        return np.zeros(shape)
+    if callable(sig):
+        out = np.array([np.asarray(sig(k * dt), dtype=float) for k in range(n)])
+    else:
+        out = np.asarray(sig, dtype=float)
+    out = out.reshape(n, -1) if width is not None else out.reshape(-1)
+    if out.shape != shape:
+        raise DimensionError(f"{name} must have shape {shape} (one value per ROM sample), got {out.shape}")
+    return out
+
+
+def envelope_growth_rate(timepts, x) -> float:
+    """Growth rate σ [1/s] of the envelope of a scalar record (slope of log peaks of |x|).
+
+    Falls back on a fit of log|x| when fewer than three peaks exist.
+    """
+    t, x = np.asarray(timepts, dtype=float), np.asarray(x, dtype=float)
+    a = np.abs(x - 0.0)
+    pk, _ = find_peaks(a)
+    if pk.size >= 3:
+        tt, yy = t[pk], np.log(np.maximum(a[pk], 1e-300))
+    else:
+        keep = a > 0
+        if keep.sum() < 2:
+            return -np.inf
+        tt, yy = t[keep], np.log(a[keep])
+    return float(np.polyfit(tt, yy, 1)[0])
+
+
+def dominant_frequency(timepts, x) -> tuple[float, np.ndarray, np.ndarray]:
+    """Fundamental frequency [Hz] of a uniformly sampled record by FFT peak.
+
+    The record is de-meaned and Hann-windowed; the peak bin is refined by parabolic
+    interpolation of the log magnitude.  Returns ``(f_hz, freq_hz, amplitude_spectrum)``.
+    """
+    t, x = np.asarray(timepts, dtype=float), np.asarray(x, dtype=float)
+    n = x.size
+    if n < 8:
+        return float("nan"), np.zeros(0), np.zeros(0)
+    dt = (t[-1] - t[0]) / (n - 1)
+    win = np.hanning(n)
+    X = np.abs(np.fft.rfft((x - x.mean()) * win)) * 2.0 / win.sum()
+    f = np.fft.rfftfreq(n, dt)
+    k = int(np.argmax(X[1:]) + 1)
+    if 1 <= k < X.size - 1 and np.all(X[k - 1:k + 2] > 0):
+        a, b, c = np.log(X[k - 1:k + 2])
+        den = a - 2 * b + c
+        p = 0.5 * (a - c) / den if den != 0 else 0.0
+    else:
+        p = 0.0
+    return float((k + p) * f[1]), f, X
+
+
+def analyze_response(timepts, X, *, window: float = 0.3, tol: float = 0.05,
+                     floor: float = 1e-12, blowup: float = np.inf) -> ResponseAnalysis:
+    """Classify a record as decay / LCO / divergence and measure its LCO (module docstring).
+
+    Parameters
+    ----------
+    timepts : array_like (n,)
+    X : array_like (n,) or (n, channels)
+    window : float
+        Fraction (0, 1] of the record, at its end, that is analysed.
+    tol : float
+        Allowed relative envelope change ``|σ T_window|`` of an LCO.
+    floor : float
+        A window amplitude below this is a decay.
+    blowup : float
+        An amplitude above this (or non-finite) is a divergence.
+    """
+    t = np.asarray(timepts, dtype=float)
+    X = np.asarray(X, dtype=float)
+    X = X[:, None] if X.ndim == 1 else X
+    if not 0 < window <= 1:
+        raise ConfigError(f"window must be a fraction in (0, 1], got {window}")
+    finite = np.all(np.isfinite(X), axis=1)
+    n_ok = int(np.argmin(finite)) if not finite.all() else t.size
+    t, X = t[:n_ok], X[:n_ok]
+    i0 = int(np.floor((1 - window) * t.size))
+    tw, Xw = t[i0:], X[i0:]
+    amp = 0.5 * (Xw.max(axis=0) - Xw.min(axis=0)) if tw.size else np.full(X.shape[1], np.nan)
+    dom = int(np.argmax(amp)) if tw.size else 0
+    blown = n_ok < finite.size or (tw.size and np.max(np.abs(Xw)) > blowup)
+    sigma = envelope_growth_rate(tw, Xw[:, dom]) if tw.size >= 2 else np.nan
+    fhz, ff, XX = dominant_frequency(tw, Xw[:, dom]) if tw.size else (np.nan, np.zeros(0), np.zeros(0))
+    T = tw[-1] - tw[0] if tw.size >= 2 else 0.0
+    if blown:
+        kind = "divergence"
+    elif not np.isfinite(sigma) or np.max(amp) < floor or sigma * T < -tol:
+        kind = "decay"
+    elif sigma * T > tol:
+        kind = "divergence"
+    else:
+        kind = "lco"
+    return ResponseAnalysis(kind, float(sigma), amp, fhz, 2 * np.pi * fhz, dom, ff, XX,
+                            (float(tw[0]) if tw.size else np.nan, float(tw[-1]) if tw.size else np.nan))
+
+
+def _check_rom(rom, n_modes: int) -> None:
+    for attr in ("step", "n_modes", "max_lag", "dt"):
+        if not hasattr(rom, attr):
+            raise ConfigError(f"the ROM lacks '{attr}'; it must implement step(y_hist, u_hist, "
+                              "v_hist) and the attributes n_modes, max_lag, dt")
+    if rom.n_modes != n_modes:
+        raise DimensionError(f"the ROM has n_modes={rom.n_modes} but Σs has {n_modes} modes; "
+                             "they must be equal")
+    if not rom.dt > 0:
+        raise ConfigError(f"the ROM must be discrete with dt > 0, got dt={rom.dt}")
+
+
+def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0=None,
+                  w=None, v=None, controller: control.StateSpace | None = None,
+                  gain: Callable[[float], float] | None = None, window: float = 0.3,
+                  tol: float = 0.05, blowup: float = 1e6) -> LoopSimulation:
+    """Simulate the nonlinear ROM in feedback with Σs at speed index V (module docstring).
+
+    Parameters
+    ----------
+    rom : object
+        Discrete ROM with ``step(y_hist, u_hist, v_hist) -> y_k``, ``n_modes``,
+        ``max_lag``, ``dt`` (the HWL ROM of ``casflutter.ident`` or any such model).
+    structure : ModalStructure
+        Σs (eq. 6-7).
+    V : float
+        Speed index (forcing ``V² y``).
+    n_steps : int
+        Number of ROM samples.
+    xs0 : array_like (2N,), optional
+        Initial structural state ``[u_1, u̇_1, ...]`` (zero by default; the ROM starts at rest).
+    w : None, callable t -> (N,), or array (n_steps, N)
+        Disturbance added to ``V² y`` (eq. 7).
+    v : None, callable t -> float, or array (n_steps,)
+        External flap command.
+    controller : control.StateSpace, optional
+        Continuous K with ``n_sensors`` inputs and one output; closes ``v = g(t) K zm``.
+    gain : callable t -> float, optional
+        Gain schedule g(t) (default 1 when a controller is given).
+    window, tol :
+        Classification settings, see :func:`analyze_response`.
+    blowup : float
+        |u| above which the run is stopped and classified as divergence.
+
+    Returns
+    -------
+    LoopSimulation
+    """
+    s = structure
+    N, m = s.n_modes, s.n_sensors
+    _check_rom(rom, N)
+    if n_steps < 2:
+        raise ConfigError(f"n_steps must be >= 2, got {n_steps}")
+    dt, L = float(rom.dt), int(rom.max_lag)
+    V2 = float(V) ** 2
+    nx = s.n_states
+    E = expm(np.block([[s.As, s.Bs], [np.zeros((N, nx + N))]]) * dt)
+    Ad, Bd = E[:nx, :nx], E[:nx, nx:]
+    Hx, Hf = s.sensor_rows()
+    Cs = s.Cs
+    W = _signal(w, n_steps, dt, N, "w")
+    Vext = _signal(v, n_steps, dt, None, "v")
+    if controller is not None:
+        if controller.ninputs != m or controller.noutputs != 1:
+            raise DimensionError(f"the controller has {controller.ninputs} inputs and "
+                                 f"{controller.noutputs} outputs; it needs {m} inputs (sensors) and 1 output (flap)")
+        Kd = control.sample_system(controller, dt, method="zoh") if controller.dt == 0 else controller
+        Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (Kd.A, Kd.B, Kd.C, Kd.D))
+        xk = np.zeros(Ak.shape[0])
+        g = (lambda t: 1.0) if gain is None else gain
+    xs = np.zeros(nx) if xs0 is None else np.asarray(xs0, dtype=float).reshape(nx)
+    y_hist, u_hist, v_hist = np.zeros((L + 1, N)), np.zeros((L + 1, N)), np.zeros(L + 1)
+    F_prev = np.zeros(N)
+    rec = {k: [] for k in ("xs", "u", "y", "zm", "v", "g")}
+    stopped = False
+    for k in range(n_steps):
+        t = k * dt
+        uk = Cs @ xs
+        zk = Hx @ xs + Hf @ F_prev
+        vk = Vext[k]
+        gk = 0.0
+        if controller is not None:
+            gk = float(g(t))
+            vk = vk + gk * float((Ck @ xk + Dk @ zk)[0])
+            xk = Ak @ xk + Bk @ zk
+        u_hist = np.roll(u_hist, 1, axis=0)
+        u_hist[0] = uk
+        v_hist = np.roll(v_hist, 1)
+        v_hist[0] = vk
+        y_hist = np.roll(y_hist, 1, axis=0)
+        y_hist[0] = 0.0
+        yk = np.asarray(rom.step(y_hist, u_hist, v_hist), dtype=float).reshape(N)
+        y_hist[0] = yk
+        for key, val in (("xs", xs), ("u", uk), ("y", yk), ("zm", zk), ("v", vk), ("g", gk)):
+            rec[key].append(val)
+        if not (np.all(np.isfinite(yk)) and np.all(np.abs(uk) < blowup)):
+            stopped = True
+            break
+        F_prev = V2 * yk + W[k]
+        xs = Ad @ xs + Bd @ F_prev
+    n = len(rec["u"])
+    tpts = dt * np.arange(n)
+    U = np.asarray(rec["u"])
+    Z = np.asarray(rec["zm"]).reshape(n, m)
+    modes = analyze_response(tpts, U, window=window, tol=tol, blowup=blowup)
+    sens = analyze_response(tpts, Z, window=window, tol=tol, blowup=np.inf) if m else None
+    if stopped:
+        modes = ResponseAnalysis("divergence", modes.growth_rate, modes.amplitude, modes.frequency_hz,
+                                 modes.omega, modes.dominant, modes.spectrum_freq_hz, modes.spectrum,
+                                 modes.window)
+    return LoopSimulation(tpts, np.asarray(rec["xs"]), U, np.asarray(rec["y"]), Z,
+                          np.asarray(rec["v"], dtype=float), W[:n], np.asarray(rec["g"], dtype=float),
+                          float(V), dt, stopped, modes, sens)
