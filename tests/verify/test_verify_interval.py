@@ -1,0 +1,105 @@
+"""Exact stability interval of A0 + δ A1 (bialternate-sum guardian map) against analytic
+cases and a dense eigenvalue sweep; small-gain interval against its formula."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from casflutter.errors import ConfigError, DimensionError
+from casflutter.verify import (NotHurwitzError, bialternate_sum, small_gain_interval,
+                               speed_interval, stability_interval)
+
+
+def _abscissa(A):
+    return np.max(np.linalg.eigvals(A).real)
+
+
+def _random_family(seed, n):
+    rng = np.random.default_rng(seed)
+    A0 = rng.standard_normal((n, n))
+    A0 -= (_abscissa(A0) + rng.uniform(0.1, 1.0)) * np.eye(n)
+    A1 = rng.standard_normal((n, n))
+    return A0, A1
+
+
+def test_bialternate_sum_eigenvalues_are_pairwise_sums():
+    A = np.random.default_rng(3).standard_normal((7, 7))
+    lam = np.linalg.eigvals(A)
+    ref = np.array([lam[i] + lam[j] for i in range(7) for j in range(i)])
+    ev = np.linalg.eigvals(bialternate_sum(A))
+    assert ev.size == 21
+    # multiset equality through nearest matches both ways
+    assert max(np.min(np.abs(ev - r)) for r in ref) < 1e-10
+    assert max(np.min(np.abs(ref - e)) for e in ev) < 1e-10
+    # linear in A
+    B = np.random.default_rng(4).standard_normal((7, 7))
+    assert_allclose(bialternate_sum(2 * A - B), 2 * bialternate_sum(A) - bialternate_sum(B),
+                    atol=1e-12)
+
+
+def test_two_by_two_analytic():
+    """s² + (1 - δ/2) s + (2 + δ): Hurwitz iff -2 < δ < 2 (real root through 0 at -2,
+    complex pair ±2j at +2)."""
+    A0 = np.array([[0.0, 1.0], [-2.0, -1.0]])
+    A1 = np.array([[0.0, 0.0], [-1.0, 0.5]])
+    si = stability_interval(A0, A1)
+    assert_allclose([si.lower, si.upper], [-2.0, 2.0], rtol=1e-12)
+    assert si.crossing_lower == "real through 0" and si.crossing_upper == "complex pair"
+    assert si.method == "bialternate"
+    assert si.contains(0.0) and not si.contains(2.0)
+
+
+def test_shift_family_has_one_sided_interval():
+    """A0 - δ I is Hurwitz iff δ > α(A0): lower end analytic, upper end infinite."""
+    A0, _ = _random_family(5, 6)
+    si = stability_interval(A0, -np.eye(6))
+    assert_allclose(si.lower, _abscissa(A0), rtol=1e-10)
+    assert si.upper == math.inf and math.isnan(si.abscissa_upper)
+
+
+@pytest.mark.parametrize("seed,n,nominal", [(s, n, 0.0) for s, n in
+                                            [(0, 3), (1, 4), (2, 6), (3, 8), (4, 10), (5, 5),
+                                             (6, 7), (7, 12)]] + [(8, 6, 0.3), (9, 4, -0.2)])
+def test_random_family_matches_dense_sweep(seed, n, nominal):
+    A0, A1 = _random_family(seed, n)
+    A0 = A0 - nominal * A1          # so that A(nominal) is the Hurwitz matrix built above
+    si = stability_interval(A0, A1, nominal=nominal)
+    assert si.lower < nominal < si.upper
+    # dense sweep: first unstable grid point on each side
+    h = 1e-3
+    for sign, end in ((+1, si.upper), (-1, si.lower)):
+        d = nominal
+        while abs(d - nominal) < 50 and _abscissa(A0 + d * A1) < 0:
+            d += sign * h
+        if math.isinf(end):
+            assert abs(d - nominal) >= 50
+        else:
+            assert abs(d - end) <= h + 1e-12
+            # and sharply: stable just inside, not stable just outside
+            eps = 1e-7 * max(1.0, abs(end))
+            assert _abscissa(A0 + (end - sign * eps) * A1) < 0
+            assert _abscissa(A0 + (end + sign * eps) * A1) > 0
+            assert abs(_abscissa(A0 + end * A1)) < 1e-8
+    assert all(np.isfinite(si.candidates))
+
+
+def test_not_hurwitz_and_bad_shapes():
+    with pytest.raises(NotHurwitzError, match="not Hurwitz"):
+        stability_interval(np.eye(2), np.eye(2))
+    with pytest.raises(DimensionError, match="square"):
+        stability_interval(-np.eye(2), np.eye(3))
+
+
+def test_small_gain_interval_formula():
+    """eq. (10), (16): V ∈ (sqrt(max(0, Vf² - 1/γ)), sqrt(Vf² + 1/γ))."""
+    assert_allclose(small_gain_interval(2.0, 1.2), (math.sqrt(1.44 - 0.5), math.sqrt(1.94)))
+    assert small_gain_interval(0.5, 1.2) == (0.0, math.sqrt(1.44 + 2.0))   # 1/γ > Vf²
+    assert small_gain_interval(math.inf, 1.2) == (1.2, 1.2)              # no certificate
+    assert small_gain_interval(0.0, 1.2) == (0.0, math.inf)
+    with pytest.raises(ConfigError):
+        small_gain_interval(-1.0, 1.2)
+    assert speed_interval(-3.0, math.inf, 1.0) == (0.0, math.inf)
