@@ -1,0 +1,71 @@
+"""``casflutter problems``: list the benchmark problems and their parameters."""
+
+from __future__ import annotations
+
+import json
+
+from ...errors import ConfigError
+
+__all__ = ["register", "run"]
+
+
+def register(subparsers) -> None:
+    """Add the ``problems`` sub-command."""
+    p = subparsers.add_parser(
+        "problems", help="list the problems, their parameters and published reference values",
+        description="List the benchmark problems with a truth simulator, every parameter "
+                    "(default = published case; change with --set name=value in the "
+                    "commands that take a problem) and the published reference values.")
+    p.add_argument("name", nargs="?", help="show only this problem")
+    p.add_argument("--set", dest="sets", action="append", default=[], metavar="NAME=VALUE",
+                   help="show the parameters with these changes applied (validated)")
+    p.add_argument("--json", action="store_true", help="machine-readable output")
+    p.set_defaults(func=run)
+
+
+def _info(name: str, sets) -> dict:
+    from ...truth import load_problem, problem_definition
+
+    model = load_problem(name, sets)
+    params = model.params
+    rows = [{"name": n, "value": getattr(params, n), "default": d, "unit": u, "doc": doc}
+            for n, d, u, doc in params.describe()]
+    try:
+        definition = problem_definition(name)
+    except ConfigError:
+        definition = {}
+    ms = model.modal_structure()
+    return {"name": name, "truth": type(model).__name__,
+            "description": definition.get("problem", {}).get(
+                "description", (type(model).__doc__ or "").strip().splitlines()[0]),
+            "speed_index": ms.speed_index, "time_unit": ms.time_unit,
+            "modes": list(ms.mode_names), "parameters": rows,
+            "reference": definition.get("reference", {})}
+
+
+def run(args) -> int:
+    """Handler: print the listing; unknown problem or parameter names raise ConfigError."""
+    from ...truth import problem_names
+
+    names = [args.name] if args.name else problem_names()
+    infos = [_info(n, args.sets) for n in names]
+    if args.json:
+        print(json.dumps(infos, indent=2))
+        return 0
+    for info in infos:
+        print(f"{info['name']}  ({info['truth']})")
+        print(f"  {info['description']}")
+        print(f"  speed index: {info['speed_index']};  time unit: {info['time_unit']}")
+        print(f"  modes: {', '.join(info['modes'])}")
+        print("  parameters:")
+        w = max(len(r["name"]) for r in info["parameters"])
+        for r in info["parameters"]:
+            mark = "" if r["value"] == r["default"] else f"  (default {r['default']:g})"
+            print(f"    {r['name']:<{w}} = {r['value']:<12g} [{r['unit']}]  {r['doc']}{mark}")
+        if info["reference"]:
+            print("  published reference values:")
+            for key, vals in info["reference"].items():
+                items = ", ".join(f"{k}={v}" for k, v in vals.items())
+                print(f"    {key}: {items}")
+        print()
+    return 0

@@ -1,0 +1,24 @@
+"""Full-order truth simulators that stand in for the paper's CFD.
+
+Given prescribed modal displacements (and flap) they return the generalised aerodynamic
+forces ``y`` of eq. (6), so identification runs on them as it would on CFD output; their
+own linear state space in the speed index ``V`` gives the true flutter speed.
+
+- :class:`TypicalSection` -- pitch--plunge section, Wagner aerodynamics in R. T. Jones'
+  two-lag form, optional flap and polynomial pitch stiffness (Hodges & Pierce HP-1 default).
+- :class:`GolandWing` -- cantilever beam with assumed bending/torsion modes and strip-theory
+  Jones aerodynamics (Goland 1945), with a trailing-edge flap of our own.
+"""
+
+from ._aero import JONES_A, JONES_B, jones_C, strip_coefficients, theodorsen_T
+from ._base import AeroelasticTruth, AeroMatrices, ModalStructure, SimulationResult
+from ._goland import GolandParams, GolandWing
+from ._registry import PROBLEMS, load_problem, problem_definition, problem_names
+from ._typical_section import TypicalSection, TypicalSectionParams
+
+__all__ = [
+    "AeroelasticTruth", "AeroMatrices", "ModalStructure", "SimulationResult",
+    "TypicalSection", "TypicalSectionParams", "GolandWing", "GolandParams",
+    "PROBLEMS", "problem_names", "load_problem", "problem_definition",
+    "JONES_A", "JONES_B", "jones_C", "theodorsen_T", "strip_coefficients",
+]

@@ -1,0 +1,500 @@
+"""The common machinery of the full-order truth simulators.
+
+A truth is a structure with ``n`` physical (or assumed-mode) coordinates ``x``,
+
+    Mhat x'' + Chat x' + Khat x + f_nl(x) = fhat,
+
+(mass-scaled so that ``Mhat`` is dimensionless), loaded by linear unsteady aerodynamics in
+the Jones/Wagner state-space form (see :mod:`._aero`)
+
+    fhat = Kx x + Cx x' + Mx x'' + Fv v + Fv1 v' + Fv2 v'' + W g_eff,
+    g    = Gx x + Gx1 x' + Gv v + Gv1 v',
+    g_eff = (1 - A1 - A2) g + A1 lam1 z1 + A2 lam2 z2,   z_j' = -lam_j z_j + g,
+
+with flap angle ``v``.  The in-vacuo modes ``x = Phi u`` (``Phi^T Mhat Phi = I``,
+``Phi^T Khat Phi = diag(omega^2)``) turn the structure into the paper's eq. (6),
+
+    u_i'' + 2 zeta_i omega_i u_i' + omega_i^2 u_i = alpha V^2 y_i,   y = Phi^T fhat / (alpha V^2),
+
+and ``y`` is what :meth:`AeroelasticTruth.aero_forces` returns for prescribed ``u`` and ``v``.
+"""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass, field
+
+import control
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.interpolate import make_interp_spline
+from scipy.linalg import eigh
+
+from ..errors import ConfigError, DataError, DimensionError
+from ._aero import JONES_A, check_timepts, integrate_lags, sample_derivatives
+
+__all__ = ["AeroMatrices", "ModalStructure", "SimulationResult", "AeroelasticTruth"]
+
+
+@dataclass(frozen=True)
+class AeroMatrices:
+    """Linear aerodynamic operator at one speed (see the module docstring for the form).
+
+    Shapes: ``Kx, Cx, Mx`` ``(n, n)``; ``Fv, Fv1, Fv2`` ``(n,)``; ``W`` ``(n, ng)``;
+    ``Gx, Gx1`` ``(ng, n)``; ``Gv, Gv1`` ``(ng,)``; ``lams`` the Jones lag rates [1/time].
+    """
+
+    Kx: np.ndarray
+    Cx: np.ndarray
+    Mx: np.ndarray
+    Fv: np.ndarray
+    Fv1: np.ndarray
+    Fv2: np.ndarray
+    W: np.ndarray
+    Gx: np.ndarray
+    Gx1: np.ndarray
+    Gv: np.ndarray
+    Gv1: np.ndarray
+    lams: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class ModalStructure:
+    """The structural data of eq. (6)-(7) for a truth model.
+
+    Attributes
+    ----------
+    omega : numpy.ndarray
+        In-vacuo natural frequencies ``omega_i`` [rad per time unit], ascending.
+    zeta : numpy.ndarray
+        Modal damping ratios ``zeta_i``.
+    alpha : float
+        Flow constant ``alpha`` of eq. (6): the structure is
+        ``u'' + 2 zeta omega u' + omega^2 u = alpha V^2 y``.
+    mode_names : tuple of str
+        A name per mode (e.g. ``"plunge"``, ``"pitch"``, ``"bending 1"``).
+    shapes : numpy.ndarray
+        ``Phi``, ``(n, N)``: physical/assumed-mode coordinates ``x = Phi u``.
+    coordinate_names : tuple of str
+        Names of the ``n`` physical coordinates.
+    sensor_rows : numpy.ndarray
+        ``Hs`` of eq. (7), ``(ns, N)``: sensor readings ``z_m = Hs u`` (displacements; the
+        accelerations are ``Hs u''``).
+    sensor_names : tuple of str
+        A name per sensor row.
+    time_unit : str
+        The unit of time of ``omega`` and of ``timepts``.
+    speed_index : str
+        The convention of the speed index ``V``.
+    """
+
+    omega: np.ndarray
+    zeta: np.ndarray
+    alpha: float
+    mode_names: tuple[str, ...]
+    shapes: np.ndarray
+    coordinate_names: tuple[str, ...]
+    sensor_rows: np.ndarray
+    sensor_names: tuple[str, ...]
+    time_unit: str
+    speed_index: str
+
+    @property
+    def n_modes(self) -> int:
+        """Number of modes ``N``."""
+        return int(self.omega.size)
+
+    def As_Bs(self) -> tuple[np.ndarray, np.ndarray]:
+        """The matrices ``As = diag(A_s^i)``, ``Bs = diag(B_s^i)`` of eq. (7)."""
+        N = self.n_modes
+        As = np.zeros((2 * N, 2 * N))
+        Bs = np.zeros((2 * N, N))
+        for i in range(N):
+            As[2 * i, 2 * i + 1] = 1.0
+            As[2 * i + 1, 2 * i] = -self.omega[i] ** 2
+            As[2 * i + 1, 2 * i + 1] = -2.0 * self.zeta[i] * self.omega[i]
+            Bs[2 * i + 1, i] = self.alpha
+        return As, Bs
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """A time simulation of the full truth (structure + Jones aerodynamics).
+
+    Attributes
+    ----------
+    timepts : numpy.ndarray
+        ``(K,)`` sample times.
+    states : numpy.ndarray
+        ``(K, 2N + 2 ng)``: ``[u, u', z1, z2]`` (modal displacements, velocities, lag states).
+    u, udot, uddot : numpy.ndarray
+        ``(K, N)`` modal displacements, velocities, accelerations.
+    y : numpy.ndarray
+        ``(K, N)`` generalised aerodynamic forces (normalised as in eq. (6)).
+    v : numpy.ndarray
+        ``(K,)`` flap angle used.
+    V : float
+        Speed index.
+    success : bool
+        Integrator status (``scipy.integrate.solve_ivp``).
+    message : str
+        Integrator message.
+    nfev : int
+        Right-hand-side evaluations.
+    """
+
+    timepts: np.ndarray
+    states: np.ndarray
+    u: np.ndarray
+    udot: np.ndarray
+    uddot: np.ndarray
+    y: np.ndarray
+    v: np.ndarray
+    V: float
+    success: bool
+    message: str
+    nfev: int
+
+
+def _as_2d(name: str, arr, K: int, N: int) -> np.ndarray:
+    a = np.asarray(arr, dtype=float)
+    if a.ndim == 1 and N == 1:
+        a = a[:, None]
+    if a.shape != (K, N):
+        raise DimensionError(f"{name} must have shape (K, N) = ({K}, {N}) (samples x modes), "
+                             f"got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise DataError(f"{name} contains NaN or inf")
+    return a
+
+
+def _as_1d(name: str, arr, K: int) -> np.ndarray:
+    a = np.asarray(arr, dtype=float).reshape(-1)
+    if a.shape != (K,):
+        raise DimensionError(f"{name} must have K = {K} samples, got shape {np.shape(arr)}")
+    if not np.all(np.isfinite(a)):
+        raise DataError(f"{name} contains NaN or inf")
+    return a
+
+
+class AeroelasticTruth(abc.ABC):
+    """Base class of the truth simulators (typical section, Goland wing).
+
+    Subclasses provide the structural matrices, the aerodynamic operator at a speed index
+    and the conventions; everything else (modes, forces for prescribed motion, the coupled
+    linear system, nonlinear simulation) is shared.
+    """
+
+    #: parameter dataclass of the problem
+    params: object
+
+    def __init__(self, params) -> None:
+        self.params = params
+        Mh, Kh = self._structure_matrices()
+        w2, Phi = eigh(Kh, Mh)
+        if np.any(w2 <= 0):
+            raise ConfigError("structural stiffness is not positive definite; check the "
+                              "stiffness parameters")
+        # sign convention: the largest component of each mode shape is positive
+        idx = np.argmax(np.abs(Phi), axis=0)
+        Phi = Phi * np.sign(Phi[idx, np.arange(Phi.shape[1])])
+        self._Mhat, self._Khat, self._Phi = Mh, Kh, Phi
+        self._omega = np.sqrt(w2)
+
+    # ---- to be provided by a problem -------------------------------------------------
+    @abc.abstractmethod
+    def _structure_matrices(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(Mhat, Khat)`` in the physical/assumed-mode coordinates."""
+
+    @abc.abstractmethod
+    def aero_matrices(self, V: float) -> AeroMatrices:
+        """The linear aerodynamic operator at speed index ``V`` (module docstring)."""
+
+    @property
+    @abc.abstractmethod
+    def alpha(self) -> float:
+        """Flow constant ``alpha`` of eq. (6)."""
+
+    @abc.abstractmethod
+    def _names(self) -> dict:
+        """Mode names, coordinate names, sensor rows/names, time unit, speed convention."""
+
+    def _nonlinear_force(self, x: np.ndarray) -> np.ndarray | None:
+        """Extra structural restoring force ``f_nl(x)`` (``None`` if linear)."""
+        return None
+
+    def _zeta(self) -> np.ndarray:
+        return np.full(self._omega.size, float(getattr(self.params, "zeta", 0.0)))
+
+    # ---- public ----------------------------------------------------------------------
+    def with_updates(self, **changes: float):
+        """The same problem with some parameters changed (unknown names raise ConfigError)."""
+        return type(self)(self.params.with_updates(**changes))
+
+    @classmethod
+    def from_sets(cls, sets=()):
+        """The problem with ``["name=value", ...]`` applied to the published parameters."""
+        return cls(cls.Params.from_sets(sets))
+
+    @property
+    def n_modes(self) -> int:
+        """Number of structural modes ``N``."""
+        return int(self._omega.size)
+
+    def modal_structure(self) -> ModalStructure:
+        """Frequencies, damping, flow constant, mode shapes, sensor rows and names."""
+        nm = self._names()
+        return ModalStructure(omega=self._omega.copy(), zeta=self._zeta(), alpha=self.alpha,
+                              mode_names=tuple(nm["mode_names"]), shapes=self._Phi.copy(),
+                              coordinate_names=tuple(nm["coordinate_names"]),
+                              sensor_rows=np.asarray(nm["sensor_rows"], float),
+                              sensor_names=tuple(nm["sensor_names"]),
+                              time_unit=nm["time_unit"], speed_index=nm["speed_index"])
+
+    def _check_V(self, V: float) -> float:
+        V = float(V)
+        if not np.isfinite(V) or V <= 0:
+            raise ConfigError(f"speed index V must be positive and finite, got {V}")
+        return V
+
+    def aero_forces(self, timepts: np.ndarray, u: np.ndarray, v: np.ndarray | None = None,
+                    V: float = 1.0, *, udot: np.ndarray | None = None,
+                    uddot: np.ndarray | None = None, vdot: np.ndarray | None = None,
+                    vddot: np.ndarray | None = None) -> np.ndarray:
+        """Generalised aerodynamic forces ``y`` for prescribed modal motion and flap.
+
+        ``y`` is normalised so that the structure is exactly eq. (6),
+        ``u'' + 2 zeta omega u' + omega^2 u = alpha V^2 y`` (see :meth:`modal_structure`).
+        The flow is at rest before ``timepts[0]`` (Wagner lag states start at zero).
+
+        Derivatives not passed are taken from a quintic interpolating spline of the samples
+        (exact for the interpolant; ``O(dt^4)`` for ``u''``); the Jones lag states are then
+        integrated exactly for the cubic Hermite interpolant of their input.
+
+        Parameters
+        ----------
+        timepts : numpy.ndarray
+            ``(K,)`` uniformly spaced sample times [time unit of the problem].
+        u : numpy.ndarray
+            ``(K, N)`` modal displacements.
+        v : numpy.ndarray, optional
+            ``(K,)`` flap angle [rad]; zero if omitted.
+        V : float
+            Speed index (see ``modal_structure().speed_index``).
+        udot, uddot, vdot, vddot : numpy.ndarray, optional
+            Exact derivatives, if the caller has them.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(K, N)`` generalised aerodynamic forces ``y``.
+        """
+        V = self._check_V(V)
+        dt = check_timepts(timepts)
+        t = np.asarray(timepts, float)
+        K, N = t.size, self.n_modes
+        u = _as_2d("u", u, K, N)
+        v = np.zeros(K) if v is None else _as_1d("v", v, K)
+        if udot is None or uddot is None:
+            d1, d2 = sample_derivatives(t, u, 2)
+            udot = d1 if udot is None else udot
+            uddot = d2 if uddot is None else uddot
+        udot, uddot = _as_2d("udot", udot, K, N), _as_2d("uddot", uddot, K, N)
+        if vdot is None or vddot is None:
+            d1, d2 = sample_derivatives(t, v, 2)
+            vdot = d1 if vdot is None else vdot
+            vddot = d2 if vddot is None else vddot
+        vdot, vddot = _as_1d("vdot", vdot, K), _as_1d("vddot", vddot, K)
+        Phi = self._Phi
+        x, xd, xdd = u @ Phi.T, udot @ Phi.T, uddot @ Phi.T
+        am = self.aero_matrices(V)
+        g = x @ am.Gx.T + xd @ am.Gx1.T + np.outer(v, am.Gv) + np.outer(vdot, am.Gv1)
+        gd = xd @ am.Gx.T + xdd @ am.Gx1.T + np.outer(vdot, am.Gv) + np.outer(vddot, am.Gv1)
+        zs = integrate_lags(g, gd, dt, am.lams)
+        geff = (1.0 - sum(JONES_A)) * g
+        for A, lam, z in zip(JONES_A, am.lams, zs):
+            geff = geff + A * lam * z
+        f = (x @ am.Kx.T + xd @ am.Cx.T + xdd @ am.Mx.T + np.outer(v, am.Fv)
+             + np.outer(vdot, am.Fv1) + np.outer(vddot, am.Fv2) + geff @ am.W.T)
+        return (f @ Phi) / (self.alpha * V * V)
+
+    # ---- coupled linear system -------------------------------------------------------
+    def _coupled(self, V: float) -> dict:
+        """Blocks of the coupled modal equations at ``V`` (see :meth:`state_matrix`)."""
+        V = self._check_V(V)
+        am = self.aero_matrices(V)
+        Phi, P = self._Phi, self._Phi.T
+        N, ng = self.n_modes, am.W.shape[1]
+        a0 = 1.0 - sum(JONES_A)
+        Mm = np.eye(N) - P @ am.Mx @ Phi
+        Minv = np.linalg.inv(Mm)
+        zeta = self._zeta()
+        Ku = -np.diag(self._omega ** 2) + P @ (am.Kx + a0 * am.W @ am.Gx) @ Phi
+        Cu = -np.diag(2.0 * zeta * self._omega) + P @ (am.Cx + a0 * am.W @ am.Gx1) @ Phi
+        Z = [A * lam * P @ am.W for A, lam in zip(JONES_A, am.lams)]
+        Bv = [P @ (am.Fv + a0 * am.W @ am.Gv), P @ (am.Fv1 + a0 * am.W @ am.Gv1), P @ am.Fv2]
+        nx = 2 * N + 2 * ng
+        A = np.zeros((nx, nx))
+        A[:N, N:2 * N] = np.eye(N)
+        A[N:2 * N, :N] = Minv @ Ku
+        A[N:2 * N, N:2 * N] = Minv @ Cu
+        Bflap = np.zeros((nx, 3))  # columns: v, v', v''
+        for j, lam in enumerate(am.lams):
+            rows = slice(2 * N + j * ng, 2 * N + (j + 1) * ng)
+            A[N:2 * N, rows] = Minv @ Z[j]
+            A[rows, :N] = am.Gx @ Phi
+            A[rows, N:2 * N] = am.Gx1 @ Phi
+            A[rows, rows] = -lam * np.eye(ng)
+            Bflap[rows, 0] = am.Gv
+            Bflap[rows, 1] = am.Gv1
+        for k in range(3):
+            Bflap[N:2 * N, k] = Minv @ Bv[k]
+        Bw = np.zeros((nx, N))
+        Bw[N:2 * N] = Minv * self.alpha
+        return {"A": A, "Bflap": Bflap, "Bw": Bw, "Minv": Minv, "am": am, "N": N, "ng": ng}
+
+    def state_matrix(self, V: float) -> np.ndarray:
+        """State matrix of the coupled full-order aeroelastic system at speed index ``V``.
+
+        States ``[u, u', z1, z2]`` (modal displacements, velocities, Jones lag states),
+        flap held at zero.  Its eigenvalues give the true flutter speed.
+        """
+        return self._coupled(V)["A"]
+
+    def statespace(self, V: float, actuator_omega: float | None = None,
+                   actuator_zeta: float = 0.7) -> control.StateSpace:
+        """The linear aeroelastic system with flap input and modal disturbances.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+        actuator_omega : float, optional
+            If given, the flap follows a second-order actuator
+            ``v'' = actuator_omega^2 (v_c - v) - 2 actuator_zeta actuator_omega v'`` and the
+            first input is the command ``v_c``; otherwise the flap states ``v, v'`` are a
+            double integrator of the first input ``v''`` (flap acceleration).
+        actuator_zeta : float
+            Actuator damping ratio.
+
+        Returns
+        -------
+        control.StateSpace
+            States ``[u, u', z1, z2, v, v']``; inputs ``[flap, w_1..w_N]`` where ``w`` enters
+            as in eq. (7) (``u'' += alpha w`` through the apparent-mass coupling); outputs
+            ``[u_1..u_N, sensors...]``.
+        """
+        c = self._coupled(V)
+        A0, Bf, Bw, N = c["A"], c["Bflap"], c["Bw"], c["N"]
+        nx = A0.shape[0]
+        A = np.zeros((nx + 2, nx + 2))
+        A[:nx, :nx] = A0
+        A[:nx, nx] = Bf[:, 0]
+        A[:nx, nx + 1] = Bf[:, 1]
+        A[nx, nx + 1] = 1.0
+        B = np.zeros((nx + 2, 1 + N))
+        B[:nx, 1:] = Bw
+        if actuator_omega is None:
+            B[:nx, 0] = Bf[:, 2]
+            B[nx + 1, 0] = 1.0
+        else:
+            wa, za = float(actuator_omega), float(actuator_zeta)
+            if wa <= 0 or za < 0:
+                raise ConfigError("actuator_omega must be > 0 and actuator_zeta >= 0")
+            # v'' = wa^2 (vc - v) - 2 za wa v'
+            A[:nx, nx] += Bf[:, 2] * (-wa * wa)
+            A[:nx, nx + 1] += Bf[:, 2] * (-2 * za * wa)
+            A[nx + 1, nx] = -wa * wa
+            A[nx + 1, nx + 1] = -2 * za * wa
+            B[:nx, 0] = Bf[:, 2] * wa * wa
+            B[nx + 1, 0] = wa * wa
+        nm = self._names()
+        H = np.asarray(nm["sensor_rows"], float)
+        C = np.zeros((N + H.shape[0], nx + 2))
+        C[:N, :N] = np.eye(N)
+        C[N:, :N] = H
+        D = np.zeros((C.shape[0], 1 + N))
+        ng = c["ng"]
+        states = ([f"u{i + 1}" for i in range(N)] + [f"u{i + 1}_dot" for i in range(N)]
+                  + [f"z{j + 1}_{k + 1}" for j in range(2) for k in range(ng)] + ["v", "v_dot"])
+        inputs = ["v_ddot" if actuator_omega is None else "v_c"] + [f"w{i + 1}" for i in range(N)]
+        outputs = [f"u{i + 1}" for i in range(N)] + list(nm["sensor_names"])
+        return control.ss(A, B, C, D, states=states, inputs=inputs, outputs=outputs,
+                          name=f"{type(self).__name__}(V={V:g})")
+
+    # ---- nonlinear simulation --------------------------------------------------------
+    def simulate(self, timepts: np.ndarray, x0: np.ndarray, V: float,
+                 v: np.ndarray | None = None, *, rtol: float = 1e-9,
+                 atol: float = 1e-12) -> SimulationResult:
+        """Time simulation of the full truth, including any nonlinear structural stiffness.
+
+        Parameters
+        ----------
+        timepts : numpy.ndarray
+            ``(K,)`` increasing output times (any spacing).
+        x0 : numpy.ndarray
+            Initial state: ``[u, u']`` (length ``2N``; lag states start at zero, i.e. the
+            flow at rest) or the full state ``[u, u', z1, z2]``.
+        V : float
+            Speed index.
+        v : numpy.ndarray, optional
+            ``(K,)`` flap angle at ``timepts`` (interpolated by a quintic spline, whose
+            derivatives give ``v'`` and ``v''``); zero if omitted.
+        rtol, atol : float
+            ``solve_ivp`` (DOP853) tolerances.
+
+        Returns
+        -------
+        SimulationResult
+        """
+        t = np.asarray(timepts, float)
+        if t.ndim != 1 or t.size < 2 or np.any(np.diff(t) <= 0):
+            raise DataError("timepts must be a 1-D increasing array of at least 2 samples")
+        c = self._coupled(V)
+        A, Bf, Minv, N = c["A"], c["Bflap"], c["Minv"], c["N"]
+        nx = A.shape[0]
+        x0 = np.asarray(x0, float).reshape(-1)
+        if x0.size == 2 * N:
+            x0 = np.concatenate([x0, np.zeros(nx - 2 * N)])
+        if x0.size != nx:
+            raise DimensionError(f"x0 must have length 2N = {2 * N} or {nx} (with lag states), "
+                                 f"got {x0.size}")
+        if v is None:
+            vs = np.zeros(t.size)
+            vfun = None
+        else:
+            vs = _as_1d("v", v, t.size)
+            if t.size < 6:
+                raise DataError("a flap history needs at least 6 samples")
+            vfun = make_interp_spline(t, vs, k=5)
+            vd1, vd2 = vfun.derivative(1), vfun.derivative(2)
+        Phi = self._Phi
+        has_nl = self._nonlinear_force(np.zeros(Phi.shape[0])) is not None
+
+        def rhs(tt, s):
+            ds = A @ s
+            if vfun is not None:
+                ds = ds + Bf @ np.array([vfun(tt), vd1(tt), vd2(tt)])
+            if has_nl:
+                fnl = self._nonlinear_force(Phi @ s[:N])
+                ds[N:2 * N] -= Minv @ (Phi.T @ fnl)
+            return ds
+
+        sol = solve_ivp(rhs, (t[0], t[-1]), x0, method="DOP853", t_eval=t, rtol=rtol,
+                        atol=atol)
+        S = sol.y.T
+        if S.shape[0] != t.size:  # integration stopped early: pad with NaN, report failure
+            S = np.vstack([S, np.full((t.size - S.shape[0], nx), np.nan)])
+        acc = np.array([rhs(tt, s)[N:2 * N] if np.all(np.isfinite(s)) else np.full(N, np.nan)
+                        for tt, s in zip(t, S)])
+        u, ud = S[:, :N], S[:, N:2 * N]
+        # eq. (6): alpha V^2 y = u'' + 2 zeta omega u' + omega^2 u + Phi^T f_nl
+        zeta = self._zeta()
+        aV2y = acc + ud * (2 * zeta * self._omega) + u * self._omega ** 2
+        if has_nl:
+            aV2y = aV2y + np.array([Phi.T @ self._nonlinear_force(Phi @ ui) for ui in u])
+        V = self._check_V(V)
+        return SimulationResult(timepts=t, states=S, u=u, udot=ud, uddot=acc,
+                                y=aV2y / (self.alpha * V * V), v=vs, V=V,
+                                success=bool(sol.success), message=str(sol.message),
+                                nfev=int(sol.nfev))

@@ -1,0 +1,104 @@
+"""Parameter dataclasses: ``with_updates`` / ``from_sets`` with clear errors."""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, Iterable
+
+from ..errors import ConfigError
+
+__all__ = ["ParamsMixin"]
+
+
+class ParamsMixin:
+    """Mixin for frozen parameter dataclasses.
+
+    Subclasses are frozen dataclasses whose fields carry ``metadata={"doc": ..., "unit": ...}``
+    and implement ``_validate()`` (raising :class:`ConfigError` naming the fault and the fix).
+    """
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            if f.type in ("int", int):
+                if isinstance(v, bool) or int(v) != v:
+                    raise ConfigError(f"parameter {f.name!r} must be an integer, got {v!r}")
+                object.__setattr__(self, f.name, int(v))
+            else:
+                try:
+                    object.__setattr__(self, f.name, float(v))
+                except (TypeError, ValueError):
+                    raise ConfigError(f"parameter {f.name!r} must be a number, got {v!r}") from None
+        self._validate()
+
+    def _validate(self) -> None:  # pragma: no cover - overridden
+        pass
+
+    @classmethod
+    def parameter_names(cls) -> list[str]:
+        """Names of all parameters, in declaration order."""
+        return [f.name for f in dataclasses.fields(cls)]
+
+    @classmethod
+    def describe(cls) -> list[tuple[str, Any, str, str]]:
+        """``(name, default, unit, doc)`` for every parameter."""
+        return [(f.name, f.default, f.metadata.get("unit", ""), f.metadata.get("doc", ""))
+                for f in dataclasses.fields(cls)]
+
+    def as_dict(self) -> dict[str, float]:
+        """Parameters as a plain dict."""
+        return dataclasses.asdict(self)
+
+    def with_updates(self, **changes: float):
+        """A copy with some parameters changed.
+
+        Raises
+        ------
+        ConfigError
+            If a name is not a parameter (the message lists the valid names) or a value is
+            not physical.
+        """
+        valid = self.parameter_names()
+        unknown = [k for k in changes if k not in valid]
+        if unknown:
+            raise ConfigError(f"unknown parameter(s) {', '.join(map(repr, unknown))} for "
+                              f"{type(self).__name__}; valid names: {', '.join(valid)}")
+        return dataclasses.replace(self, **changes)
+
+    @classmethod
+    def from_sets(cls, sets: Iterable[str] = (), base=None):
+        """Parameters from ``["name=value", ...]`` strings (the CLI's ``--set``).
+
+        Parameters
+        ----------
+        sets : iterable of str
+            Each ``"name=value"`` with a numeric value.
+        base : optional
+            Parameters to start from (default: the published case).
+
+        Raises
+        ------
+        ConfigError
+            Malformed item, unknown name (valid names listed) or non-physical value.
+        """
+        base = cls() if base is None else base
+        changes: dict[str, float] = {}
+        for item in sets:
+            name, sep, value = str(item).partition("=")
+            name = name.strip()
+            if not sep or not name:
+                raise ConfigError(f"--set item {item!r} is not of the form name=value")
+            if name not in cls.parameter_names():
+                raise ConfigError(f"unknown parameter {name!r} for {cls.__name__}; valid "
+                                  f"names: {', '.join(cls.parameter_names())}")
+            try:
+                changes[name] = float(value)
+            except ValueError:
+                raise ConfigError(f"--set {name}={value!r}: value must be a number") from None
+        return base.with_updates(**changes)
+
+
+def require(cond: bool, message: str) -> None:
+    """Raise :class:`ConfigError` with ``message`` unless ``cond``."""
+    if not cond:
+        raise ConfigError(message)

@@ -1,0 +1,70 @@
+"""The registry of truth problems and their definitions in ``problems/``."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+from ..errors import ConfigError
+from ._base import AeroelasticTruth
+from ._goland import GolandWing
+from ._typical_section import TypicalSection
+
+__all__ = ["PROBLEMS", "problem_names", "load_problem", "problem_definition"]
+
+#: name -> truth class
+PROBLEMS: dict[str, type[AeroelasticTruth]] = {
+    "typical_section": TypicalSection,
+    "goland": GolandWing,
+}
+
+_PROBLEMS_DIR = Path(__file__).resolve().parents[2] / "problems"
+
+
+def problem_names() -> list[str]:
+    """Names of the problems that have a truth simulator."""
+    return list(PROBLEMS)
+
+
+def _cls(name: str) -> type[AeroelasticTruth]:
+    try:
+        return PROBLEMS[name]
+    except KeyError:
+        raise ConfigError(f"unknown problem {name!r}; available: {', '.join(PROBLEMS)}") from None
+
+
+def load_problem(name: str, sets=()) -> AeroelasticTruth:
+    """The truth model of problem ``name`` with ``--set``-style changes applied.
+
+    Parameters
+    ----------
+    name : str
+        A name from :func:`problem_names`.
+    sets : iterable of str
+        ``"name=value"`` items (unknown names raise :class:`ConfigError` listing the valid
+        ones).
+
+    Returns
+    -------
+    AeroelasticTruth
+    """
+    return _cls(name).from_sets(sets)
+
+
+def problem_definition(name: str, problems_dir: str | Path | None = None) -> dict:
+    """The TOML definition ``problems/NAME/problem.toml`` (published reference values).
+
+    Raises
+    ------
+    ConfigError
+        Unknown problem, or the definition file is not found (e.g. an installed package
+        without the repository's ``problems/`` folder: pass ``problems_dir``).
+    """
+    _cls(name)
+    root = Path(problems_dir) if problems_dir is not None else _PROBLEMS_DIR
+    path = root / name / "problem.toml"
+    if not path.is_file():
+        raise ConfigError(f"problem definition {path} not found; pass problems_dir= pointing "
+                          "at the repository's problems/ folder")
+    with open(path, "rb") as fh:
+        return tomllib.load(fh)
