@@ -137,6 +137,6 @@ def build_lft(system: AeroelasticSystem, Vf: float) -> AeroelasticLFT:
                    np.block([[D11, D12], [D21, D22]]),
                    inputs=[f"wf[{i}]" for i in range(N)] + [f"w[{i}]" for i in range(N)] + ["v"],
                    outputs=[f"zf[{i}]" for i in range(N)] + [f"zm[{j}]" for j in range(s.n_sensors)],
-                   name=f"LFT(Vf={Vf:g})")
+                   name="Sigma_AE_LFT")
     return AeroelasticLFT(float(Vf), A, B1bar, B2, C1, D11, D12, C2, D21, D22, Mx, Nx, Nw, Nv,
                           B1, P, N, s.n_sensors, 1, s.sensor)

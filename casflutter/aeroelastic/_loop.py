@@ -112,7 +112,7 @@ class AeroelasticLoop:
             outs += [f"u[{i}]" for i in range(self.n_modes)]
         return control.ss(self.A, np.hstack([self.B1, self.B2[:, None]]), C, D,
                           inputs=[f"w[{i}]" for i in range(self.n_modes)] + ["v"],
-                          outputs=outs, name=f"Sigma_AE(V={self.V:g})")
+                          outputs=outs, name="Sigma_AE")
 
     def poles(self) -> np.ndarray:
         """Eigenvalues of Â(V)."""

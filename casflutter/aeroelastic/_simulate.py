@@ -263,7 +263,9 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
     n_steps : int
         Number of ROM samples.
     xs0 : array_like (2N,), optional
-        Initial structural state ``[u_1, u̇_1, ...]`` (zero by default; the ROM starts at rest).
+        Initial structural state ``[u_1, u̇_1, ...]`` (zero by default).  The ROM's past
+        inputs are the initial displacements held constant (the wing is held deflected and
+        released at t = 0); its past outputs and flap inputs are zero.
     w : None, callable t -> (N,), or array (n_steps, N)
         Disturbance added to ``V² y`` (eq. 7).
     v : None, callable t -> float, or array (n_steps,)
@@ -304,7 +306,8 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
         xk = np.zeros(Ak.shape[0])
         g = (lambda t: 1.0) if gain is None else gain
     xs = np.zeros(nx) if xs0 is None else np.asarray(xs0, dtype=float).reshape(nx)
-    y_hist, u_hist, v_hist = np.zeros((L + 1, N)), np.zeros((L + 1, N)), np.zeros(L + 1)
+    y_hist, v_hist = np.zeros((L + 1, N)), np.zeros(L + 1)
+    u_hist = np.tile(Cs @ xs, (L + 1, 1))  # held at the initial deflection before release
     F_prev = np.zeros(N)
     rec = {k: [] for k in ("xs", "u", "y", "zm", "v", "g")}
     stopped = False

@@ -1,0 +1,133 @@
+"""Flutter / divergence search and eigenvector-continuity tracking."""
+
+import control
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from casflutter.aeroelastic import (AeroelasticSystem, ModalStructure, find_flutter,
+                                    track_eigenvalues)
+from casflutter.errors import ConfigError
+
+from ._cases import binary_system, spectral_abscissa_bisection
+
+
+@pytest.mark.parametrize("dynamic", [False, True])
+def test_flutter_speed_matches_independent_bisection(dynamic):
+    sysae = binary_system(dynamic=dynamic)
+    res = find_flutter(sysae, (0.0, 3.0), n_grid=61)
+    assert res.status == "flutter" and res.found
+    assert not res.unstable_at_start
+    lo = res.flutter.bracket[0] - 0.2  # a stable point below, found independently of the tracker
+    Vf_ref = spectral_abscissa_bisection(sysae.state_matrix, max(lo, 0.0), 3.0)
+    assert_allclose(res.Vf, Vf_ref, rtol=1e-8)
+    lam = np.linalg.eigvals(sysae.state_matrix(res.Vf))
+    k = np.argmin(np.abs(lam - res.flutter.eigenvalue))
+    assert abs(lam[k].real) < 1e-8 * abs(lam[k])
+    assert_allclose(res.omega_f, abs(lam[k].imag), rtol=1e-8)
+    assert_allclose(res.frequency_hz, res.omega_f / (2 * np.pi), rtol=1e-14)
+    assert res.flutter.converged and res.flutter.slope > 0
+
+
+def test_binary_flutter_matches_routh_hurwitz():
+    """Static two-mode case: the quartic's Hurwitz determinant Δ3 vanishes at Vf."""
+    from scipy.optimize import brentq
+    sysae = binary_system(dynamic=False)
+
+    def delta3(V):
+        a = np.poly(sysae.state_matrix(V))  # monic a0 s^4 + a1 s^3 + ... + a4
+        return a[1] * a[2] * a[3] - a[1] ** 2 * a[4] - a[3] ** 2
+
+    res = find_flutter(sysae, (0.0, 3.0), n_grid=31)
+    Vrh = brentq(delta3, res.flutter.bracket[0], res.flutter.bracket[1], xtol=1e-14, rtol=1e-14)
+    assert_allclose(res.Vf, Vrh, rtol=1e-8)
+
+
+def _analytic_blocks(V):
+    """Hump mode a(V) = −(V−1)(V−2) at ω = 7 and a real eigenvalue V − 2.5."""
+    a = -(V - 1.0) * (V - 2.0)
+    A = np.zeros((5, 5))
+    A[:2, :2] = [[a, 7.0], [-7.0, a]]
+    A[2, 2] = V - 2.5
+    A[3:, 3:] = [[-0.5, 3.0], [-3.0, -0.5]]
+    T = np.array([[1, 2, 0, 0, 1], [0, 1, 1, 0, 0], [1, 0, 1, 1, 0], [0, 0, 0, 1, 2], [1, 0, 0, 0, 1.0]])
+    return T @ A @ np.linalg.inv(T)  # hide the block structure
+
+
+def test_every_crossing_reported_on_a_generic_callable():
+    res = find_flutter(_analytic_blocks, (0.0, 3.0), n_grid=41)
+    kinds = [(c.kind, c.direction) for c in res.crossings]
+    assert kinds == [("flutter", "destabilizing"), ("flutter", "stabilizing"),
+                     ("divergence", "destabilizing")]
+    assert_allclose([c.V for c in res.crossings], [1.0, 2.0, 2.5], rtol=1e-10)
+    assert_allclose(res.crossings[0].omega, 7.0, rtol=1e-10)
+    assert res.crossings[2].omega == 0.0
+    assert res.Vf == pytest.approx(1.0, rel=1e-10)
+    assert res.divergence.V == pytest.approx(2.5, rel=1e-10)
+    assert (res.origin == -1).all()  # no structural information given
+
+
+def test_static_divergence_single_mode_analytic():
+    """ü + 2ζωu̇ + (ω² − αV²d) u = 0 diverges at V = ω/√(αd)."""
+    w, z, alpha, d = 4.0, 0.05, 2.0, 3.0
+    sysae = AeroelasticSystem.from_parts(control.ss([], [], [], [[d]]), ModalStructure([w], [z], alpha=alpha))
+    res = find_flutter(sysae, (0.0, 3.0), n_grid=31)
+    assert res.status == "divergence" and res.Vf is None
+    assert res.divergence.kind == "divergence"
+    assert_allclose(res.divergence.V, w / np.sqrt(alpha * d), rtol=1e-8)
+    assert res.divergence.origin_mode == 0
+
+
+def test_no_crossing_is_reported_as_such():
+    sysae = binary_system()
+    res = find_flutter(sysae, (0.0, 1.0), n_grid=21)
+    assert res.status == "no_crossing"
+    assert res.Vf is None and res.omega_f is None and res.flutter is None and not res.found
+    assert res.crossings == ()
+    assert "no flutter" in res.message
+
+
+def test_unstable_at_start_is_flagged():
+    s = ModalStructure([3.0], [0.05])
+    with pytest.warns(RuntimeWarning):
+        sysae = AeroelasticSystem.from_parts(control.ss([[0.2]], [[1.0]], [[1.0]], [[0.0]]), s)
+    with pytest.warns(RuntimeWarning, match="unstable already"):
+        res = find_flutter(sysae, (0.0, 1.0), n_grid=11)
+    assert res.unstable_at_start and res.spectral_abscissa_start > 0
+
+
+def test_tracking_follows_eigenvectors_through_frequency_crossing():
+    """Uncoupled modes whose frequencies cross: sorting would swap them, tracking must not."""
+    s = ModalStructure([5.0, 8.0], [0.01, 0.01], alpha=1.0)
+    sysae = AeroelasticSystem.from_parts(control.ss([], [], [], np.diag([-30.0, 30.0])), s)
+    V = np.linspace(0.0, 1.3, 27)  # ω1² + 30 V² and ω2² − 30 V² cross at V² = 39/60
+    tr = track_eigenvalues(sysae, V)
+    w1 = np.sqrt(25.0 + 30.0 * tr.V ** 2)
+    for b in range(4):
+        E = np.abs(tr.eigenvectors[:, :, b]) ** 2
+        mode0 = E[:, :2].sum(axis=1) > 0.5
+        assert mode0.all() or (~mode0).all()  # each branch stays in one mode
+    up = tr.upper_branches()
+    assert up.size == 2
+    b0 = next(b for b in up if np.abs(tr.eigenvectors[0, :2, b]).sum() > 0.5)
+    wd = np.sqrt(w1 ** 2 - (0.01 * 5.0) ** 2)
+    assert_allclose(tr.frequency[:, b0], wd, rtol=1e-10)
+    assert_allclose(tr.damping_ratio[:, b0], 0.05 / np.sqrt(25.0 + 30.0 * tr.V ** 2) * 1.0, rtol=1e-8)
+    res = find_flutter(sysae, V_grid=V)
+    assert_allclose(np.sort(res.origin[up]), [0, 1])
+
+
+def test_origin_mode_of_binary_flutter_by_participation_and_frequency_agree():
+    sysae = binary_system(dynamic=True)
+    res_p = find_flutter(sysae, (0.0, 3.0), n_grid=31)
+    res_w = find_flutter(sysae.state_matrix, (0.0, 3.0), n_grid=31, omega=sysae.structure.omega)
+    assert res_p.flutter_mode in (0, 1)
+    assert res_p.flutter_mode == res_w.flutter_mode
+    assert_allclose(res_p.Vf, res_w.Vf, rtol=1e-10)
+
+
+def test_bad_ranges():
+    with pytest.raises(ConfigError):
+        find_flutter(_analytic_blocks, (2.0, 1.0))
+    with pytest.raises(ConfigError):
+        track_eigenvalues(_analytic_blocks, [0.0, 0.0, 1.0])

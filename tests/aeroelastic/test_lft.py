@@ -1,0 +1,49 @@
+"""The LFT of eq. 10-15 closed with wf = −ΔV zf equals ΣAE assembled at V² = Vf² + ΔV."""
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from casflutter.aeroelastic import build_lft, find_flutter
+from casflutter.errors import ConfigError
+
+from ._cases import binary_system
+
+
+@pytest.mark.parametrize("sensor", ["state", "acceleration", "velocity"])
+@pytest.mark.parametrize("dynamic", [False, True])
+def test_lft_closure_equals_direct_assembly(sensor, dynamic):
+    sysae = binary_system(sensor, dynamic=dynamic)
+    Vf = find_flutter(sysae, (0.0, 3.0), n_grid=31).Vf
+    lft = build_lft(sysae, Vf)
+    assert lft.n_delta == 2 and lft.ncon == 1 and lft.nmeas == sysae.structure.n_sensors
+    assert lft.P.ninputs == 2 * 2 + 1 and lft.P.noutputs == 2 + lft.nmeas
+    rng = np.random.default_rng(20160706)
+    for dV in rng.uniform(-0.8 * Vf ** 2, 2.0 * Vf ** 2, size=6):
+        closed = lft.close(dV)
+        direct = sysae.loop(np.sqrt(Vf ** 2 + dV))
+        for got, want in ((closed.A, direct.A),
+                          (closed.B, np.hstack([direct.B1, direct.B2[:, None]])),
+                          (closed.C, direct.C2),
+                          (closed.D, np.hstack([direct.D21, direct.D22[:, None]]))):
+            assert_allclose(got, want, rtol=0, atol=1e-10 * max(1.0, np.abs(want).max()))
+
+
+def test_lemma1_factorisation_and_paper_structure():
+    """[ΔA ΔB1 ΔB2] = −Mx ΔV [Nx Nw Nv] (eq. 12); state sensors give D21 = D22 = 0 (eq. 14)."""
+    sysae = binary_system("state", dynamic=True)
+    Vf, dV = 1.5, 0.37
+    lft = build_lft(sysae, Vf)
+    lo, hi = sysae.loop(Vf), sysae.loop(np.sqrt(Vf ** 2 + dV))
+    assert_allclose(hi.A - lo.A, -lft.Mx * dV @ lft.Nx, atol=1e-12)
+    assert_allclose(hi.B1 - lo.B1, -lft.Mx * dV @ lft.Nw, atol=1e-12)
+    assert_allclose((hi.B2 - lo.B2)[:, None], -lft.Mx * dV @ lft.Nv, atol=1e-12)
+    assert np.all(lft.D21 == 0) and np.all(lft.D22 == 0)
+    assert_allclose(lft.C2[:, :4], sysae.structure.Hs)
+
+
+def test_lft_requires_a_flutter_speed():
+    sysae = binary_system()
+    res = find_flutter(sysae, (0.0, 1.0), n_grid=11)
+    with pytest.raises(ConfigError, match="Vf"):
+        build_lft(sysae, res.Vf)

@@ -1,0 +1,133 @@
+"""Nonlinear loop simulation: linear test double vs the exact sampled-data loop, LCO vs
+harmonic balance, controller with gain schedule."""
+
+import control
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+from scipy.signal import cont2discrete
+
+from casflutter.aeroelastic import ModalStructure, analyze_response, simulate_loop
+from casflutter.errors import DimensionError
+
+from ._cases import DF2, OMEGA2, ZETA2
+
+
+class LinearARX:
+    """Test double of the HWL-ROM protocol: y_k = a1 y_{k-1} + B0 u_k + B1 u_{k-1} + e v_k."""
+
+    def __init__(self, a1, B0, B1, e, dt):
+        self.a1, self.B0, self.B1, self.e, self.dt = a1, np.asarray(B0), np.asarray(B1), np.asarray(e), dt
+        self.n_modes, self.max_lag, self.has_u, self.has_v = self.B0.shape[0], 1, True, True
+
+    def step(self, y_hist, u_hist, v_hist):
+        return self.a1 * y_hist[1] + self.B0 @ u_hist[0] + self.B1 @ u_hist[1] + self.e * v_hist[0]
+
+
+class Rayleigh:
+    """One-mode ROM with negative, cubic-saturating aerodynamic damping:
+    y = c u̇ − c3 u̇³ with u̇ ≈ (u_k − u_{k−1})/dt, plus flap effectiveness e v."""
+
+    def __init__(self, c, c3, e, dt):
+        self.c, self.c3, self.e, self.dt = c, c3, e, dt
+        self.n_modes, self.max_lag, self.has_u, self.has_v = 1, 1, True, True
+
+    def step(self, y_hist, u_hist, v_hist):
+        ud = (u_hist[0] - u_hist[1]) / self.dt
+        return self.c * ud - self.c3 * ud ** 3 + self.e * v_hist[0]
+
+
+def _sampled_loop_growth(rom, s, V):
+    """Independent growth rate: eigenvalues of the exact sampled-data loop matrix."""
+    N, nx, dt = s.n_modes, s.n_states, rom.dt
+    Ad, Bd, *_ = cont2discrete((s.As, s.Bs, np.eye(nx), np.zeros((nx, N))), dt, method="zoh")
+    Cs, V2 = s.Cs, V ** 2
+    a1 = rom.a1 * np.eye(N)
+    # z_k = [xs_k, y_{k-1}, u_{k-1}]
+    Phi = np.block([
+        [Ad + V2 * Bd @ rom.B0 @ Cs, V2 * Bd @ a1, V2 * Bd @ rom.B1],
+        [rom.B0 @ Cs, a1, rom.B1],
+        [Cs, np.zeros((N, N)), np.zeros((N, N))]])
+    return np.log(np.max(np.abs(np.linalg.eigvals(Phi)))) / dt
+
+
+@pytest.mark.parametrize("V, kind", [(1.0, "decay"), (2.2, "divergence")])
+def test_linear_double_reproduces_sampled_loop_growth_rate(V, kind):
+    dt = 2e-3
+    s = ModalStructure(OMEGA2, ZETA2, alpha=1.3)
+    rom = LinearARX(0.3, 0.7 * DF2, np.zeros((2, 2)), np.zeros(2), dt)
+    sim = simulate_loop(rom, s, V, 6000, xs0=[0.01, 0.0, 0.0, 0.05], window=0.5, blowup=1e12)
+    sigma = _sampled_loop_growth(rom, s, V)
+    assert sim.kind == kind
+    assert sim.modes.growth_rate == pytest.approx(sigma, rel=0.02, abs=0.01)
+
+
+def test_linear_double_close_to_continuous_loop_for_small_dt():
+    """The sampled-data loop approaches ΣAE(V) (static Σf = Df) as dt → 0."""
+    import control as ct
+    from casflutter.aeroelastic import AeroelasticSystem
+    s = ModalStructure(OMEGA2, ZETA2, alpha=1.3)
+    V, dt = 2.2, 1e-4
+    rom = LinearARX(0.0, DF2, np.zeros((2, 2)), np.zeros(2), dt)
+    sysae = AeroelasticSystem.from_parts(ct.ss([], [], [], DF2), s)
+    sigma_c = np.max(np.linalg.eigvals(sysae.state_matrix(V)).real)
+    assert _sampled_loop_growth(rom, s, V) == pytest.approx(sigma_c, rel=0.02)
+
+
+def _lco_case(dt=1e-3):
+    omega, zeta, alpha, V = 2 * np.pi * 5.0, 0.01, 1.0, 1.0
+    eps = 0.6  # net negative damping: c αV² − 2ζω
+    c = eps + 2 * zeta * omega
+    A_target = 0.01
+    c3 = 4 * eps / (3 * omega ** 2 * A_target ** 2)
+    s = ModalStructure([omega], [zeta], alpha=alpha, Hs=[[2.0]], sensor="displacement")
+    return s, Rayleigh(c, c3, 0.0, dt), V, omega, eps, A_target
+
+
+@pytest.mark.parametrize("u0", [0.004, 0.02])
+def test_lco_amplitude_and_frequency_match_harmonic_balance(u0):
+    """Rayleigh oscillator ü + ω²u = ε u̇ − β u̇³: harmonic balance A = √(4ε / (3 β ω²))."""
+    s, rom, V, omega, eps, A = _lco_case()
+    sim = simulate_loop(rom, s, V, 30000, xs0=[u0, 0.0], window=0.3)
+    assert sim.kind == "lco"
+    assert_allclose(sim.modes.amplitude[0], A, rtol=0.01)
+    assert_allclose(sim.sensors.amplitude[0], 2.0 * A, rtol=0.01)
+    assert_allclose(sim.modes.frequency_hz, omega / (2 * np.pi), rtol=0.005)
+    assert sim.sensors.kind == "lco"
+
+
+def test_linear_negative_damping_diverges_and_positive_decays():
+    s, rom, V, omega, eps, A = _lco_case()
+    rom.c3 = 0.0
+    sim = simulate_loop(rom, s, V, 20000, xs0=[0.01, 0.0], blowup=1.0)
+    assert sim.kind == "divergence" and sim.stopped_early
+    rom.c = 0.0
+    sim = simulate_loop(rom, s, V, 20000, xs0=[0.01, 0.0])
+    assert sim.kind == "decay"
+    assert sim.modes.growth_rate == pytest.approx(-0.01 * omega, rel=0.02)
+
+
+def test_controller_with_gain_schedule_suppresses_lco():
+    """Velocity feedback v = −k u̇ through the flap adds damping k e αV²: after the gain is
+    switched on the envelope decays at (k e − ε)/2."""
+    s, rom, V, omega, eps, A = _lco_case()
+    s = ModalStructure(s.omega, s.zeta, alpha=1.0, Hs=[[1.0]], sensor="velocity")
+    rom.e = 1.0
+    k = 2.0
+    K = control.ss([], [], [], [[-k]])
+    t_on = 15.0
+    sim = simulate_loop(rom, s, V, 30000, xs0=[0.01, 0.0], controller=K,
+                        gain=lambda t: float(t >= t_on), window=0.4)
+    assert sim.kind == "decay"
+    assert sim.modes.growth_rate == pytest.approx(-(k * rom.e - eps) / 2, rel=0.03)
+    before = analyze_response(sim.timepts[:15000], sim.u[:15000], window=0.3)
+    assert before.kind == "lco"
+    assert_allclose(sim.gain[[0, 14999, 15000, -1]], [0, 0, 1, 1])
+    assert_allclose(sim.v[16000], -k * sim.zm[16000, 0])
+
+
+def test_dimension_mismatch_names_both():
+    s = ModalStructure(OMEGA2, ZETA2)
+    rom = Rayleigh(1.0, 0.0, 0.0, 1e-3)
+    with pytest.raises(DimensionError, match=r"n_modes=1.*2 modes"):
+        simulate_loop(rom, s, 1.0, 10)
