@@ -420,7 +420,7 @@ class AeroelasticTruth(abc.ABC):
         inputs = ["v_ddot" if actuator_omega is None else "v_c"] + [f"w{i + 1}" for i in range(N)]
         outputs = [f"u{i + 1}" for i in range(N)] + list(nm["sensor_names"])
         return control.ss(A, B, C, D, states=states, inputs=inputs, outputs=outputs,
-                          name=f"{type(self).__name__}(V={V:g})")
+                          name=f"{type(self).__name__}_V{V:g}".replace(".", "p"))
 
     # ---- nonlinear simulation --------------------------------------------------------
     def simulate(self, timepts: np.ndarray, x0: np.ndarray, V: float,
