@@ -9,8 +9,8 @@ Uses python-control, slycot, numpy and scipy only; shares no code with
 
 from ._common import IllPosedError, NotHurwitzError
 from ._hinf import HinfNorm, hinf_norm, sigma_max, slycot_available
-from ._interval import (StabilityInterval, bialternate_sum, small_gain_interval,
-                        speed_interval, stability_interval)
+from ._interval import (StabilityInterval, bialternate_sum, feedback_stability_interval,
+                        small_gain_interval, speed_interval, stability_interval)
 from ._io import (PlantData, controller_from_json, controller_to_json, load_controller,
                   load_plant, plant_from_json, plant_to_json, save_json)
 from ._lft import lft_closed_loop, partition_plant
@@ -19,7 +19,7 @@ from ._report import VerificationReport, delta_family, verify_controller
 __all__ = [
     "IllPosedError", "NotHurwitzError",
     "HinfNorm", "hinf_norm", "sigma_max", "slycot_available",
-    "StabilityInterval", "bialternate_sum", "small_gain_interval", "speed_interval",
+    "StabilityInterval", "bialternate_sum", "feedback_stability_interval", "small_gain_interval", "speed_interval",
     "stability_interval",
     "PlantData", "controller_from_json", "controller_to_json", "load_controller", "load_plant",
     "plant_from_json", "plant_to_json", "save_json",

@@ -21,7 +21,7 @@ from ..errors import ConfigError, DimensionError
 from ._common import NotHurwitzError, is_hurwitz, spectral_abscissa
 
 __all__ = ["small_gain_interval", "StabilityInterval", "stability_interval",
-           "bialternate_sum", "speed_interval"]
+           "feedback_stability_interval", "bialternate_sum", "speed_interval"]
 
 
 def small_gain_interval(gamma: float, Vf: float) -> tuple[float, float]:
@@ -184,10 +184,23 @@ def stability_interval(A0: np.ndarray, A1: np.ndarray, *, nominal: float = 0.0,
     t_real = _pencil_roots(An, A1, imag_tol)
     kinds = {float(t): "complex pair" for t in t_cplx}
     kinds.update({float(t): "real through 0" for t in t_real})
+
+    def matrix(t: float) -> np.ndarray:
+        return An + t * A1
+
+    return _pick_ends(kinds, matrix, nominal, "bialternate", check_tol)
+
+
+def _pick_ends(kinds: dict[float, str], matrix, nominal: float, method: str,
+               check_tol: float) -> StabilityInterval:
+    """Nearest verified candidate on each side of 0 (candidates are offsets from
+    ``nominal``; ``matrix(t)`` is ``A(nominal + t)`` or None where the loop is ill posed)."""
     cands = np.array(sorted(kinds))
 
     def accept(t: float) -> tuple[bool, float]:
-        At = An + t * A1
+        At = matrix(t)
+        if At is None:                       # loop not well posed: a genuine end
+            return True, math.nan
         a = spectral_abscissa(At)
         return abs(a) <= check_tol * max(1.0, float(np.linalg.norm(At))), a
 
@@ -202,5 +215,98 @@ def stability_interval(A0: np.ndarray, A1: np.ndarray, *, nominal: float = 0.0,
     (tu, au, ku), (tl, al, kl) = ends["upper"], ends["lower"]
     return StabilityInterval(
         lower=nominal + tl, upper=nominal + tu, nominal=float(nominal),
-        method="bialternate", candidates=tuple(float(nominal + c) for c in cands),
+        method=method, candidates=tuple(float(nominal + c) for c in cands),
         abscissa_lower=al, abscissa_upper=au, crossing_lower=kl, crossing_upper=ku)
+
+
+def feedback_stability_interval(A: np.ndarray, B: np.ndarray, C: np.ndarray,
+                                D: np.ndarray | None = None, *, imag_tol: float = 1e-6,
+                                check_tol: float = 1e-6) -> StabilityInterval:
+    """Exact maximal interval of δ around 0 on which the loop ``w = -δ z`` closed around
+    ``(A, B, C, D)`` is well posed and stable (eq. 15 with ``δ = ΔV``).
+
+    The closed loop is ``A(δ) = A - B Φ(δ) C`` with ``Φ(δ) = δ (I + δ D)⁻¹``: affine in δ
+    when ``D = 0`` (then equal to :func:`stability_interval` with ``A1 = -B C``),
+    rational otherwise (e.g. accelerometer measurements with a controller
+    feedthrough).  Both cases are linearised exactly: an eigenvalue pair
+    ``λ_i + λ_j = 0`` means that ``A(δ) X + X A(δ)ᵀ = 0`` has an antisymmetric solution
+    ``X``; with ``Y = Φ(δ) C X`` this is ``A X + X Aᵀ - B Y + Yᵀ Bᵀ = 0`` and
+    ``Y + δ (D Y - C X) = 0``, a pencil in δ of order ``n(n-1)/2 + k n``.  A real
+    eigenvalue through 0 solves ``A x - B y = 0``, ``y + δ (D y - C x) = 0``.  Values
+    with ``det(I + δ D) = 0`` (loop not well posed) are ends as well.
+
+    Parameters
+    ----------
+    A, B, C : array_like
+        ``(n, n)``, ``(n, k)``, ``(k, n)``: the loop seen from the ΔV channel.
+    D : array_like, optional
+        ``(k, k)`` feedthrough from ``w`` to ``z`` (default 0).
+    imag_tol, check_tol : float
+        As in :func:`stability_interval`.
+
+    Returns
+    -------
+    StabilityInterval
+        ``method = "bialternate-lft"``; a crossing may also be ``"ill-posed"``.
+
+    Raises
+    ------
+    DimensionError
+        Inconsistent shapes.
+    NotHurwitzError
+        If ``A`` is not Hurwitz.
+    """
+    A = np.atleast_2d(np.asarray(A, dtype=float))
+    B = np.atleast_2d(np.asarray(B, dtype=float))
+    C = np.atleast_2d(np.asarray(C, dtype=float))
+    n = A.shape[0]
+    k = B.shape[1] if B.ndim == 2 else 0
+    D = np.zeros((k, k)) if D is None else np.atleast_2d(np.asarray(D, dtype=float))
+    if A.shape != (n, n) or B.shape != (n, k) or C.shape != (k, n) or D.shape != (k, k):
+        raise DimensionError(f"need A (n,n), B (n,k), C (k,n), D (k,k); got A{A.shape}, "
+                             f"B{B.shape}, C{C.shape}, D{D.shape}")
+    stable, alpha = is_hurwitz(A)
+    if not stable:
+        raise NotHurwitzError(
+            f"the nominal closed loop (δ = 0) is not Hurwitz (spectral abscissa "
+            f"{alpha:.6g} >= 0): there is no stability interval around it")
+    p_idx, q_idx = np.tril_indices(n, -1)
+    N2 = p_idx.size
+    size = N2 + k * n
+    N0 = np.zeros((size, size))
+    N1 = np.zeros((size, size))
+    # columns for the antisymmetric X basis
+    for col in range(N2):
+        r, s_ = p_idx[col], q_idx[col]
+        X = np.zeros((n, n))
+        X[r, s_], X[s_, r] = 1.0, -1.0
+        S = A @ X + X @ A.T
+        N0[:N2, col] = S[p_idx, q_idx]
+        N1[N2:, col] = -(C @ X).ravel()
+    # columns for Y (k x n), row-major
+    for col in range(k * n):
+        Y = np.zeros((k, n))
+        Y.flat[col] = 1.0
+        S = -B @ Y + Y.T @ B.T
+        N0[:N2, N2 + col] = S[p_idx, q_idx]
+        N0[N2:, N2 + col] = Y.ravel()
+        N1[N2:, N2 + col] = (D @ Y).ravel()
+    t_cplx = _pencil_roots(N0, N1, imag_tol)
+    R0 = np.block([[A, -B], [np.zeros((k, n)), np.eye(k)]])
+    R1 = np.block([[np.zeros((n, n)), np.zeros((n, k))], [-C, D]])
+    t_real = _pencil_roots(R0, R1, imag_tol)
+    lam = np.linalg.eigvals(D) if k else np.zeros(0)
+    lam = lam[(np.abs(lam.imag) <= imag_tol * np.abs(lam)) & (np.abs(lam) > 0)]
+    t_ill = -1.0 / lam.real
+    kinds = {float(t): "complex pair" for t in t_cplx}
+    kinds.update({float(t): "real through 0" for t in t_real})
+    kinds.update({float(t): "ill-posed" for t in t_ill})
+    eye_k = np.eye(k)
+
+    def matrix(t: float):
+        M = eye_k + t * D
+        if np.linalg.cond(M) > 1e12:
+            return None
+        return A - B @ np.linalg.solve(M, t * C)
+
+    return _pick_ends(kinds, matrix, 0.0, "bialternate-lft", check_tol)

@@ -12,9 +12,10 @@ import control
 import numpy as np
 
 from ..errors import ConfigError, DimensionError
-from ._common import IllPosedError, NotHurwitzError, SystemLike, as_statespace, is_hurwitz, ssdata
+from ._common import NotHurwitzError, SystemLike, as_statespace, is_hurwitz, ssdata
 from ._hinf import HinfNorm, hinf_norm
-from ._interval import StabilityInterval, small_gain_interval, speed_interval, stability_interval
+from ._interval import (StabilityInterval, feedback_stability_interval, small_gain_interval,
+                        speed_interval)
 from ._lft import lft_closed_loop
 
 __all__ = ["VerificationReport", "verify_controller", "delta_family"]
@@ -47,7 +48,8 @@ class VerificationReport:
     small_gain_dV_delta, small_gain_V_delta : tuple of float or None
         The same from ``hinf_delta`` (at least as large).
     exact : StabilityInterval or None
-        Exact ΔV interval of closed-loop stability, ``A(ΔV) = Acl - ΔV B_wf C_zf``.
+        Exact ΔV interval of closed-loop stability, ``A(ΔV) = Acl - ΔV B_wf C_zf`` (or its
+        rational form when ``D_zf,wf != 0``).
     exact_V : tuple of float or None
         Exact speed-index interval, ``V = sqrt(Vf² + ΔV)``, ``V ≥ 0``.
     notes : tuple of str
@@ -154,34 +156,29 @@ class VerificationReport:
         return self.format()
 
 
-def delta_family(closed_loop: control.StateSpace, n_delta: int,
-                 *, atol: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:
-    """``(A0, A1)`` with ``A(ΔV) = A0 + ΔV A1`` for the loop closed by ``wf = -ΔV zf`` (eq. 15).
+def delta_family(closed_loop: control.StateSpace, n_delta: int
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(A, B_wf, C_zf, D_zf,wf)`` of the closed loop seen from the ΔV channel (eq. 15).
 
-    ``A0 = Acl``, ``A1 = -B_wf C_zf``; affine only when the closed-loop feedthrough
-    ``D_{zf wf}`` vanishes (true for eq. 14: ``D11 = [0 Nw]`` and ``D21 = 0``).
+    Closing ``wf = -ΔV zf`` gives ``A(ΔV) = A - ΔV B_wf (I + ΔV D_zf,wf)⁻¹ C_zf``: affine
+    (``A - ΔV B_wf C_zf``) when the closed-loop feedthrough vanishes (eq. 14 with state
+    sensors: ``D11 = [0 Nw]``, ``D21 = 0``), rational otherwise (accelerometers with a
+    controller feedthrough); :func:`feedback_stability_interval` handles both.
 
     Raises
     ------
     DimensionError
         If ``n_delta`` exceeds the closed loop's inputs or outputs.
-    IllPosedError
-        If ``D_{zf wf} != 0`` (the family is rational, not affine, in ΔV).
     """
     A, B, C, D = ssdata(closed_loop)
-    if not (isinstance(n_delta, (int, np.integer)) and 0 < n_delta <= min(B.shape[1],
-                                                                           C.shape[0])):
+    k_max = min(B.shape[1], C.shape[0])
+    if isinstance(n_delta, bool) or not (isinstance(n_delta, (int, np.integer))
+                                         and 0 < n_delta <= k_max):
         raise DimensionError(
-            f"n_delta={n_delta!r} must be an integer in 1..{min(B.shape[1], C.shape[0])} "
-            f"(closed loop has {B.shape[1]} exogenous inputs, {C.shape[0]} outputs)")
-    Dff = D[:n_delta, :n_delta]
-    if np.max(np.abs(Dff), initial=0.0) > atol * max(1.0, float(np.max(np.abs(D),
-                                                                        initial=0.0))):
-        raise IllPosedError(
-            f"closed-loop feedthrough D_zf,wf is nonzero (max |entry| "
-            f"{np.max(np.abs(Dff)):.3g}): A(ΔV) = Acl - ΔV B (I + ΔV D)^-1 C is not affine "
-            "in ΔV; only D_zf,wf = 0 is supported (eq. 14 has D11 = [0 Nw], D21 = 0)")
-    return A, -B[:, :n_delta] @ C[:n_delta, :]
+            f"n_delta={n_delta!r} must be an integer in 1..{k_max} (closed loop has "
+            f"{B.shape[1]} exogenous inputs and {C.shape[0]} outputs; the first n_delta "
+            "of each are wf and zf)")
+    return A, B[:, :n_delta], C[:n_delta, :], D[:n_delta, :n_delta]
 
 
 def verify_controller(P: SystemLike, K: SystemLike, nmeas: int, ncon: int, *,
@@ -220,7 +217,7 @@ def verify_controller(P: SystemLike, K: SystemLike, nmeas: int, ncon: int, *,
     DimensionError
         Shapes of ``P`` and ``K`` that do not fit, or a bad ``n_delta``.
     IllPosedError
-        Loop not well posed, or ``D_{zf wf} != 0`` in the closed loop.
+        Loop not well posed (``I - Dk D22`` singular).
     ConfigError
         ``Vf`` without ``n_delta`` (or the reverse), or a discrete-time system.
     """
@@ -246,7 +243,7 @@ def verify_controller(P: SystemLike, K: SystemLike, nmeas: int, ncon: int, *,
     notes: list[str] = []
     extra: dict = {}
     if Vf is not None:
-        A0, A1 = delta_family(cl, n_delta)
+        Ad, Bf, Cf, Dff = delta_family(cl, n_delta)
         hinf_d = hinf_norm(cl[:n_delta, :n_delta], method=method, tol=tol)
         extra.update(Vf=float(Vf), n_delta=int(n_delta), hinf_delta=hinf_d)
         if stable:
@@ -255,11 +252,14 @@ def verify_controller(P: SystemLike, K: SystemLike, nmeas: int, ncon: int, *,
                 extra["small_gain_dV" + key] = (-r, r)
                 extra["small_gain_V" + key] = small_gain_interval(g, Vf)
             try:
-                ex = stability_interval(A0, A1, nominal=0.0)
+                ex = feedback_stability_interval(Ad, Bf, Cf, Dff)
             except NotHurwitzError as exc:  # pragma: no cover - guarded by `stable`
                 notes.append(str(exc))
             else:
                 extra.update(exact=ex, exact_V=speed_interval(ex.lower, ex.upper, Vf))
+            if np.any(Dff):
+                notes.append("closed-loop feedthrough D_zf,wf != 0: A(ΔV) is rational in "
+                             "ΔV; the exact interval uses the rational (LFT) pencil")
         else:
             notes.append("nominal closed loop is unstable (spectral abscissa "
                          f"{alpha:.6g} >= 0): gamma is infinite and no ΔV interval around "

@@ -68,3 +68,50 @@ def dense_peak(sys: control.StateSpace, npts: int = 4000) -> tuple[float, float]
         if -r.fun > best_g:
             best_g, best_w = float(-r.fun), float(r.x)
     return best_g, best_w
+
+
+# --- a two-mode wing with quasi-steady aerodynamics, written from eq. (8)-(14) -----------
+# ẍ = -K q - C q̇ + V² (Ka q + Ca q̇ + df v): bending-torsion coalescence flutter near V ≈ 1.
+
+def wing(sensor: str = "state") -> dict:
+    """Matrices of the toy wing; ``sensor`` "state" (zm = q, D21 = 0 as in eq. 14) or
+    "accel" (zm = q̈, which gives D21 = [-I 0] and D22 = Vf² Nv)."""
+    N = 2
+    K, Cd = np.diag([1.0, 4.0]), np.diag([0.04, 0.08])
+    As = np.block([[np.zeros((N, N)), np.eye(N)], [-K, -Cd]])
+    Bs = np.vstack([np.zeros((N, N)), np.eye(N)])
+    Nx = np.hstack([np.array([[0.0, 1.0], [-1.0, 1.0]]),
+                    np.array([[-0.15, 0.05], [0.02, -0.05]])])
+    Nv = np.array([[0.3], [-0.5]])
+    if sensor == "state":
+        Hx, Hf = np.hstack([np.eye(N), np.zeros((N, N))]), np.zeros((N, N))
+    else:
+        Hx, Hf = np.hstack([-K, -Cd]), np.eye(N)
+    return dict(N=N, As=As, Bs=Bs, Nx=Nx, Nv=Nv, Hx=Hx, Hf=Hf)
+
+
+def wing_plant_at(w: dict, V: float) -> control.StateSpace:
+    """ΣAE at speed index V directly (no LFT): input v, outputs zm."""
+    return control.ss(w["As"] + V**2 * w["Bs"] @ w["Nx"], V**2 * w["Bs"] @ w["Nv"],
+                      w["Hx"] + V**2 * w["Hf"] @ w["Nx"], V**2 * w["Hf"] @ w["Nv"])
+
+
+def wing_lft(w: dict, Vf: float) -> control.StateSpace:
+    """The LFT of eq. (14): inputs [wf, w, v], outputs [zf, zm]; Mx = -Bs, Nx, Nv."""
+    N, Bs, Nx, Nv, Hf = w["N"], w["Bs"], w["Nx"], w["Nv"], w["Hf"]
+    A = w["As"] + Vf**2 * Bs @ Nx
+    B = np.hstack([-Bs, Bs, Vf**2 * Bs @ Nv])
+    C = np.vstack([Nx, w["Hx"] + Vf**2 * Hf @ Nx])
+    D = np.block([[np.zeros((N, 2 * N)), Nv], [-Hf, np.zeros((N, N)), Vf**2 * Hf @ Nv]])
+    return control.ss(A, B, C, D)
+
+
+def lqg_controller(P: control.StateSpace, Dk: np.ndarray) -> control.StateSpace:
+    """Observer-based controller u = -Kc x̂ + Dk y (positive-feedback convention u = K y)."""
+    A, B, C, D = (np.asarray(M, float) for M in (P.A, P.B, P.C, P.D))
+    n = A.shape[0]
+    Kc, _, _ = control.lqr(A, B, np.eye(n), np.eye(B.shape[1]))
+    L, _, _ = control.lqe(A, np.eye(n), C, np.eye(n), 0.1 * np.eye(C.shape[0]))
+    Ak = A - L @ C - (B - L @ D) @ Kc
+    Bk = L + (B - L @ D) @ Dk
+    return control.ss(Ak, Bk, -Kc, Dk)
