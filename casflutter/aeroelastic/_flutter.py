@@ -131,7 +131,8 @@ def origin_modes(tracking: EigenTracking, *, mode_states=None, omega=None) -> np
     :attr:`AeroelasticSystem.mode_states`, states ``[u_i, u̇_i]``), the branch's right
     eigenvector at ``V[0]`` is split into per-mode energies ``ω_i² |x_u|² + |x_u̇|²``
     (the two-state form; a plain squared norm otherwise) and the mode with the largest
-    energy is the origin.  Otherwise, with ``omega`` (natural frequencies), the mode whose
+    energy is the origin; a branch whose eigenvector has less than half of its squared
+    norm in the structural states (an aerodynamic-lag branch of Σf) gets -1.  Otherwise, with ``omega`` (natural frequencies), the mode whose
     ω_i is nearest to |λ| in relative terms is the origin.  Returns -1 for every branch
     when neither is given.
     """
@@ -147,7 +148,9 @@ def origin_modes(tracking: EigenTracking, *, mode_states=None, omega=None) -> np
             if om is not None and idx.size == 2:
                 comp = comp * np.array([[om[i] ** 2], [1.0]])
             E[i] = comp.sum(axis=0)
-        return np.argmax(E, axis=0).astype(int)
+        idx_all = np.concatenate([np.asarray(i) for i in mode_states])
+        share = (np.abs(vec0[idx_all, :]) ** 2).sum(axis=0) / (np.abs(vec0) ** 2).sum(axis=0)
+        return np.where(share >= 0.5, np.argmax(E, axis=0), -1).astype(int)
     if omega is not None:
         om = np.asarray(omega, dtype=float)
         rel = np.abs(np.abs(lam0)[None, :] - om[:, None]) / om[:, None]

@@ -43,8 +43,8 @@ def plot_vg_vf(result, *, branches=None, hz: bool = True, ax=None) -> Figure:
     freq = tr.frequency_hz if hz else tr.frequency
     for b in bs:
         lab = f"branch {b}"
-        if res is not None and res.origin[b] >= 0:
-            lab += f" (mode {res.origin[b] + 1})"
+        if res is not None:
+            lab += f" (mode {res.origin[b] + 1})" if res.origin[b] >= 0 else " (aero)"
         line, = ag.plot(tr.V, tr.damping_ratio[:, b], label=lab)
         af.plot(tr.V, np.abs(freq[:, b]), color=line.get_color())
     ag.axhline(0.0, color="k", lw=0.8)

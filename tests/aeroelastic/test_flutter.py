@@ -123,6 +123,8 @@ def test_origin_mode_of_binary_flutter_by_participation_and_frequency_agree():
     res_w = find_flutter(sysae.state_matrix, (0.0, 3.0), n_grid=31, omega=sysae.structure.omega)
     assert res_p.flutter_mode in (0, 1)
     assert res_p.flutter_mode == res_w.flutter_mode
+    up = res_p.tracking.upper_branches()  # two aerodynamic lags (real) and two structural pairs
+    assert sorted(res_p.origin[up]) == [-1, -1, 0, 1]
     assert_allclose(res_p.Vf, res_w.Vf, rtol=1e-10)
 
 
