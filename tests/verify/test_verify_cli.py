@@ -1,0 +1,97 @@
+"""JSON round trips and the ``casflutter verify`` command (on temp files and on a
+COMPleib plant copied into tests/verify/data)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import control
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from casflutter.cli import main
+from casflutter.errors import DataError, DimensionError
+from casflutter.verify import (controller_from_json, controller_to_json, load_plant,
+                               plant_from_json, plant_to_json, save_json, verify_controller)
+from verify_helpers import dense_peak, lqg_controller, wing, wing_lft, wing_plant_at
+
+DATA = Path(__file__).parent / "data"
+
+
+def test_plant_and_controller_round_trip(tmp_path):
+    P = wing_lft(wing("accel"), 1.0)
+    d = json.loads(json.dumps(plant_to_json(P, 2, 1, Vf=1.0, n_delta=2, name="toy")))
+    back = plant_from_json(d)
+    assert (back.nmeas, back.ncon, back.Vf, back.n_delta, back.name) == (2, 1, 1.0, 2, "toy")
+    for a, b in zip((P.A, P.B, P.C, P.D), (back.sys.A, back.sys.B, back.sys.C, back.sys.D)):
+        assert_allclose(np.asarray(b), np.asarray(a), rtol=0, atol=0)
+    # static gain: 0 states survive the round trip
+    Ks = controller_from_json(json.loads(json.dumps(controller_to_json(np.array([[1.0, -2.0]])))))
+    assert Ks.nstates == 0 and Ks.ninputs == 2 and Ks.noutputs == 1
+    # hand-written static controller with D only
+    assert controller_from_json({"D": [[0.5, 0.5]]}).nstates == 0
+    with pytest.raises(DimensionError, match="inconsistent shapes"):
+        controller_from_json({"A": [[1.0]], "B": [[1.0, 2.0]], "C": [[1.0], [2.0]],
+                              "D": [[0.0]]})
+    with pytest.raises(DataError, match="'D' is missing"):
+        controller_from_json({"A": [[1.0]]})
+
+
+def test_compleib_plant_is_partitioned_from_the_file():
+    raw = json.loads((DATA / "AC4.json").read_text())
+    pd_ = load_plant(DATA / "AC4.json")
+    assert pd_.source_format == "compleib"
+    assert (pd_.nmeas, pd_.ncon) == (raw["ny"], raw["nu"])
+    assert pd_.sys.ninputs == raw["nw"] + raw["nu"] and pd_.sys.noutputs == raw["nz"] + raw["ny"]
+    assert_allclose(np.asarray(pd_.sys.B)[:, raw["nw"]:], raw["B"])
+    assert_allclose(np.asarray(pd_.sys.C)[raw["nz"]:], raw["C"])
+    assert_allclose(np.asarray(pd_.sys.D)[:raw["nz"], :raw["nw"]], raw["D11"])
+
+
+def test_cli_on_compleib_plant_json_output(tmp_path, capsys):
+    pd_ = load_plant(DATA / "AC4.json")
+    A, B, C = (np.asarray(M) for M in (pd_.sys.A, pd_.sys.B, pd_.sys.C))
+    P22 = control.ss(A, B[:, -1:], C[-2:], np.zeros((2, 1)))
+    K = lqg_controller(P22, np.zeros((1, 2)))
+    save_json(controller_to_json(K), tmp_path / "K.json")
+    rc = main(["verify", str(DATA / "AC4.json"), str(tmp_path / "K.json"), "--json",
+               "--method", "scipy"])
+    assert rc == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["stable"] is True and out["hinf"]["method"] == "scipy"
+    ref = verify_controller(pd_.sys, K, 2, 1, method="scipy")
+    assert_allclose(out["hinf"]["gamma"], ref.gamma, rtol=1e-12)
+    assert_allclose(out["hinf"]["gamma"], dense_peak(ref.closed_loop)[0], rtol=1e-6)
+    # no controller order beats the full-order optimum of reference.json (0.55919, LMI)
+    assert out["hinf"]["gamma"] >= 0.55919 * (1 - 1e-4)
+
+
+def test_cli_text_report_with_delta_channel(tmp_path, capsys):
+    w = wing("state")
+    K = lqg_controller(wing_plant_at(w, 1.0), np.zeros((1, 2)))
+    save_json(plant_to_json(wing_lft(w, 1.0), 2, 1, Vf=1.0, n_delta=2), tmp_path / "P.json")
+    save_json(controller_to_json(K), tmp_path / "K.json")
+    assert main(["verify", str(tmp_path / "P.json"), str(tmp_path / "K.json")]) == 0
+    text = capsys.readouterr().out
+    ref = verify_controller(wing_lft(w, 1.0), K, 2, 1, Vf=1.0, n_delta=2)
+    assert text.strip() == ref.format().strip()
+    assert "exact stability" in text and f"{ref.exact_V[1]:.6g}" in text
+
+
+def test_cli_errors_exit_with_code_1(tmp_path, capsys):
+    save_json({"D": [[0.0, 0.0]]}, tmp_path / "K.json")
+    assert main(["verify", str(tmp_path / "missing.json"), str(tmp_path / "K.json")]) == 1
+    assert "file not found" in capsys.readouterr().err
+    w = wing("state")
+    save_json(plant_to_json(wing_lft(w, 1.0), 2, 1), tmp_path / "P.json")
+    assert main(["verify", str(tmp_path / "P.json"), str(tmp_path / "K.json"),
+                 "--vf", "1.0"]) == 1
+    assert "--n-delta" in capsys.readouterr().err
+    # unstable loop (K = 0 above flutter): reported, exit 0, gamma inf
+    assert main(["verify", str(tmp_path / "P.json"), str(tmp_path / "K.json"), "--vf", "1.0",
+                 "--n-delta", "2", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["stable"] is False and out["hinf"]["gamma"] == "inf" and out["exact_V"] is None
