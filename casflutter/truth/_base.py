@@ -268,8 +268,11 @@ class AeroelasticTruth(abc.ABC):
         The flow is at rest before ``timepts[0]`` (Wagner lag states start at zero).
 
         Derivatives not passed are taken from a quintic interpolating spline of the samples
-        (exact for the interpolant; ``O(dt^4)`` for ``u''``); the Jones lag states are then
-        integrated exactly for the cubic Hermite interpolant of their input.
+        (exact for the interpolant; ``O(dt^4)`` for ``u''`` away from the first and last
+        few samples, where the spline's end conditions lose accuracy: pass exact derivatives
+        or discard ~10 samples at each end); the Jones lag states are then integrated
+        exactly for the cubic Hermite interpolant of their input.  Sample finely enough to
+        resolve the highest modal frequency excited (``omega dt`` well below 1).
 
         Parameters
         ----------
