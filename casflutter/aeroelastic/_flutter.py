@@ -15,7 +15,7 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
+from scipy.optimize import brentq, linear_sum_assignment
 
 from ..errors import ConfigError
 from ._tracking import (EigenTracking, as_matrix_fn, eig_sorted_by_reference,
@@ -131,8 +131,10 @@ def origin_modes(tracking: EigenTracking, *, mode_states=None, omega=None) -> np
     :attr:`AeroelasticSystem.mode_states`, states ``[u_i, u̇_i]``), the branch's right
     eigenvector at ``V[0]`` is split into per-mode energies ``ω_i² |x_u|² + |x_u̇|²``
     (the two-state form; a plain squared norm otherwise) and the mode with the largest
-    energy is the origin; a branch whose eigenvector has less than half of its squared
-    norm in the structural states (an aerodynamic-lag branch of Σf) gets -1.  Otherwise, with ``omega`` (natural frequencies), the mode whose
+    energy fraction (relative to the whole eigenvector, the non-structural states counted
+    by their squared magnitude) is attributed to it, exactly two branches per mode (the
+    assignment maximising the total fraction, :func:`scipy.optimize.linear_sum_assignment`);
+    the remaining branches (aerodynamic lags of Σf) get -1.  Otherwise, with ``omega`` (natural frequencies), the mode whose
     ω_i is nearest to |λ| in relative terms is the origin.  Returns -1 for every branch
     when neither is given.
     """
@@ -149,8 +151,14 @@ def origin_modes(tracking: EigenTracking, *, mode_states=None, omega=None) -> np
                 comp = comp * np.array([[om[i] ** 2], [1.0]])
             E[i] = comp.sum(axis=0)
         idx_all = np.concatenate([np.asarray(i) for i in mode_states])
-        share = (np.abs(vec0[idx_all, :]) ** 2).sum(axis=0) / (np.abs(vec0) ** 2).sum(axis=0)
-        return np.where(share >= 0.5, np.argmax(E, axis=0), -1).astype(int)
+        rest = np.ones(vec0.shape[0], dtype=bool)
+        rest[idx_all] = False
+        frac = E / (E.sum(axis=0) + (np.abs(vec0[rest, :]) ** 2).sum(axis=0))
+        # two branches (a conjugate pair, or two real roots) per structural mode
+        rows, cols = linear_sum_assignment(-np.repeat(frac, 2, axis=0))
+        out = -np.ones(nb, dtype=int)
+        out[cols] = rows // 2
+        return out
     if omega is not None:
         om = np.asarray(omega, dtype=float)
         rel = np.abs(np.abs(lam0)[None, :] - om[:, None]) / om[:, None]

@@ -133,3 +133,23 @@ def test_bad_ranges():
         find_flutter(_analytic_blocks, (2.0, 1.0))
     with pytest.raises(ConfigError):
         track_eigenvalues(_analytic_blocks, [0.0, 0.0, 1.0])
+
+
+def test_truth_typical_section_hp1_published_values():
+    """Hodges & Pierce HP-1 typical section (truth simulator's own state_matrix, Jones
+    aerodynamics): published V_F = 2.170, Ω_F/ω_θ = 0.644 (rtol 0.005) and the analytic
+    divergence speed √(μ r²/(1 + 2a)) = √8."""
+    truth = pytest.importorskip("casflutter.truth")
+    m = truth.load_problem("typical_section")
+    ref = truth.problem_definition("typical_section")["reference"]
+    N = m.n_modes
+    res = find_flutter(m, (0.05, 3.2), n_grid=64, mode_states=[[i, N + i] for i in range(N)],
+                       omega=m.modal_structure().omega)
+    assert res.status == "flutter"
+    assert_allclose(res.Vf, ref["jones"]["flutter_speed"], rtol=ref["jones"]["rtol"])
+    assert_allclose(res.omega_f, ref["jones"]["flutter_frequency_ratio"], rtol=ref["jones"]["rtol"])
+    assert_allclose(res.divergence.V, np.sqrt(8.0), rtol=1e-8)
+    by_freq = find_flutter(m.state_matrix, (0.05, 3.2), n_grid=64, omega=m.modal_structure().omega)
+    assert res.flutter_mode == by_freq.flutter_mode == 1  # the pitch mode (nearest-frequency check)
+    Vb = spectral_abscissa_bisection(m.state_matrix, 0.05, 2.5)
+    assert_allclose(res.Vf, Vb, rtol=1e-8)
