@@ -22,7 +22,7 @@ and ``y`` is what :meth:`AeroelasticTruth.aero_forces` returns for prescribed ``
 from __future__ import annotations
 
 import abc
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import control
 import numpy as np

@@ -195,6 +195,7 @@ class GolandWing(AeroelasticTruth):
 
     @property
     def alpha(self) -> float:
+        """Flow constant of eq. (6): ``omega_ref^2 / (pi mu)``, so ``alpha V^2 = rho U^2 / m``."""
         p = self.params
         return p.omega_ref ** 2 / (np.pi * p.mu)
 

@@ -107,6 +107,7 @@ class TypicalSection(AeroelasticTruth):
 
     @property
     def alpha(self) -> float:
+        """Flow constant of eq. (6): ``omega_theta^2 / (pi mu)``."""
         return self.params.omega_theta ** 2 / (np.pi * self.params.mu)
 
     def airspeed_ratio(self, V: float) -> float:
