@@ -153,3 +153,19 @@ def test_truth_typical_section_hp1_published_values():
     assert res.flutter_mode == by_freq.flutter_mode == 1  # the pitch mode (nearest-frequency check)
     Vb = spectral_abscissa_bisection(m.state_matrix, 0.05, 2.5)
     assert_allclose(res.Vf, Vb, rtol=1e-8)
+
+
+def test_truth_goland_wing_tracking_agrees_with_bisection():
+    """30-state Goland wing (7 modes, Jones lags): tracked Vf equals the independent
+    spectral-abscissa bisection to 1e-8; the critical branch comes from the first torsion mode."""
+    truth = pytest.importorskip("casflutter.truth")
+    m = truth.load_problem("goland")
+    ms = m.modal_structure()
+    N = m.n_modes
+    res = find_flutter(m, (0.05, 6.0), n_grid=120, mode_states=[[i, N + i] for i in range(N)],
+                       omega=ms.omega)
+    assert res.status == "flutter" and res.flutter.converged
+    Vb = spectral_abscissa_bisection(m.state_matrix, 0.05, res.flutter.bracket[1])
+    assert_allclose(res.Vf, Vb, rtol=1e-8)
+    assert ms.mode_names[res.flutter_mode] == "torsion 1"
+    assert [c.V for c in res.crossings] == sorted(c.V for c in res.crossings)
