@@ -19,7 +19,8 @@ from ._report import VerificationReport, delta_family, verify_controller
 __all__ = [
     "IllPosedError", "NotHurwitzError",
     "HinfNorm", "hinf_norm", "sigma_max", "slycot_available",
-    "StabilityInterval", "bialternate_sum", "feedback_stability_interval", "small_gain_interval", "speed_interval",
+    "StabilityInterval", "bialternate_sum", "feedback_stability_interval",
+    "small_gain_interval", "speed_interval",
     "stability_interval",
     "PlantData", "controller_from_json", "controller_to_json", "load_controller", "load_plant",
     "plant_from_json", "plant_to_json", "save_json",

@@ -156,8 +156,12 @@ def _hinf_slycot(A, B, C, D, tol):
     slycot = importlib.import_module("slycot")
     n, m, p = A.shape[0], B.shape[1], C.shape[0]
     jobd = "Z" if not np.any(D) else "D"
-    gpeak, fpeak = slycot.ab13dd("C", "I", "S", jobd, n, m, p, A.copy(), np.eye(n),
-                                 B.copy(), C.copy(), D.copy(), tol)
+    try:
+        gpeak, fpeak = slycot.ab13dd("C", "I", "S", jobd, n, m, p, A.copy(), np.eye(n),
+                                     B.copy(), C.copy(), D.copy(), tol)
+    except Exception as exc:  # slycot raises its own SlycotError hierarchy
+        raise ConvergenceError(f"slycot ab13dd failed ({exc}); try method='scipy'",
+                               result=exc) from exc
     return float(gpeak), float(fpeak)
 
 

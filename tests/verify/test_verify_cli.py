@@ -4,7 +4,6 @@ COMPleib plant copied into tests/verify/data)."""
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import control

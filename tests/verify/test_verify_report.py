@@ -90,7 +90,8 @@ def test_random_rational_feedback_family_matches_sweep():
     n, k = 6, 2
     A = rng.standard_normal((n, n))
     A -= (np.max(np.linalg.eigvals(A).real) + 0.5) * np.eye(n)
-    B, C, D = rng.standard_normal((n, k)), rng.standard_normal((k, n)), 0.5 * rng.standard_normal((k, k))
+    B, C = rng.standard_normal((n, k)), rng.standard_normal((k, n))
+    D = 0.5 * rng.standard_normal((k, k))
     si = feedback_stability_interval(A, B, C, D)
 
     def ok(d):

@@ -1,5 +1,6 @@
-"""Helpers for the verification tests (imported by the test modules): seeded random systems and an independent dense
-frequency sweep (python-control's own frequency evaluation + scipy local refinement)."""
+"""Helpers for the verification tests (imported by the test modules): seeded random
+systems, an independent dense frequency sweep (python-control's own frequency evaluation
+with scipy local refinement) and a toy wing LFT written from eq. (8)-(14)."""
 
 from __future__ import annotations
 
