@@ -257,8 +257,8 @@ class AeroelasticTruth(abc.ABC):
             raise ConfigError(f"speed index V must be positive and finite, got {V}")
         return V
 
-    def aero_forces(self, timepts: np.ndarray, u: np.ndarray, v: np.ndarray | None = None,
-                    V: float = 1.0, *, udot: np.ndarray | None = None,
+    def aero_forces(self, timepts: np.ndarray, u: np.ndarray, v: np.ndarray | None,
+                    V: float, *, udot: np.ndarray | None = None,
                     uddot: np.ndarray | None = None, vdot: np.ndarray | None = None,
                     vddot: np.ndarray | None = None) -> np.ndarray:
         """Generalised aerodynamic forces ``y`` for prescribed modal motion and flap.
@@ -280,8 +280,8 @@ class AeroelasticTruth(abc.ABC):
             ``(K,)`` uniformly spaced sample times [time unit of the problem].
         u : numpy.ndarray
             ``(K, N)`` modal displacements.
-        v : numpy.ndarray, optional
-            ``(K,)`` flap angle [rad]; zero if omitted.
+        v : numpy.ndarray or None
+            ``(K,)`` flap angle [rad]; ``None`` for no flap motion.
         V : float
             Speed index (see ``modal_structure().speed_index``).
         udot, uddot, vdot, vddot : numpy.ndarray, optional

@@ -332,11 +332,11 @@ def test_aero_forces_bad_input():
     m = TypicalSection()
     t = np.arange(0, 1, 0.1)
     with pytest.raises(DimensionError, match=r"\(K, N\)"):
-        m.aero_forces(t, np.zeros((10, 3)), V=1.0)
+        m.aero_forces(t, np.zeros((10, 3)), None, 1.0)
     with pytest.raises(DataError, match="uniformly spaced"):
-        m.aero_forces(t ** 2, np.zeros((10, 2)), V=1.0)
+        m.aero_forces(t ** 2, np.zeros((10, 2)), None, 1.0)
     with pytest.raises(ConfigError, match="positive"):
-        m.aero_forces(t, np.zeros((10, 2)), V=0.0)
+        m.aero_forces(t, np.zeros((10, 2)), None, 0.0)
 
 
 def test_flap_driven_simulation_statespace_and_aero_forces_agree():
