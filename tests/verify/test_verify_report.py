@@ -145,3 +145,18 @@ def test_argument_errors():
                           Vf=1.0, n_delta=9)
     with pytest.raises(DimensionError, match="controller K has 2 outputs x 2 inputs"):
         verify_controller(P, np.zeros((2, 2)), 2, 1)
+
+
+def test_report_without_slycot_matches_report_with_it(monkeypatch):
+    """"auto" falls back to the scipy branch when slycot is absent; same numbers."""
+    import sys
+
+    w = wing("accel")
+    K = lqg_controller(wing_plant_at(w, VF), np.array([[0.05, -0.03]]))
+    with_default = verify_controller(wing_lft(w, VF), K, 2, 1, Vf=VF, n_delta=2)
+    monkeypatch.setitem(sys.modules, "slycot", None)
+    without = verify_controller(wing_lft(w, VF), K, 2, 1, Vf=VF, n_delta=2)
+    assert without.hinf.method == "scipy" and without.hinf_delta.method == "scipy"
+    assert_allclose(without.gamma, with_default.gamma, rtol=1e-8)
+    assert_allclose(without.small_gain_V_delta, with_default.small_gain_V_delta, rtol=1e-8)
+    assert without.exact_V == with_default.exact_V
