@@ -1,0 +1,1 @@
+"""Tests of the truth simulators (casflutter.truth) and the problems listing."""
