@@ -14,7 +14,8 @@ from ._interval import (StabilityInterval, bialternate_sum, feedback_stability_i
 from ._io import (PlantData, controller_from_json, controller_to_json, load_controller,
                   load_plant, plant_from_json, plant_to_json, save_json)
 from ._lft import lft_closed_loop, partition_plant
-from ._report import VerificationReport, delta_family, verify_controller
+from ._report import VerificationReport, delta_family, verify_controller, verify_lft
+from ._sweep import SpeedSweep, speed_sweep
 
 __all__ = [
     "IllPosedError", "NotHurwitzError",
@@ -25,5 +26,6 @@ __all__ = [
     "PlantData", "controller_from_json", "controller_to_json", "load_controller", "load_plant",
     "plant_from_json", "plant_to_json", "save_json",
     "lft_closed_loop", "partition_plant",
-    "VerificationReport", "delta_family", "verify_controller",
+    "VerificationReport", "delta_family", "verify_controller", "verify_lft",
+    "SpeedSweep", "speed_sweep",
 ]

@@ -8,6 +8,9 @@
   ``det(2A(δ) ⊙ I) = 0`` (a complex pair, λ_i + λ_j = 0) or ``det A(δ) = 0`` (a real
   eigenvalue through 0).  ``2A ⊙ I`` (the bialternate sum, order n(n-1)/2) is linear in
   ``A``, so the candidates are eigenvalues of two generalised pencils.
+* :func:`feedback_stability_interval`: the same for the loop ``wf = -δ zf`` closed around
+  a system with feedthrough (eq. 15), where ``A(δ)`` is rational in δ; linearised
+  exactly by a Sylvester-operator pencil of order ``n(n-1)/2 + k n``.
 """
 
 from __future__ import annotations

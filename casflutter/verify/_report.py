@@ -18,7 +18,7 @@ from ._interval import (StabilityInterval, feedback_stability_interval, small_ga
                         speed_interval)
 from ._lft import lft_closed_loop
 
-__all__ = ["VerificationReport", "verify_controller", "delta_family"]
+__all__ = ["VerificationReport", "verify_controller", "verify_lft", "delta_family"]
 
 
 @dataclass(frozen=True)
@@ -269,3 +269,22 @@ def verify_controller(P: SystemLike, K: SystemLike, nmeas: int, ncon: int, *,
                      "the H-inf norm is infinite")
     return VerificationReport(closed_loop=cl, poles=poles, stable=stable,
                               spectral_abscissa=alpha, hinf=hinf, notes=tuple(notes), **extra)
+
+
+def verify_lft(lft, K: SystemLike, *, method: str = "auto",
+               tol: float = 1e-10) -> VerificationReport:
+    """:func:`verify_controller` for an object that carries its partition, such as
+    :class:`casflutter.aeroelastic.AeroelasticLFT` (attributes ``P``, ``nmeas``,
+    ``ncon``, ``Vf``, ``n_delta``; duck-typed).
+
+    Raises
+    ------
+    ConfigError
+        If an attribute is missing.
+    """
+    missing = [a for a in ("P", "nmeas", "ncon", "Vf", "n_delta") if not hasattr(lft, a)]
+    if missing:
+        raise ConfigError(f"{type(lft).__name__} lacks {missing}; pass the plant and its "
+                          "partition to verify_controller(P, K, nmeas, ncon, Vf=, n_delta=)")
+    return verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=lft.Vf, n_delta=lft.n_delta,
+                             method=method, tol=tol)

@@ -160,3 +160,29 @@ def test_report_without_slycot_matches_report_with_it(monkeypatch):
     assert_allclose(without.gamma, with_default.gamma, rtol=1e-8)
     assert_allclose(without.small_gain_V_delta, with_default.small_gain_V_delta, rtol=1e-8)
     assert without.exact_V == with_default.exact_V
+
+
+@pytest.mark.parametrize("sensor,Dk", [("state", np.zeros((1, 2))),
+                                       ("accel", np.array([[0.05, -0.03]]))])
+def test_speed_sweep_poles_equal_direct_assembly_and_bracket_exact_interval(sensor, Dk):
+    from types import SimpleNamespace
+
+    from casflutter.verify import speed_sweep, verify_lft
+
+    w = wing(sensor)
+    K = lqg_controller(wing_plant_at(w, VF), Dk)
+    P = wing_lft(w, VF)
+    Vgrid = np.linspace(0.0, 3.0, 301)
+    sw = speed_sweep(P, K, 2, 1, Vf=VF, n_delta=2, V=Vgrid)
+    for i in (0, 57, 150, 299):
+        direct = np.linalg.eigvals(control.feedback(wing_plant_at(w, Vgrid[i]), K, sign=1).A)
+        assert_allclose(np.sort_complex(sw.poles[i]), np.sort_complex(direct), rtol=1e-8,
+                        atol=1e-9)
+    r = verify_lft(SimpleNamespace(P=P, nmeas=2, ncon=1, Vf=VF, n_delta=2), K)
+    lo, hi = r.exact_V
+    inside = (Vgrid > lo) & (Vgrid < hi)
+    assert np.all(sw.stable[inside])
+    # the first grid point above the upper end is unstable
+    assert not sw.stable[np.argmax(Vgrid >= hi)]
+    with pytest.raises(ConfigError, match="lacks"):
+        verify_lft(SimpleNamespace(P=P), K)
