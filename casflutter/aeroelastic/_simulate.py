@@ -21,7 +21,8 @@ state evolves whatever the gain ``g(t)`` (paper Fig. 11 ramps g from 0 to 1).
 
 Classification
 --------------
-From the envelope (peaks of |x|) of the last ``window`` fraction of the record:
+From the envelope (half swings maximum → minimum, see :func:`envelope_growth_rate`) of
+the last ``window`` fraction of the record:
 the growth rate σ is the slope of log-envelope against time; with ``r = σ T_window``,
 ``r < −tol`` is a decay, ``r > tol`` a divergence, otherwise a limit-cycle oscillation
 (LCO).  A non-finite or blown-up record is a divergence; a record that has fallen
@@ -147,21 +148,30 @@ def _signal(sig, n: int, dt: float, width: int | None, name: str) -> np.ndarray:
 
 
 def envelope_growth_rate(timepts, x) -> float:
-    """Growth rate σ [1/s] of the envelope of a scalar record (slope of log peaks of |x|).
+    """Growth rate σ [1/s] of the envelope of a scalar record.
 
-    Falls back on a fit of log|x| when fewer than three peaks exist.
+    The envelope is half the swing from each local maximum to the next local minimum
+    (insensitive to a static offset), placed at the mid time; σ is the slope of its
+    logarithm.  Falls back on a fit of log|x| when fewer than three swings exist
+    (non-oscillatory records).
     """
     t, x = np.asarray(timepts, dtype=float), np.asarray(x, dtype=float)
-    a = np.abs(x - 0.0)
-    pk, _ = find_peaks(a)
-    if pk.size >= 3:
-        tt, yy = t[pk], np.log(np.maximum(a[pk], 1e-300))
-    else:
-        keep = a > 0
-        if keep.sum() < 2:
-            return -np.inf
-        tt, yy = t[keep], np.log(a[keep])
-    return float(np.polyfit(tt, yy, 1)[0])
+    mx, _ = find_peaks(x)
+    mn, _ = find_peaks(-x)
+    if mx.size >= 3 and mn.size >= 3:
+        j = np.searchsorted(mn, mx)
+        ok = j < mn.size
+        i_max, i_min = mx[ok], mn[j[ok]]
+        half = 0.5 * (x[i_max] - x[i_min])
+        keep = half > 0
+        if keep.sum() >= 3:
+            tt = 0.5 * (t[i_max] + t[i_min])[keep]
+            return float(np.polyfit(tt, np.log(half[keep]), 1)[0])
+    a = np.abs(x)
+    keep = a > 0
+    if keep.sum() < 2:
+        return -np.inf
+    return float(np.polyfit(t[keep], np.log(a[keep]), 1)[0])
 
 
 def dominant_frequency(timepts, x) -> tuple[float, np.ndarray, np.ndarray]:

@@ -59,7 +59,7 @@ def test_linear_double_reproduces_sampled_loop_growth_rate(V, kind):
     sim = simulate_loop(rom, s, V, 6000, xs0=[0.01, 0.0, 0.0, 0.05], window=0.5, blowup=1e12)
     sigma = _sampled_loop_growth(rom, s, V)
     assert sim.kind == kind
-    assert sim.modes.growth_rate == pytest.approx(sigma, rel=0.02, abs=0.01)
+    assert sim.modes.growth_rate == pytest.approx(sigma, rel=5e-3)
 
 
 def test_linear_double_close_to_continuous_loop_for_small_dt():
@@ -90,10 +90,21 @@ def test_lco_amplitude_and_frequency_match_harmonic_balance(u0):
     s, rom, V, omega, eps, A = _lco_case()
     sim = simulate_loop(rom, s, V, 30000, xs0=[u0, 0.0], window=0.3)
     assert sim.kind == "lco"
-    assert_allclose(sim.modes.amplitude[0], A, rtol=0.01)
-    assert_allclose(sim.sensors.amplitude[0], 2.0 * A, rtol=0.01)
-    assert_allclose(sim.modes.frequency_hz, omega / (2 * np.pi), rtol=0.005)
+    # harmonic balance is exact to O((ε/ω)²) ≈ 4e-4 here; sampling adds O((ω dt)²) ≈ 1e-3
+    assert_allclose(sim.modes.amplitude[0], A, rtol=2e-3)
+    assert_allclose(sim.sensors.amplitude[0], 2.0 * A, rtol=2e-3)
+    assert_allclose(sim.modes.frequency_hz, omega / (2 * np.pi), rtol=2e-3)
     assert sim.sensors.kind == "lco"
+
+
+def test_lco_about_a_static_flap_offset():
+    """A held flap v0 shifts the mean by αV²e v0/ω² but leaves the LCO unchanged."""
+    s, rom, V, omega, eps, A = _lco_case()
+    rom.e, v0 = 1.0, 5.0
+    sim = simulate_loop(rom, s, V, 30000, xs0=[0.004, 0.0], v=np.full(30000, v0))
+    assert sim.kind == "lco"
+    assert_allclose(sim.modes.amplitude[0], A, rtol=2e-3)
+    assert_allclose(sim.u[-9000:, 0].mean(), v0 / omega ** 2, rtol=0.02)
 
 
 def test_linear_negative_damping_diverges_and_positive_decays():
