@@ -311,6 +311,9 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
         if controller.ninputs != m or controller.noutputs != 1:
             raise DimensionError(f"the controller has {controller.ninputs} inputs and "
                                  f"{controller.noutputs} outputs; it needs {m} inputs (sensors) and 1 output (flap)")
+        if controller.dt not in (0, None) and not np.isclose(controller.dt, dt):
+            raise ConfigError(f"the discrete controller has dt={controller.dt} but the ROM has "
+                              f"dt={dt}; give a continuous controller or one sampled at the ROM's dt")
         Kd = control.sample_system(controller, dt, method="zoh") if controller.dt == 0 else controller
         Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (Kd.A, Kd.B, Kd.C, Kd.D))
         xk = np.zeros(Ak.shape[0])

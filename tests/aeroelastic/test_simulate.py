@@ -130,7 +130,7 @@ def test_controller_with_gain_schedule_suppresses_lco():
     sim = simulate_loop(rom, s, V, 30000, xs0=[0.01, 0.0], controller=K,
                         gain=lambda t: float(t >= t_on), window=0.4)
     assert sim.kind == "decay"
-    assert sim.modes.growth_rate == pytest.approx(-(k * rom.e - eps) / 2, rel=0.03)
+    assert sim.modes.growth_rate == pytest.approx(-(k * rom.e - eps) / 2, rel=5e-3)
     before = analyze_response(sim.timepts[:15000], sim.u[:15000], window=0.3)
     assert before.kind == "lco"
     assert_allclose(sim.gain[[0, 14999, 15000, -1]], [0, 0, 1, 1])
