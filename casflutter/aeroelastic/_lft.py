@@ -79,6 +79,30 @@ class AeroelasticLFT:
     ncon: int
     sensor: str
 
+    def plant_without_d22(self) -> control.StateSpace:
+        """``P`` with ``D22 = 0`` (loop shifting), for syntheses that require it.
+
+        Accelerometers with a flap feed-through give ``D22 = Vf² α Hs df ≠ 0``.  Design a
+        controller K̃ on the shifted measurement ``z̃m = zm − D22 v`` with this plant, then
+        use :meth:`physical_controller` to get the K that acts on the real ``zm``.
+        """
+        D = np.array(self.P.D, dtype=float)
+        D[-self.nmeas:, -self.ncon:] = 0.0
+        return control.ss(self.P.A, self.P.B, self.P.C, D, inputs=self.P.input_labels,
+                          outputs=self.P.output_labels, name="Sigma_AE_LFT_shifted")
+
+    def physical_controller(self, K_shifted) -> control.StateSpace:
+        """Controller on the real sensors from one designed on :meth:`plant_without_d22`.
+
+        With ``v = K̃ (zm − D22 v)``: ``K = (I + K̃ D22)⁻¹ K̃`` (a positive-feedback
+        interconnection, exact including the algebraic loop).
+        """
+        Kt = control.ss(K_shifted)
+        if np.allclose(self.D22, 0.0):
+            return Kt
+        D22 = np.asarray(self.D22, dtype=float).reshape(self.nmeas, self.ncon)
+        return control.feedback(Kt, control.ss([], [], [], D22), sign=-1)
+
     def close(self, dV: float) -> control.StateSpace:
         """Close the internal feedback ``wf = −ΔV zf`` (eq. 15).
 

@@ -47,3 +47,25 @@ def test_lft_requires_a_flutter_speed():
     res = find_flutter(sysae, (0.0, 1.0), n_grid=11)
     with pytest.raises(ConfigError, match="Vf"):
         build_lft(sysae, res.Vf)
+
+
+def test_loop_shifting_of_d22():
+    """Accelerometers with a flap feed-through: a controller designed on the plant with
+    D22 removed, mapped back by physical_controller, gives the same closed-loop poles on
+    ΣAE(Vf) as the shifted design loop (python-control's interconnection)."""
+    import control
+    sysae = binary_system("acceleration", dynamic=True)
+    Vf = find_flutter(sysae, (0.0, 3.0), n_grid=31).Vf
+    lft = build_lft(sysae, Vf)
+    assert np.abs(lft.D22).max() > 0.1
+    m = lft.nmeas
+    rng = np.random.default_rng(3)
+    Kt = control.ss([[-4.0]], rng.standard_normal((1, m)), [[0.7]], 0.05 * rng.standard_normal((1, m)))
+    Pt = lft.plant_without_d22()
+    assert np.all(Pt.D[-m:, -1] == 0)
+    nz, nu = Pt.noutputs - m, Pt.ninputs - 1
+    design_loop = control.feedback(Pt[nz:nz + m, nu:nu + 1], Kt, sign=+1)  # v -> z~m closed by K~
+    K = lft.physical_controller(Kt)
+    got = np.linalg.eigvals(sysae.closed_loop_state_matrix(Vf, K))
+    assert_allclose(np.sort_complex(np.round(got, 7)), np.sort_complex(np.round(design_loop.poles(), 7)),
+                    atol=1e-6)
