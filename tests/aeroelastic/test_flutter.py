@@ -169,3 +169,23 @@ def test_truth_goland_wing_tracking_agrees_with_bisection():
     assert_allclose(res.Vf, Vb, rtol=1e-8)
     assert ms.mode_names[res.flutter_mode] == "torsion 1"
     assert [c.V for c in res.crossings] == sorted(c.V for c in res.crossings)
+
+
+def test_adaptive_refinement_keeps_branch_identity_on_a_coarse_grid():
+    """Five grid points across a frequency crossing: refinement inserts points where the
+    eigenvector match is poor, and branches keep their modes."""
+    s = ModalStructure([5.0, 8.0], [0.01, 0.01], alpha=1.0, Hs=None)
+    A0 = AeroelasticSystem.from_parts(control.ss([], [], [], np.diag([-30.0, 30.0])), s).state_matrix
+    rng = np.random.default_rng(5)
+    T = np.eye(4) + 0.3 * rng.standard_normal((4, 4))  # dense coordinates
+    fn = lambda V: T @ A0(V) @ np.linalg.inv(T)  # noqa: E731
+    tr = track_eigenvalues(fn, np.linspace(0.0, 1.3, 5), min_score=0.999)
+    assert tr.n_refined > 0 and tr.V.size > 5 and tr.n_unresolved == 0
+    assert np.all(tr.scores >= 0.999)
+    # each branch's eigenvalue stays on one analytic mode: ω1² = 25 + 30V², ω2² = 64 − 30V²
+    for b in range(4):
+        lam = tr.eigenvalues[:, b]
+        k2 = (lam * lam.conj()).real  # |λ|² = ω_eff² for a viscous mode
+        on1 = np.allclose(k2, 25 + 30 * tr.V ** 2, rtol=1e-9)
+        on2 = np.allclose(k2, 64 - 30 * tr.V ** 2, rtol=1e-9)
+        assert on1 != on2

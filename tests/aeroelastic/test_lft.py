@@ -69,3 +69,30 @@ def test_loop_shifting_of_d22():
     got = np.linalg.eigvals(sysae.closed_loop_state_matrix(Vf, K))
     assert_allclose(np.sort_complex(np.round(got, 7)), np.sort_complex(np.round(design_loop.poles(), 7)),
                     atol=1e-6)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_lft_closure_random_systems(seed):
+    """Random Σf (N = 1..3 modes, order 0..4, with/without flap) and random sensors."""
+    import control
+    from casflutter.aeroelastic import AeroelasticSystem, ModalStructure
+    rng = np.random.default_rng(seed)
+    N, nf = int(rng.integers(1, 4)), int(rng.integers(0, 5))
+    sensor = ["acceleration", "velocity", "displacement", "state"][seed % 4]
+    s = ModalStructure(rng.uniform(2, 20, N), rng.uniform(0, 0.1, N), alpha=rng.uniform(0.5, 2),
+                       Hs=rng.standard_normal((2, 2 * N if sensor == "state" else N)), sensor=sensor)
+    m_in = N + int(rng.integers(0, 2))
+    if nf:
+        Af = rng.standard_normal((nf, nf)) - 3 * np.sqrt(nf) * np.eye(nf)
+        sf = control.ss(Af, rng.standard_normal((nf, m_in)), rng.standard_normal((N, nf)),
+                        rng.standard_normal((N, m_in)))
+    else:
+        sf = control.ss([], [], [], rng.standard_normal((N, m_in)))
+    sysae = AeroelasticSystem.from_parts(sf, s)
+    Vf = rng.uniform(0.5, 2.0)
+    lft = build_lft(sysae, Vf)
+    for dV in rng.uniform(-0.9 * Vf ** 2, 3 * Vf ** 2, size=4):
+        closed, direct = lft.close(dV), sysae.loop(np.sqrt(Vf ** 2 + dV))
+        want = direct.statespace()
+        for got_M, want_M in ((closed.A, want.A), (closed.B, want.B), (closed.C, want.C), (closed.D, want.D)):
+            assert_allclose(got_M, want_M, rtol=0, atol=1e-10 * max(1.0, np.abs(want_M).max()))
