@@ -334,13 +334,13 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
             gk = float(g(t))
             vk = vk + gk * float((Ck @ xk + Dk @ zk)[0])
             xk = Ak @ xk + Bk @ zk
-        u_hist = np.roll(u_hist, 1, axis=0)
+        u_hist[1:] = u_hist[:-1].copy()
         u_hist[0] = uk
-        v_hist = np.roll(v_hist, 1)
+        v_hist[1:] = v_hist[:-1].copy()
         v_hist[0] = vk
-        y_hist = np.roll(y_hist, 1, axis=0)
+        y_hist[1:] = y_hist[:-1].copy()
         y_hist[0] = 0.0
-        yk = np.asarray(rom.step(y_hist, u_hist, v_hist), dtype=float).reshape(N)
+        yk = np.asarray(rom.step(y_hist.copy(), u_hist.copy(), v_hist.copy()), dtype=float).reshape(N)
         y_hist[0] = yk
         for key, val in (("xs", xs), ("u", uk), ("y", yk), ("zm", zk), ("v", vk), ("g", gk)):
             rec[key].append(val)
