@@ -219,6 +219,12 @@ def find_flutter(system, V_range=None, *, V_grid=None, n_grid: int = 101, mode_s
     -------
     FlutterResult
         ``status == "no_crossing"`` and ``Vf is None`` when nothing crosses in the range.
+
+    Notes
+    -----
+    Crossings are detected as sign changes of Re λ of a branch between neighbouring grid
+    points, so a branch that crosses and re-crosses inside one grid interval (a very narrow
+    hump) is missed: use a grid finer than the narrowest hump of interest.
     """
     fn = as_matrix_fn(system)
     if V_grid is None:
