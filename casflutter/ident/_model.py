@@ -1,0 +1,606 @@
+"""The MIMO Hammerstein--Wiener-like (HWL) model with mu-Markov structure (paper eq. 1--4).
+
+Index conventions (against eq. 3)
+---------------------------------
+For output ``i = 1..N`` (code: ``i = 0..N-1``)::
+
+    y_i(k) = - sum_j sum_{m=1}^{na} A[m-1,i,j] * sum_{l=1}^{q} alpha[l-1,i,j] * y_j(k-mu-m+1)^l
+             + sum_j sum_{d=0}^{mu-1} H[d,i,j] * sum_{l=1}^{p} gamma[l-1,i,j] * u_j(k-r-d)^l
+             +       sum_{d=0}^{mu-1} h[d,i]   * sum_{l=1}^{p} beta[l-1,i]    * v(k-r-d)^l
+             + sum_j sum_{d=0}^{nb}   B[d,i,j] * sum_{l=1}^{p} gamma[l-1,i,j] * u_j(k-r-mu-d)^l
+             +       sum_{d=0}^{nb}   b[d,i]   * sum_{l=1}^{p} beta[l-1,i]    * v(k-r-mu-d)^l
+
+so ``A[m-1] = A^(m)`` (m = 1..na), ``H[d] = H^(d)`` (d = 0..mu-1), ``B[d] = B^(d)``
+(d = 0..nb), ``alpha[l-1] = alpha^[l]`` and so on.
+
+*The typo in eq. 2.*  The paper prints ``A_ij(z^-1) = A^(1) z^-1 + ... + A^(na) z^(-mu+1)``
+(and the same last exponent for ``B_ij``).  The last exponent must be ``z^-na`` (``z^-nb``
+for ``B``): the coefficient index and the power of ``z^-1`` run together, and only then does the
+prefactor ``z^(-mu+1)`` in eq. 2 give the output lags ``mu, ..., mu+na-1`` of the scalar
+mu-Markov model eq. 1 (``y(k-mu+1-j)``, ``j = 1..na``), whose first ``mu`` impulse-response
+samples are exactly the Markov parameters ``H``.  With ``z^(-mu+1)`` the degree of ``A_ij``
+would not depend on ``na`` at all and the model would not reduce to eq. 1 for ``N = 1``.
+
+*Normalisation.*  Each product ``A_ij(z)·alpha_ij``, ``[H_ij, B_ij](z)·gamma_ij`` and
+``[h_i, b_i](z)·beta_i`` is bilinear, hence defined only up to a scale factor.  We fix
+``alpha^[1] = gamma^[1] = beta^[1] = 1`` (the linear coefficient of every polynomial is one).
+Then the linearisation about zero keeps exactly the mu-Markov system ``{A, H, h, B, b}``
+(paper §III.A.1) and the higher polynomial coefficients measure the nonlinearity directly.
+The normalisation needs a non-zero linear part; a purely nonlinear path cannot be represented.
+
+The same formulas are evaluated by numpy and by CasADi (:func:`hwl_predict_function`,
+:func:`hwl_simulate_function`): one code path, so the twins agree to rounding.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from ..errors import DataError, DimensionError, OrderError
+from ._orders import HWLOrders
+
+__all__ = ["HWLStructure", "HWLModel", "hwl_predict_function", "hwl_simulate_function",
+           "paper_parameter_count"]
+
+
+def paper_parameter_count(n_modes: int, orders: HWLOrders) -> int:
+    """Parameter count printed in §II.C: ``N²(na+2mu+2(nb+1)) + 2N·mu + N²(q+2p)``.
+
+    It counts more than the model has (eq. 3 has ``N²(na+mu+nb+1+q+p) + N(mu+nb+1+p)``
+    coefficients, before normalisation): see :attr:`HWLStructure.n_coefficients`.
+    """
+    o = orders
+    N = n_modes
+    return N * N * (o.na + 2 * o.mu + 2 * (o.nb + 1)) + 2 * N * o.mu + N * N * (o.q + 2 * o.p)
+
+
+@dataclass(frozen=True)
+class HWLStructure:
+    """Dimensions of an HWL model: orders, number of modes, which inputs exist.
+
+    Knows how the free parameters are stacked into one vector ``theta`` (what the NLP
+    optimises) and unpacks it into coefficient blocks for numpy or CasADi alike.
+
+    Parameters
+    ----------
+    orders : HWLOrders
+        ``(mu, na, nb, r, p, q)``.
+    n_modes : int
+        ``N``: number of outputs y (generalised forces) and, when present, of inputs u.
+    has_u, has_v : bool
+        Whether the modal-displacement input u and the flap input v exist.
+    """
+
+    orders: HWLOrders
+    n_modes: int
+    has_u: bool = True
+    has_v: bool = True
+
+    def __post_init__(self):
+        object.__setattr__(self, "orders", HWLOrders.from_tuple(self.orders))
+        if not isinstance(self.n_modes, (int, np.integer)) or self.n_modes < 1:
+            raise OrderError(f"n_modes={self.n_modes!r} must be a positive integer")
+        if not (self.has_u or self.has_v):
+            raise OrderError("an HWL model needs at least one input: u (modal displacements) "
+                             "or v (flap deflection)")
+
+    # -- layout of theta ------------------------------------------------------------
+    def blocks(self) -> list[tuple[str, tuple[int, ...]]]:
+        """``(name, shape)`` of the free-parameter blocks, in the order they sit in theta."""
+        o, N = self.orders, self.n_modes
+        out: list[tuple[str, tuple[int, ...]]] = [("A", (o.na, N, N))]
+        if self.has_u:
+            out += [("H", (o.mu, N, N)), ("B", (o.nb + 1, N, N))]
+        if self.has_v:
+            out += [("h", (o.mu, N)), ("b", (o.nb + 1, N))]
+        out.append(("alpha", (o.q - 1, N, N)))
+        if self.has_u:
+            out.append(("gamma", (o.p - 1, N, N)))
+        if self.has_v:
+            out.append(("beta", (o.p - 1, N)))
+        return out
+
+    @property
+    def n_params(self) -> int:
+        """Number of free parameters after the normalisation ``alpha^[1]=gamma^[1]=beta^[1]=1``."""
+        return int(sum(np.prod(shape) for _, shape in self.blocks()))
+
+    @property
+    def n_coefficients(self) -> int:
+        """Number of coefficients in eq. 3 before normalisation."""
+        o, N = self.orders, self.n_modes
+        n = N * N * (o.na + o.q)
+        if self.has_u:
+            n += N * N * (o.mu + o.nb + 1 + o.p)
+        if self.has_v:
+            n += N * (o.mu + o.nb + 1 + o.p)
+        return n
+
+    @property
+    def max_lag(self) -> int:
+        """Largest delay in eq. 3, in samples."""
+        return self.orders.max_lag
+
+    def pack(self, coefficients: dict[str, np.ndarray]) -> np.ndarray:
+        """Stack coefficient arrays (with the normalised leading polynomial coefficient)
+        into the free-parameter vector theta."""
+        parts = []
+        for name, shape in self.blocks():
+            arr = np.asarray(coefficients[name], dtype=float)
+            if name in ("alpha", "gamma", "beta"):
+                arr = arr[1:]
+            if arr.shape != shape:
+                raise DimensionError(f"coefficient {name} has shape {arr.shape}, expected {shape}")
+            # column-major within each (i, j) matrix so that numpy and CasADi agree
+            parts.append(np.concatenate([np.ravel(a, order="F") for a in arr]) if arr.size else
+                         np.zeros(0))
+        return np.concatenate(parts) if parts else np.zeros(0)
+
+    def unpack(self, theta) -> dict[str, list]:
+        """Split theta into lists of matrices (numpy arrays or CasADi expressions).
+
+        Vector-valued blocks (``h``, ``b``, ``beta``) become ``1 x N`` rows; the polynomial
+        lists ``alpha``, ``gamma``, ``beta`` include the fixed leading coefficient 1.
+        """
+        is_ca = isinstance(theta, (ca.MX, ca.SX, ca.DM))
+        N = self.n_modes
+        out: dict[str, list] = {}
+        pos = 0
+        for name, shape in self.blocks():
+            mats = []
+            size = int(np.prod(shape[1:]))
+            for _ in range(shape[0]):
+                chunk = theta[pos:pos + size]
+                pos += size
+                if len(shape) == 3:
+                    mats.append(ca.reshape(chunk, N, N) if is_ca
+                                else np.reshape(chunk, (N, N), order="F"))
+                else:
+                    mats.append(ca.reshape(chunk, 1, N) if is_ca else np.reshape(chunk, (1, N)))
+            out[name] = mats
+        ones_sq = np.ones((N, N))
+        ones_row = np.ones((1, N))
+        out["alpha"] = [ones_sq] + out["alpha"]
+        if self.has_u:
+            out["gamma"] = [ones_sq] + out["gamma"]
+        if self.has_v:
+            out["beta"] = [ones_row] + out["beta"]
+        return out
+
+    def weights(self, theta) -> dict[str, list[list]]:
+        """Products ``W[lag][l]`` of linear coefficients and polynomial coefficients.
+
+        ``"ar"``: ``A^(m) ∘ alpha^[l]``; ``"u"``: ``[H,B]^(d) ∘ gamma^[l]``;
+        ``"v"``: ``[h,b]^(d) ∘ beta^[l]`` (Hadamard products, eq. 2).  These are the entries of
+        the over-parameterised linear regression of stage 1.
+        """
+        c = self.unpack(theta)
+        W: dict[str, list[list]] = {"ar": [[a * al for al in c["alpha"]] for a in c["A"]]}
+        if self.has_u:
+            W["u"] = [[hb * g for g in c["gamma"]] for hb in c["H"] + c["B"]]
+        if self.has_v:
+            W["v"] = [[hb * be for be in c["beta"]] for hb in c["h"] + c["b"]]
+        return W
+
+
+def _input_part(structure: HWLStructure, W, u, v, n_samples: int):
+    """Sum of the input terms of eq. 3 for k = L..K-1 (rows), numpy or CasADi alike."""
+    L = structure.max_lag
+    K = n_samples
+    lags = structure.orders.input_lags()
+    total = 0
+    if structure.has_u:
+        for d, lag in enumerate(lags):
+            block = u[L - lag:K - lag, :]
+            for l, w in enumerate(W["u"][d], start=1):
+                total = total + (block ** l) @ w.T
+    if structure.has_v:
+        for d, lag in enumerate(lags):
+            block = v[L - lag:K - lag, :]
+            for l, w in enumerate(W["v"][d], start=1):
+                total = total + (block ** l) @ w
+    return total
+
+
+def _ar_part(structure: HWLStructure, W, y, n_samples: int):
+    """Autoregressive terms of eq. 3 (without the minus sign) for k = L..K-1."""
+    L = structure.max_lag
+    K = n_samples
+    total = 0
+    for m, lag in enumerate(structure.orders.ar_lags()):
+        block = y[L - lag:K - lag, :]
+        for l, w in enumerate(W["ar"][m], start=1):
+            total = total + (block ** l) @ w.T
+    return total
+
+
+def ar_weights(structure: HWLStructure, W) -> "ca.MX | np.ndarray":
+    """The autoregressive weights ``A^(m) ∘ alpha^[l]`` stacked in one column (the only
+    parameters the free-run recursion needs)."""
+    o = structure.orders
+    mats = [W["ar"][m][l] for m in range(o.na) for l in range(o.q)]
+    if mats and isinstance(mats[0], (ca.MX, ca.SX, ca.DM)):
+        return ca.vertcat(*[ca.vec(w) for w in mats])
+    return np.concatenate([np.ravel(w, order="F") for w in mats])
+
+
+def recursion_step(structure: HWLStructure) -> ca.Function:
+    """One step of the free-run recursion: ``(hist, xin_k, w_ar) -> hist_next``.
+
+    ``hist = [y(k-1); ...; y(k-H)]`` (each block N long, ``H`` the largest output lag);
+    ``xin_k`` the input part of eq. 3 at time k; ``w_ar`` from :func:`ar_weights`.  The first
+    N entries of ``hist_next`` are ``y(k)``.  Built from SX so that ``mapaccum`` over long
+    records runs at compiled-expression speed.
+    """
+    o, N = structure.orders, structure.n_modes
+    lags = o.ar_lags()
+    H = max(lags)
+    hist = ca.SX.sym("hist", H * N)
+    xk = ca.SX.sym("xin", N)
+    w_ar = ca.SX.sym("w_ar", o.na * o.q * N * N)
+    yk = xk
+    pos = 0
+    for lag in lags:
+        past = hist[(lag - 1) * N:lag * N]
+        for l in range(1, o.q + 1):
+            w = ca.reshape(w_ar[pos:pos + N * N], N, N)
+            pos += N * N
+            yk = yk - ca.mtimes(w, past ** l)
+    new = ca.vertcat(yk, hist[:(H - 1) * N]) if H > 1 else yk
+    return ca.Function("hwl_step", [hist, xk, w_ar], [new])
+
+
+@dataclass(frozen=True)
+class HWLModel:
+    """An identified (or prescribed) HWL ROM of the aerodynamic response, eq. 4.
+
+    Attributes
+    ----------
+    structure : HWLStructure
+        Orders, N and which inputs exist.
+    theta : ndarray
+        Free parameters (see :meth:`HWLStructure.blocks`).
+    dt : float
+        Sampling time in seconds.
+    output_names, u_names : tuple of str
+        Channel names of y and u; ``v_name`` of the flap.
+    """
+
+    structure: HWLStructure
+    theta: np.ndarray
+    dt: float = 1.0
+    output_names: tuple[str, ...] = ()
+    u_names: tuple[str, ...] = ()
+    v_name: str = "v"
+    _weights: Any = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self):
+        theta = np.asarray(self.theta, dtype=float).ravel()
+        if theta.size != self.structure.n_params:
+            raise DimensionError(f"theta has {theta.size} entries, the structure "
+                                 f"{self.structure.orders} with N={self.structure.n_modes} "
+                                 f"needs {self.structure.n_params}")
+        if not np.all(np.isfinite(theta)):
+            raise DataError("HWL parameters contain NaN or inf")
+        if not (np.isfinite(self.dt) and self.dt > 0):
+            raise DataError(f"sampling time dt={self.dt} must be positive")
+        object.__setattr__(self, "theta", theta)
+        N = self.structure.n_modes
+        if not self.output_names:
+            object.__setattr__(self, "output_names", tuple(f"y{i + 1}" for i in range(N)))
+        if not self.u_names and self.structure.has_u:
+            object.__setattr__(self, "u_names", tuple(f"u{i + 1}" for i in range(N)))
+        object.__setattr__(self, "_weights", self.structure.weights(theta))
+
+    # -- construction ---------------------------------------------------------------
+    @classmethod
+    def from_coefficients(cls, orders, *, A, alpha, H=None, B=None, gamma=None, h=None, b=None,
+                          beta=None, dt: float = 1.0, **names) -> "HWLModel":
+        """Build from coefficient arrays with the paper's names (shapes in the module doc).
+
+        The polynomial arrays ``alpha``, ``gamma``, ``beta`` include their leading
+        coefficient, which must be 1 (the normalisation).
+        """
+        A = np.asarray(A, dtype=float)
+        N = A.shape[-1] if A.ndim == 3 and A.shape[0] else np.asarray(alpha).shape[-1]
+        has_u, has_v = H is not None, h is not None
+        structure = HWLStructure(HWLOrders.from_tuple(orders), N, has_u, has_v)
+        coeffs = {"A": A.reshape(structure.orders.na, N, N), "alpha": alpha}
+        if has_u:
+            coeffs.update(H=H, B=B, gamma=gamma)
+        if has_v:
+            coeffs.update(h=h, b=b, beta=beta)
+        for name in ("alpha", "gamma", "beta"):
+            if name in coeffs and not np.allclose(np.asarray(coeffs[name])[0], 1.0):
+                raise DataError(f"{name}[0] (the linear coefficient {name}^[1]) must be 1: "
+                                "rescale the polynomial and its linear filter (see the "
+                                "normalisation in casflutter.ident)")
+        return cls(structure, structure.pack(coeffs), dt, **names)
+
+    def coefficients(self) -> dict[str, np.ndarray]:
+        """Coefficient arrays with the paper's names: ``A (na,N,N)``, ``H (mu,N,N)``,
+        ``B (nb+1,N,N)``, ``h (mu,N)``, ``b (nb+1,N)``, ``alpha (q,N,N)``, ``gamma (p,N,N)``,
+        ``beta (p,N)`` (the polynomial arrays include the leading 1)."""
+        c = self.structure.unpack(self.theta)
+        out = {}
+        for name, mats in c.items():
+            arr = np.array([np.asarray(m, dtype=float) for m in mats])
+            if name in ("h", "b", "beta"):
+                arr = arr.reshape(len(mats), -1)
+            out[name] = arr
+        N = self.n_modes
+        out["A"] = out["A"].reshape(self.orders.na, N, N)
+        return out
+
+    def with_theta(self, theta) -> "HWLModel":
+        """The same structure with new parameters."""
+        return replace(self, theta=np.asarray(theta, dtype=float), _weights=None)
+
+    # -- properties -----------------------------------------------------------------
+    @property
+    def orders(self) -> HWLOrders:
+        return self.structure.orders
+
+    @property
+    def n_modes(self) -> int:
+        return self.structure.n_modes
+
+    @property
+    def has_u(self) -> bool:
+        return self.structure.has_u
+
+    @property
+    def has_v(self) -> bool:
+        return self.structure.has_v
+
+    @property
+    def max_lag(self) -> int:
+        return self.structure.max_lag
+
+    @property
+    def n_params(self) -> int:
+        return self.structure.n_params
+
+    # -- evaluation -------------------------------------------------------------------
+    def _arrays(self, u, v, y, n_samples=None):
+        N = self.n_modes
+        K = None
+        for arr in (y, u, v):
+            if arr is not None:
+                K = np.asarray(arr).shape[0]
+                break
+        if K is None:
+            K = n_samples
+        if K is None:
+            raise DataError("give at least one signal (or n_samples)")
+        def as2d(x, cols, name):
+            if x is None:
+                return None
+            x = np.asarray(x, dtype=float)
+            x = x.reshape(-1, 1) if x.ndim == 1 else x
+            if x.shape != (K, cols):
+                raise DimensionError(f"{name} has shape {x.shape}, expected ({K}, {cols})")
+            return x
+        u = as2d(u, N, "u") if self.has_u else None
+        v = as2d(v, 1, "v") if self.has_v else None
+        if self.has_u and u is None:
+            raise DataError("this model has a modal-displacement input u: pass u=")
+        if self.has_v and v is None:
+            raise DataError("this model has a flap input v: pass v=")
+        y = as2d(y, N, "y")
+        if K <= self.max_lag:
+            raise DataError(f"{K} samples are not more than the model's largest lag "
+                            f"{self.max_lag}")
+        return u, v, y, K
+
+    def predict(self, y, u=None, v=None) -> np.ndarray:
+        """mu-step-ahead prediction: eq. 3 evaluated with the *measured* past outputs.
+
+        Since the autoregressive terms start at lag ``mu``, ``y(k)`` is predicted from data up
+        to ``k - mu`` (and inputs up to ``k - r``).
+
+        Returns
+        -------
+        ndarray, shape (K, N)
+            Predictions; the first ``max_lag`` rows (no prediction possible) are copied from ``y``.
+        """
+        u, v, y, K = self._arrays(u, v, y)
+        L = self.max_lag
+        out = np.array(y, dtype=float)
+        out[L:] = _input_part(self.structure, self._weights, u, v, K) - (
+            _ar_part(self.structure, self._weights, y, K) if self.orders.na else 0)
+        return out
+
+    def simulate(self, u=None, v=None, y0=None, n_samples: int | None = None) -> np.ndarray:
+        """Free-run simulation of eq. 3 (the model's own past outputs fed back).
+
+        Parameters
+        ----------
+        u : array (K, N), optional
+        v : array (K,), optional
+        y0 : array (K0 >= max_lag, N), optional
+            Initial outputs for the first ``max_lag`` samples (zeros when omitted).
+
+        Returns
+        -------
+        ndarray, shape (K, N)
+        """
+        u, v, _, K = self._arrays(u, v, None, n_samples)
+        N, L = self.n_modes, self.max_lag
+        y = np.zeros((K, N))
+        if y0 is not None:
+            y0 = np.asarray(y0, dtype=float).reshape(-1, N)
+            if y0.shape[0] < L:
+                raise DataError(f"y0 needs at least max_lag={L} rows, got {y0.shape[0]}")
+            y[:L] = y0[:L]
+        xin = _input_part(self.structure, self._weights, u, v, K)
+        lags = self.orders.ar_lags()
+        if not lags:
+            y[L:] = xin
+            return y
+        Wt = [[w.T for w in row] for row in self._weights["ar"]]
+        mu = self.orders.mu
+        # y(k) depends on outputs at lags >= mu only: advance mu samples per step
+        for k0 in range(L, K, mu):
+            k1 = min(k0 + mu, K)
+            acc = np.array(xin[k0 - L:k1 - L])
+            for m, lag in enumerate(lags):
+                block = y[k0 - lag:k1 - lag]
+                for l, wt in enumerate(Wt[m], start=1):
+                    acc -= (block ** l) @ wt
+            y[k0:k1] = acc
+        return y
+
+    def step(self, y_hist, u_hist=None, v_hist=None) -> np.ndarray:
+        """One output sample ``y(k)`` of eq. 3, for coupling with a structure model.
+
+        Each history has ``max_lag + 1`` rows, row ``d`` holding the value at time ``k - d``
+        (row 0 = time k; ``y_hist[0]`` is ignored).  ``v_hist`` has shape ``(max_lag + 1,)``.
+        """
+        L = self.max_lag
+        y_hist = np.asarray(y_hist, dtype=float).reshape(L + 1, self.n_modes)
+        # reversed histories are chronological: row L is time k
+        u = None if u_hist is None else np.asarray(u_hist, dtype=float).reshape(L + 1, -1)[::-1]
+        v = None if v_hist is None else np.asarray(v_hist, dtype=float).reshape(L + 1, 1)[::-1]
+        u, v, y, K = self._arrays(u, v, y_hist[::-1])
+        val = _input_part(self.structure, self._weights, u, v, K)
+        if self.orders.na:
+            val = val - _ar_part(self.structure, self._weights, y, K)
+        return np.asarray(val).ravel()
+
+    # -- linear part ------------------------------------------------------------------
+    def markov_parameters(self, n: int) -> np.ndarray:
+        """Impulse response ``G[k]`` (k = 0..n-1), shape ``(n, N, n_inputs)``, of the
+        linearisation about zero: the mu-Markov system ``{A, H, h, B, b}`` (paper §III.A.1).
+
+        Inputs are ordered ``[u_1..u_N, v]`` (whichever exist).  ``G[r + d] = [H^(d), h^(d)]``
+        for ``d < mu``: the Markov parameters are the model's own coefficients.
+        """
+        c = self.coefficients()
+        N = self.n_modes
+        cols = []
+        if self.has_u:
+            cols.append(np.concatenate([c["H"], c["B"]], axis=0))
+        if self.has_v:
+            cols.append(np.concatenate([c["h"], c["b"]], axis=0)[:, :, None])
+        num = np.concatenate(cols, axis=2)  # (mu+nb+1, N, m)
+        m = num.shape[2]
+        G = np.zeros((n, N, m))
+        in_lags = self.orders.input_lags()
+        ar_lags = self.orders.ar_lags()
+        for k in range(n):
+            acc = np.zeros((N, m))
+            for d, lag in enumerate(in_lags):
+                if lag == k:
+                    acc += num[d]
+            for mm, lag in enumerate(ar_lags):
+                if k - lag >= 0:
+                    acc -= c["A"][mm] @ G[k - lag]
+            G[k] = acc
+        return G
+
+    def linear_model(self) -> "HWLModel":
+        """The linearisation about zero as an HWL model with p = q = 1."""
+        o = self.orders
+        c = self.coefficients()
+        lin = HWLOrders(o.mu, o.na, o.nb, o.r, 1, 1)
+        kw = {"A": c["A"], "alpha": c["alpha"][:1]}
+        if self.has_u:
+            kw.update(H=c["H"], B=c["B"], gamma=c["gamma"][:1])
+        if self.has_v:
+            kw.update(h=c["h"], b=c["b"], beta=c["beta"][:1])
+        return HWLModel.from_coefficients(lin, dt=self.dt, output_names=self.output_names,
+                                          u_names=self.u_names, v_name=self.v_name, **kw)
+
+    def rescaled(self, y_scale, u_scale=None, v_scale=None) -> "HWLModel":
+        """The same input--output map expressed in scaled signals
+        ``y~ = y / y_scale``, ``u~ = u / u_scale``, ``v~ = v / v_scale``.
+
+        The HWL class is closed under this change of units: with the normalisation
+        ``alpha^[1] = 1``, ``A~_ij = A_ij s_yj / s_yi`` and ``alpha~^[l]_ij = alpha^[l]_ij
+        s_yj^(l-1)`` (likewise for gamma, beta).  Used to identify on unit-RMS data.
+        """
+        N = self.n_modes
+        sy = np.broadcast_to(np.asarray(y_scale, float), (N,))
+        su = np.broadcast_to(np.asarray(1.0 if u_scale is None else u_scale, float), (N,))
+        sv = float(1.0 if v_scale is None else v_scale)
+        c = self.coefficients()
+        ratio_y = sy[None, :] / sy[:, None]           # s_yj / s_yi
+        new = {"A": c["A"] * ratio_y,
+               "alpha": c["alpha"] * np.array([sy[None, :] ** l for l in range(self.orders.q)])}
+        if self.has_u:
+            ratio_u = su[None, :] / sy[:, None]
+            new["H"] = c["H"] * ratio_u
+            new["B"] = c["B"] * ratio_u
+            new["gamma"] = c["gamma"] * np.array([np.broadcast_to(su[None, :] ** l, (N, N))
+                                                  for l in range(self.orders.p)])
+        if self.has_v:
+            new["h"] = c["h"] * sv / sy[None, :]
+            new["b"] = c["b"] * sv / sy[None, :]
+            new["beta"] = c["beta"] * np.array([[sv ** l] * N for l in range(self.orders.p)])
+        return replace(self, theta=self.structure.pack(new), _weights=None)
+
+    def __str__(self) -> str:
+        s = self.structure
+        ins = [n for n, ok in (("u", s.has_u), ("v", s.has_v)) if ok]
+        return (f"HWLModel(N={s.n_modes}, {s.orders}, inputs {'+'.join(ins)}, "
+                f"{s.n_params} parameters, dt={self.dt:g} s)")
+
+
+def _sym_signals(structure: HWLStructure, n_samples: int):
+    N = structure.n_modes
+    theta = ca.MX.sym("theta", structure.n_params)
+    u = ca.MX.sym("u", n_samples, N) if structure.has_u else None
+    v = ca.MX.sym("v", n_samples, 1) if structure.has_v else None
+    return theta, u, v
+
+
+def hwl_predict_function(structure: HWLStructure, n_samples: int) -> ca.Function:
+    """CasADi twin of :meth:`HWLModel.predict`.
+
+    ``f(theta, y, [u], [v]) -> yhat`` with ``yhat`` of shape ``(K - max_lag, N)`` (the rows
+    where a prediction exists).  Inputs u, v appear only when the structure has them.
+    """
+    theta, u, v = _sym_signals(structure, n_samples)
+    y = ca.MX.sym("y", n_samples, structure.n_modes)
+    W = structure.weights(theta)
+    yhat = _input_part(structure, W, u, v, n_samples)
+    if structure.orders.na:
+        yhat = yhat - _ar_part(structure, W, y, n_samples)
+    args = [theta, y] + [s for s in (u, v) if s is not None]
+    names = ["theta", "y"] + [n for n, s in (("u", u), ("v", v)) if s is not None]
+    return ca.Function("hwl_predict", args, [yhat], names, ["yhat"])
+
+
+def hwl_simulate_function(structure: HWLStructure, n_samples: int) -> ca.Function:
+    """CasADi twin of :meth:`HWLModel.simulate`, built with ``mapaccum``.
+
+    ``f(theta, y0, [u], [v]) -> ysim`` with ``y0`` the first ``max_lag`` outputs
+    (``max_lag x N``) and ``ysim`` of shape ``(K - max_lag, N)``.
+    """
+    o = structure.orders
+    N, L = structure.n_modes, structure.max_lag
+    theta, u, v = _sym_signals(structure, n_samples)
+    y0 = ca.MX.sym("y0", L, N)
+    W = structure.weights(theta)
+    xin = _input_part(structure, W, u, v, n_samples)  # (K-L, N)
+    n_steps = n_samples - L
+    lags = o.ar_lags()
+    if lags:
+        H = max(lags)  # history length carried by the recursion
+        step = recursion_step(structure)
+        acc = step.mapaccum("hwl_recursion", n_steps)
+        # initial history from y0: rows L-1, L-2, ..., L-H
+        rows = [y0[L - 1 - d, :].T for d in range(H)]
+        hist0 = ca.vertcat(*rows)
+        traj = acc(hist0, xin.T, ca.repmat(ar_weights(structure, W), 1, n_steps))  # (H*N, n_steps)
+        ysim = traj[:N, :].T
+    else:
+        ysim = xin
+    args = [theta, y0] + [s for s in (u, v) if s is not None]
+    names = ["theta", "y0"] + [n for n, s in (("u", u), ("v", v)) if s is not None]
+    return ca.Function("hwl_simulate", args, [ysim], names, ["ysim"])
