@@ -544,6 +544,28 @@ class HWLModel:
             new["beta"] = c["beta"] * np.array([[sv ** l] * N for l in range(self.orders.p)])
         return replace(self, theta=self.structure.pack(new), _weights=None)
 
+    # -- persistence ------------------------------------------------------------------
+    def save(self, path) -> None:
+        """Write the model to an ``.npz`` file (orders, N, inputs, theta, dt, names)."""
+        s = self.structure
+        np.savez(path, format=np.array("casflutter.HWLModel/1"),
+                 orders=np.array(s.orders.as_tuple()), n_modes=np.array(s.n_modes),
+                 has_u=np.array(s.has_u), has_v=np.array(s.has_v), theta=self.theta,
+                 dt=np.array(self.dt), output_names=np.array(self.output_names),
+                 u_names=np.array(self.u_names), v_name=np.array(self.v_name))
+
+    @classmethod
+    def load(cls, path) -> "HWLModel":
+        """Read a model written by :meth:`save`."""
+        with np.load(path, allow_pickle=False) as z:
+            if "format" not in z.files or not str(z["format"]).startswith("casflutter.HWLModel"):
+                raise DataError(f"{path} is not a casflutter HWL model file")
+            structure = HWLStructure(HWLOrders.from_tuple(tuple(int(x) for x in z["orders"])),
+                                     int(z["n_modes"]), bool(z["has_u"]), bool(z["has_v"]))
+            return cls(structure, z["theta"], float(z["dt"]),
+                       tuple(str(x) for x in z["output_names"]),
+                       tuple(str(x) for x in z["u_names"]), str(z["v_name"]))
+
     def __str__(self) -> str:
         s = self.structure
         ins = [n for n, ok in (("u", s.has_u), ("v", s.has_v)) if ok]

@@ -46,7 +46,7 @@ def prediction_problem(structure: HWLStructure, data: IOData, regularization: fl
     const = max(float(np.sum(Y ** 2) - np.sum(C ** 2)), 0.0)
     RD = R * col_norm[None, :]
     scale = 0.5 / (n_rows * structure.n_modes)
-    theta = ca.SX.sym("theta", structure.n_params)
+    theta = ca.MX.sym("theta", structure.n_params)
     Wm = ca.vertcat(*weights_matrix(structure, structure.weights(theta)))
     res = ca.DM(C) - ca.mtimes(ca.DM(RD), Wm)
     f = scale * (ca.sumsqr(res) + const)
