@@ -1,0 +1,289 @@
+"""The registry of evaluators: a point (dict of parameter values) -> a dict of outputs.
+
+An evaluator is a plain function ``f(params, settings) -> dict`` where ``params`` are the
+swept values of one point and ``settings`` the study's fixed settings.  It raises on
+failure (the runner records the error and carries on).  Built-in evaluators:
+
+``truth_flutter``
+    Flutter speed, frequency and divergence of a truth problem's full-order linear system
+    (:func:`casflutter.aeroelastic.find_flutter` on ``truth.state_matrix``), optionally the
+    LCO amplitude of the nonlinear truth above the flutter speed.  Parameters: any truth
+    parameter (``casflutter problems`` lists them).
+``synthesis``
+    Fixed-order H∞ synthesis (:func:`casflutter.design.synthesize`) on a COMPleib-format plant
+    file: verified γ vs controller ``order`` (and ``seed``, ``starts``).
+``rom_flutter``
+    The ROM route of the pipeline, registered only when ``casflutter.pipeline`` provides it.
+
+Further evaluators plug in with :func:`register_evaluator` or as ``"package.module:function"``
+in the study file (the form that also reaches spawned and Dask worker processes).
+"""
+
+from __future__ import annotations
+
+import importlib
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from ..errors import ConfigError
+
+__all__ = ["Evaluator", "register_evaluator", "get_evaluator", "evaluator_names",
+           "truth_flutter", "synthesis_gamma"]
+
+
+@dataclass(frozen=True)
+class Evaluator:
+    """A registered evaluator.
+
+    Attributes
+    ----------
+    name : str
+        Registry name (``[study] evaluator = NAME``).
+    function : callable
+        ``function(params: dict, settings: dict) -> dict`` of outputs.
+    outputs : tuple of str
+        Output names it returns (documentation and default columns).
+    description : str
+        One line for ``casflutter sweep --list``.
+    modules : tuple of str
+        Modules a worker imports before its first point (so that start-up is not counted
+        as the first point's work).
+    """
+
+    name: str
+    function: Callable[[Mapping[str, Any], Mapping[str, Any]], dict]
+    outputs: tuple = ()
+    description: str = ""
+    modules: tuple = ()
+
+    def warm_up(self) -> None:
+        """Import :attr:`modules` (run once per worker process)."""
+        for m in self.modules:
+            importlib.import_module(m)
+
+
+_REGISTRY: dict[str, Evaluator] = {}
+
+
+def register_evaluator(name: str, function: Callable, outputs=(), description: str = "",
+                       modules=()) -> Evaluator:
+    """Add (or replace) an evaluator under ``name`` and return it (fields of
+    :class:`Evaluator`)."""
+    ev = Evaluator(name=name, function=function, outputs=tuple(outputs),
+                   description=description, modules=tuple(modules))
+    _REGISTRY[name] = ev
+    return ev
+
+
+def evaluator_names() -> list[str]:
+    """Names of the registered evaluators."""
+    _maybe_register_pipeline()
+    return sorted(_REGISTRY)
+
+
+def get_evaluator(ref: str) -> Evaluator:
+    """The evaluator registered as ``ref``, or the function ``"package.module:function"``.
+
+    Raises
+    ------
+    ConfigError
+        Unknown name (the message lists the registered ones) or an import path that does
+        not resolve.
+    """
+    _maybe_register_pipeline()
+    if ref in _REGISTRY:
+        return _REGISTRY[ref]
+    if ":" in ref:
+        mod, _, attr = ref.partition(":")
+        try:
+            fn = getattr(importlib.import_module(mod), attr)
+        except (ImportError, AttributeError) as exc:
+            raise ConfigError(f"evaluator {ref!r} cannot be imported ({exc}); give "
+                              "'package.module:function' importable on every worker") from None
+        return Evaluator(name=ref, function=fn)
+    raise ConfigError(f"unknown evaluator {ref!r}; registered: {', '.join(sorted(_REGISTRY))} "
+                      "(or give 'package.module:function')")
+
+
+# ----------------------------------------------------------------------- truth flutter
+
+_TRUTH_OPTIONS = {
+    "problem": "truth problem name (casflutter problems)",
+    "V_min": "lowest speed index of the flutter search (default 0.02)",
+    "V_max": "highest speed index of the flutter search (default 4.0)",
+    "n_grid": "grid points of the eigenvalue tracking (default 81)",
+    "lco_speed_ratio": "if given: simulate the nonlinear truth at this multiple of Vf",
+    "lco_time": "LCO simulation length in the problem's time unit (default 600)",
+    "lco_samples": "output samples of the LCO simulation (default 6001)",
+    "lco_x0": "initial modal displacement of every mode for the LCO run (default 0.01)",
+}
+
+
+def _split_truth(params: Mapping[str, Any], settings: Mapping[str, Any]):
+    from ..truth import PROBLEMS  # noqa: PLC0415
+
+    merged = {**settings, **params}
+    merged.pop("_base_dir", None)
+    name = str(merged.pop("problem", "typical_section"))
+    if name not in PROBLEMS:
+        raise ConfigError(f"unknown problem {name!r}; available: {', '.join(PROBLEMS)}")
+    valid = PROBLEMS[name].Params.parameter_names()
+    truth_params = {k: v for k, v in merged.items() if k in valid}
+    options = {k: v for k, v in merged.items() if k not in valid}
+    bad = set(options) - set(_TRUTH_OPTIONS)
+    if bad:
+        raise ConfigError(f"truth_flutter: {sorted(bad)} are neither parameters of {name!r} "
+                          f"({', '.join(valid)}) nor options ({', '.join(_TRUTH_OPTIONS)})")
+    return name, truth_params, options
+
+
+def load_truth(params: Mapping[str, Any], settings: Mapping[str, Any] | None = None):
+    """The truth model of a point: ``(model, options)`` (see :func:`truth_flutter`)."""
+    from ..truth import PROBLEMS  # noqa: PLC0415
+
+    name, tp, options = _split_truth(params, settings or {})
+    cls = PROBLEMS[name]
+    return cls(cls.Params().with_updates(**tp)), options
+
+
+def _lco_amplitude(model, V: float, options: Mapping[str, Any]) -> dict[str, float]:
+    """Half peak-to-peak of every physical coordinate over the last quarter of a free run
+    of the nonlinear truth at ``V``, and its relative change against the previous quarter
+    (small when the oscillation has settled on a limit cycle)."""
+    T = float(options.get("lco_time", 600.0))
+    n = int(options.get("lco_samples", 6001))
+    x0 = float(options.get("lco_x0", 0.01))
+    N = model.n_modes
+    t = np.linspace(0.0, T, n)
+    sim = model.simulate(t, np.concatenate([np.full(N, x0), np.zeros(N)]), V)
+    if not sim.success:
+        raise RuntimeError(f"LCO simulation failed at V = {V:g}: {sim.message}")
+    shapes = model.modal_structure().shapes
+    x = sim.u @ shapes.T  # physical coordinates
+    q = n // 4
+    last, prev = x[-q:], x[-2 * q:-q]
+    amp = 0.5 * (last.max(axis=0) - last.min(axis=0))
+    amp_prev = 0.5 * (prev.max(axis=0) - prev.min(axis=0))
+    names = model.modal_structure().coordinate_names
+    out = {f"lco_amplitude_{c.replace('/', '_')}": float(a) for c, a in zip(names, amp)}
+    out["lco_amplitude"] = float(np.max(amp))
+    out["lco_settling"] = float(np.max(np.abs(amp - amp_prev)) / max(float(np.max(amp)), 1e-300))
+    out["lco_V"] = float(V)
+    return out
+
+
+def truth_flutter(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dict[str, Any]:
+    """Flutter and divergence of a truth problem's full-order linear system.
+
+    Parameters
+    ----------
+    params : mapping
+        Swept values: any truth parameter of the problem (e.g. ``mu``, ``zeta``, ``a``).
+    settings : mapping
+        ``problem`` (default ``"typical_section"``), ``V_min``, ``V_max``, ``n_grid`` and,
+        for an LCO amplitude, ``lco_speed_ratio`` (simulate at this multiple of Vf; the
+        problem needs a nonlinear stiffness, e.g. ``kappa3``), ``lco_time``,
+        ``lco_samples``, ``lco_x0``; any truth parameter held fixed.
+
+    Returns
+    -------
+    dict
+        ``status`` (:class:`FlutterResult` status), ``Vf``, ``omega_f``, ``frequency_hz``,
+        ``flutter_mode``, ``divergence_V``, ``n_crossings``, ``flutter_time`` and, with
+        ``lco_speed_ratio``, ``lco_amplitude`` (largest coordinate), one
+        ``lco_amplitude_<coordinate>`` per coordinate, ``lco_settling``, ``lco_V``.
+    """
+    from ..aeroelastic import find_flutter  # noqa: PLC0415
+
+    model, options = load_truth(params, settings)
+    t0 = time.perf_counter()
+    res = find_flutter(model.state_matrix, (float(options.get("V_min", 0.02)),
+                                            float(options.get("V_max", 4.0))),
+                       n_grid=int(options.get("n_grid", 81)),
+                       omega=model.modal_structure().omega)
+    out: dict[str, Any] = {
+        "status": res.status, "Vf": res.Vf, "omega_f": res.omega_f,
+        "frequency_hz": res.frequency_hz, "flutter_mode": res.flutter_mode,
+        "divergence_V": None if res.divergence is None else res.divergence.V,
+        "n_crossings": len(res.crossings), "flutter_time": time.perf_counter() - t0}
+    ratio = options.get("lco_speed_ratio")
+    if ratio is not None:
+        if res.Vf is None:
+            raise RuntimeError("no flutter speed in the range, so no LCO speed "
+                               f"(lco_speed_ratio = {ratio}); widen V_min..V_max")
+        out.update(_lco_amplitude(model, float(ratio) * res.Vf, options))
+    return out
+
+
+# --------------------------------------------------------------------------- synthesis
+
+def synthesis_gamma(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dict[str, Any]:
+    """Fixed-order H∞ synthesis on one COMPleib-format plant file (γ vs controller order).
+
+    Parameters
+    ----------
+    params, settings : mapping
+        ``plant`` (path, relative to the study file), ``order`` (controller order),
+        ``starts`` (default 2), ``seed`` (default 0), ``time_limit`` [s] (default none),
+        any other key is a :class:`casflutter.design.SynthesisOptions` field.
+
+    Returns
+    -------
+    dict
+        ``gamma`` (verified, exact norm), ``delta_bound`` (= 1/γ), ``spectral_abscissa``,
+        ``success``, ``converged``, ``statuses`` (Ipopt, best start), ``synthesis_time``.
+
+    Notes
+    -----
+    :func:`~casflutter.design.synthesize` builds its NLPs inside every call (it does not
+    expose them), so this evaluator cannot reuse a solver across points; the study's
+    own parametric solvers use :func:`casflutter.study.cached_solver`.
+    """
+    from ..design import load_compleib, synthesize  # noqa: PLC0415
+
+    merged = {**settings, **params}
+    base = Path(str(merged.pop("_base_dir", ".")))
+    if "plant" not in merged or "order" not in merged:
+        raise ConfigError("synthesis needs 'plant' (COMPleib JSON path) and 'order'")
+    plant = Path(str(merged.pop("plant")))
+    if not plant.is_absolute():
+        plant = base / plant
+    order = int(merged.pop("order"))
+    starts = int(merged.pop("starts", 2))
+    seed = int(merged.pop("seed", 0))
+    P, nmeas, ncon, _ = load_compleib(plant)
+    t0 = time.perf_counter()
+    res = synthesize(P, nmeas, ncon, order, starts=starts, seed=seed, options=merged or None)
+    return {"gamma": res.gamma, "delta_bound": res.delta_bound,
+            "spectral_abscissa": res.spectral_abscissa, "success": res.success,
+            "converged": res.converged, "statuses": ";".join(res.statuses),
+            "synthesis_time": time.perf_counter() - t0}
+
+
+register_evaluator("truth_flutter", truth_flutter,
+                   outputs=("status", "Vf", "omega_f", "frequency_hz", "flutter_mode",
+                            "divergence_V", "n_crossings", "flutter_time", "lco_amplitude"),
+                   description="truth flutter speed/frequency/divergence (and LCO amplitude)",
+                   modules=("casflutter.truth", "casflutter.aeroelastic"))
+register_evaluator("synthesis", synthesis_gamma,
+                   outputs=("gamma", "delta_bound", "spectral_abscissa", "success",
+                            "converged", "statuses", "synthesis_time"),
+                   description="fixed-order H-infinity synthesis on a COMPleib plant (gamma vs order)",
+                   modules=("casflutter.design",))
+
+
+def _maybe_register_pipeline() -> None:
+    """Register ``rom_flutter`` when the pipeline provides a ROM flutter evaluator."""
+    if "rom_flutter" in _REGISTRY:
+        return
+    try:
+        mod = importlib.import_module("casflutter.pipeline._rom_flutter")
+    except ImportError:
+        return
+    fn = getattr(mod, "evaluate", None) or getattr(mod, "rom_flutter", None)
+    if callable(fn):
+        register_evaluator("rom_flutter", fn, description="ROM route: identify, realize, find Vf")

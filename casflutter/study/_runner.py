@@ -1,0 +1,418 @@
+"""Run a study: local worker processes (default) or a Dask distributed cluster, resumable.
+
+Every finished point is appended to the :class:`PointStore` the moment its result arrives,
+so an interrupted sweep (Ctrl-C, a killed driver or worker) resumes without recomputing or
+losing a point.  An evaluator that raises gives a ``"failed"`` record with the error text
+and the sweep goes on; a point that kills its worker process is retried once in a
+fresh process and, if it kills that one too, recorded as failed.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import sys
+import time
+import traceback
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass
+from multiprocessing import get_context
+from pathlib import Path
+from typing import Any, Mapping
+
+from ..errors import ConfigError
+from ._spec import Study
+from ._store import PointStore
+
+__all__ = ["SweepResult", "Progress", "run_sweep", "evaluate_point"]
+
+
+def evaluate_point(evaluator: str, params: Mapping[str, Any], settings: Mapping[str, Any],
+                   key: str) -> dict[str, Any]:
+    """Evaluate one point and return its record (never raises for an evaluator error).
+
+    Runs in the worker (process pool or Dask).  ``work_time`` is the evaluator's own wall
+    time, the reference for the runner's overhead figures.
+    """
+    from ._evaluators import get_evaluator  # noqa: PLC0415
+
+    started = time.time()
+    t0 = time.perf_counter()
+    rec: dict[str, Any] = {"key": key, "params": dict(params),
+                           "worker": f"{socket.gethostname()}:{os.getpid()}"}
+    try:
+        outputs = get_evaluator(evaluator).function(dict(params), dict(settings))
+        if not isinstance(outputs, Mapping):
+            raise TypeError(f"evaluator {evaluator!r} returned {type(outputs).__name__}, "
+                            "not a dict of outputs")
+        rec.update(status="ok", outputs=dict(outputs), error=None)
+    except Exception as exc:  # noqa: BLE001 - a failed point is data, not a crash
+        tb = traceback.format_exception(type(exc), exc, exc.__traceback__)
+        rec.update(status="failed", outputs={}, error=f"{type(exc).__name__}: {exc}",
+                   traceback="".join(tb[-3:]))
+    rec["work_time"] = time.perf_counter() - t0
+    rec["started"] = started
+    rec["finished"] = time.time()
+    return rec
+
+
+def _warm(evaluator: str) -> None:
+    """Worker initializer: import the evaluator's modules before the first point."""
+    from ._evaluators import get_evaluator  # noqa: PLC0415
+
+    get_evaluator(evaluator).warm_up()
+
+
+def _ready(_: int = 0) -> int:
+    time.sleep(0.02)
+    return os.getpid()
+
+
+def _start_workers(ex: ProcessPoolExecutor, workers: int, timeout: float = 120.0) -> None:
+    """Block until every worker process has started and run its initializer."""
+    seen: set[int] = set()
+    t0 = time.perf_counter()
+    while len(seen) < workers and time.perf_counter() - t0 < timeout:
+        seen.update(ex.map(_ready, range(2 * workers)))
+
+
+class Progress:
+    """A one-line progress report on stderr: points done, failed, left, elapsed, ETA.
+
+    On a terminal the line is redrawn in place; otherwise a line is printed at most every
+    ``interval`` seconds and once at the end.
+    """
+
+    def __init__(self, total: int, *, skipped: int = 0, enabled: bool = True,
+                 stream=None, interval: float = 2.0) -> None:
+        self.total, self.skipped = total, skipped
+        self.done = self.failed = 0
+        self.enabled = enabled
+        self.stream = stream if stream is not None else sys.stderr
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.interval = interval
+        self.t0 = time.perf_counter()
+        self._last = -1e300
+
+    @property
+    def left(self) -> int:
+        """Points not yet finished."""
+        return self.total - self.skipped - self.done
+
+    def line(self) -> str:
+        """The current progress line."""
+        el = time.perf_counter() - self.t0
+        rate = self.done / el if el > 0 and self.done else 0.0
+        eta = f", ETA {self.left / rate:.0f} s" if rate > 0 and self.left else ""
+        width = 24
+        frac = (self.skipped + self.done) / self.total if self.total else 1.0
+        bar = "#" * int(round(frac * width))
+        return (f"[{bar:<{width}}] {self.skipped + self.done}/{self.total} done "
+                f"({self.skipped} resumed), {self.failed} failed, {self.left} left, "
+                f"{el:.1f} s{eta}")
+
+    def update(self, record: Mapping[str, Any] | None = None, *, force: bool = False) -> None:
+        """Count one finished record and redraw."""
+        if record is not None:
+            self.done += 1
+            self.failed += record.get("status") != "ok"
+        if not self.enabled:
+            return
+        now = time.perf_counter()
+        if self.tty:
+            self.stream.write("\r" + self.line())
+            self.stream.flush()
+        elif force or now - self._last >= self.interval:
+            self.stream.write(self.line() + "\n")
+            self.stream.flush()
+            self._last = now
+
+    def close(self) -> None:
+        """Final line."""
+        if self.enabled:
+            if self.tty:
+                self.stream.write("\r" + self.line() + "\n")
+            else:
+                self.stream.write(self.line() + "\n")
+            self.stream.flush()
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """Outcome of :func:`run_sweep`.
+
+    Attributes
+    ----------
+    study : Study
+        The study that was run.
+    store : Path
+        The JSON-lines store holding every finished point.
+    n_points : int
+        Points in the design.
+    n_resumed : int
+        Points already in the store before this run (not recomputed).
+    n_computed : int
+        Points finished in this run.
+    n_failed : int
+        Failed points in the store after this run (all runs).
+    n_left : int
+        Points still missing (non-zero only after an interruption).
+    interrupted : bool
+        True when the run stopped early (Ctrl-C, ``max_points``); resume by running again.
+    executor : str
+        ``"inline"``, ``"processes(N)"`` or ``"dask(ADDRESS)"``.
+    wall_time : float
+        Seconds from the first submission to the last record (excluding worker start-up).
+    startup_time : float
+        Seconds to start and warm the workers.
+    work_time : float
+        Sum of the evaluators' own times of the points computed in this run.
+    worker_restarts : int
+        Local worker pools replaced after a worker process died.
+    """
+
+    study: Study
+    store: Path
+    n_points: int
+    n_resumed: int
+    n_computed: int
+    n_failed: int
+    n_left: int
+    interrupted: bool
+    executor: str
+    wall_time: float
+    startup_time: float
+    work_time: float
+    worker_restarts: int
+
+    @property
+    def success(self) -> bool:
+        """Every point finished without failure."""
+        return self.n_left == 0 and self.n_failed == 0
+
+    def records(self) -> dict[str, dict]:
+        """Newest stored record per key."""
+        return PointStore(self.store).records()
+
+
+def default_store_path(study: Study, out_dir: str | Path | None = None) -> Path:
+    """``OUT_DIR/NAME.jsonl`` (``OUT_DIR`` defaults to ``sweeps/`` in the working directory)."""
+    return Path(out_dir if out_dir is not None else "sweeps") / f"{study.name}.jsonl"
+
+
+def _dead_worker_record(key: str, params: Mapping[str, Any], err: BaseException) -> dict:
+    return {"key": key, "params": dict(params), "status": "failed", "outputs": {},
+            "error": f"worker process died while computing this point ({type(err).__name__}: "
+                     f"{err}); it died again when retried alone",
+            "work_time": None, "worker": None, "started": None, "finished": time.time()}
+
+
+def _run_local(study, todo, store, progress, workers, max_points, state) -> None:
+    """Process pool; a broken pool is replaced and its lost points are re-run in isolation."""
+    settings = study.resolved_settings()
+    ctx = get_context("spawn")
+    suspects: dict[str, dict] = {}
+    remaining = dict(todo)
+    while remaining:
+        t_start = time.perf_counter()
+        ex = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_warm,
+                                 initargs=(study.evaluator,))
+        try:
+            # start and warm every worker before timing the work
+            _start_workers(ex, workers)
+            state["startup"] += time.perf_counter() - t_start
+            t_work = time.perf_counter()
+            futs = {ex.submit(evaluate_point, study.evaluator, p, settings, k): k
+                    for k, p in remaining.items()}
+            broken = False
+            for fut in as_completed(futs):
+                k = futs[fut]
+                try:
+                    rec = fut.result()
+                except BrokenProcessPool:
+                    broken = True
+                    continue
+                store.append(rec)
+                remaining.pop(k)
+                progress.update(rec)
+                state["work"] += rec["work_time"] or 0.0
+                state["computed"] += 1
+                if max_points is not None and state["computed"] >= max_points:
+                    state["interrupted"] = True
+                    for f in futs:
+                        f.cancel()
+                    break
+            state["wall"] += time.perf_counter() - t_work
+        except KeyboardInterrupt:
+            state["interrupted"] = True
+            ex.shutdown(wait=False, cancel_futures=True)
+            for proc in list(getattr(ex, "_processes", {}).values()):  # stop running points
+                proc.terminate()
+            raise
+        finally:
+            ex.shutdown(wait=not state["interrupted"], cancel_futures=True)
+        if state["interrupted"] or not broken:
+            break
+        state["restarts"] += 1
+        if state["restarts"] < 2:
+            continue  # a worker died: a fresh pool retries the lost points once
+        # it died again: re-run each remaining point alone to find the culprit(s)
+        suspects.update(remaining)
+        for k, p in list(suspects.items()):
+            rec = _isolated(study, k, p, settings, ctx, state)
+            store.append(rec)
+            remaining.pop(k, None)
+            suspects.pop(k)
+            progress.update(rec)
+            state["computed"] += 1
+            if max_points is not None and state["computed"] >= max_points:
+                state["interrupted"] = True
+                return
+        break
+
+
+def _isolated(study, key, params, settings, ctx, state) -> dict:
+    """One point in its own single-worker pool; a second death records the point failed."""
+    t0 = time.perf_counter()
+    with ProcessPoolExecutor(max_workers=1, mp_context=ctx) as ex:
+        try:
+            rec = ex.submit(evaluate_point, study.evaluator, params, settings, key).result()
+        except BrokenProcessPool as exc:
+            rec = _dead_worker_record(key, params, exc)
+    state["wall"] += time.perf_counter() - t0
+    state["work"] += rec.get("work_time") or 0.0
+    return rec
+
+
+def _run_dask(study, todo, store, progress, scheduler, max_points, state) -> None:
+    """Submit every point to a Dask distributed cluster (an address or a ``Client``)."""
+    try:
+        from distributed import Client, as_completed as dask_completed  # noqa: PLC0415
+    except ImportError:
+        raise ConfigError("a Dask scheduler was given but 'distributed' is not installed: "
+                          "pip install 'dask[distributed]' (extra 'dask')") from None
+    settings = study.resolved_settings()
+    t0 = time.perf_counter()
+    own = not isinstance(scheduler, Client)
+    client = Client(scheduler, timeout=30) if own else scheduler
+    try:
+        client.run(_warm, study.evaluator)
+        state["startup"] += time.perf_counter() - t0
+        t_work = time.perf_counter()
+        futs = {client.submit(evaluate_point, study.evaluator, p, settings, k, pure=False,
+                              key=f"casflutter-point-{k}-{time.time_ns()}"): (k, p)
+                for k, p in todo.items()}
+        by_key = {f.key: kp for f, kp in futs.items()}
+        try:
+            for fut in dask_completed(list(futs)):
+                k, p = by_key[fut.key]
+                try:
+                    rec = fut.result()
+                except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker after retries
+                    rec = {"key": k, "params": dict(p), "status": "failed", "outputs": {},
+                           "error": f"{type(exc).__name__}: {exc}", "work_time": None,
+                           "worker": None, "started": None, "finished": time.time()}
+                store.append(rec)
+                progress.update(rec)
+                state["work"] += rec.get("work_time") or 0.0
+                state["computed"] += 1
+                if max_points is not None and state["computed"] >= max_points:
+                    state["interrupted"] = True
+                    client.cancel(list(futs))
+                    break
+        except KeyboardInterrupt:
+            state["interrupted"] = True
+            client.cancel(list(futs))
+            raise
+        state["wall"] += time.perf_counter() - t_work
+    finally:
+        if own:
+            client.close()
+
+
+def run_sweep(study: Study, *, store: str | Path | None = None, workers: int | None = None,
+              scheduler=None, progress: bool = True, retry_failed: bool = False,
+              max_points: int | None = None) -> SweepResult:
+    """Run (or resume) a study and store every finished point.
+
+    Parameters
+    ----------
+    study : Study
+        The study (:func:`load_study`).
+    store : str or Path, optional
+        JSON-lines store (default ``sweeps/NAME.jsonl``); points already in it are skipped.
+    workers : int, optional
+        Local worker processes (default ``study.workers``); ``0`` runs in this process.
+    scheduler : str or distributed.Client, optional
+        Dask scheduler address ``tcp://HOST:PORT`` (or a client); default
+        ``study.scheduler``.  When given, ``workers`` is ignored.
+    progress : bool
+        Show the progress line on stderr.
+    retry_failed : bool
+        Compute the points stored as failed again.
+    max_points : int, optional
+        Stop after this many points (the run is then ``interrupted``; run again to resume).
+
+    Returns
+    -------
+    SweepResult
+
+    Raises
+    ------
+    KeyboardInterrupt
+        Re-raised after Ctrl-C; every point finished before it is stored.
+    """
+    store_path = Path(store) if store is not None else default_store_path(study)
+    pstore = PointStore(store_path)
+    points = study.points()
+    keyed = {study.key(p): p for p in points}
+    finished = pstore.finished_keys(include_failed=not retry_failed)
+    todo = {k: p for k, p in keyed.items() if k not in finished}
+    n_resumed = len(keyed) - len(todo)
+    prog = Progress(len(keyed), skipped=n_resumed, enabled=progress)
+    state = {"startup": 0.0, "wall": 0.0, "work": 0.0, "computed": 0, "restarts": 0,
+             "interrupted": False}
+    scheduler = scheduler if scheduler is not None else study.scheduler
+    workers = study.workers if workers is None else int(workers)
+    if scheduler is not None:
+        executor = f"dask({getattr(scheduler, 'scheduler', None) and scheduler.scheduler.address or scheduler})"
+    elif workers == 0:
+        executor = "inline"
+    else:
+        executor = f"processes({workers})"
+    prog.update(force=True)
+    try:
+        if not todo:
+            pass
+        elif scheduler is not None:
+            _run_dask(study, todo, pstore, prog, scheduler, max_points, state)
+        elif workers == 0:
+            settings = study.resolved_settings()
+            t0 = time.perf_counter()
+            _warm(study.evaluator)
+            state["startup"] = time.perf_counter() - t0
+            t0 = time.perf_counter()
+            for k, p in todo.items():
+                rec = evaluate_point(study.evaluator, p, settings, k)
+                pstore.append(rec)
+                prog.update(rec)
+                state["work"] += rec["work_time"]
+                state["computed"] += 1
+                if max_points is not None and state["computed"] >= max_points:
+                    state["interrupted"] = True
+                    break
+            state["wall"] = time.perf_counter() - t0
+        else:
+            _run_local(study, todo, pstore, prog, workers, max_points, state)
+    finally:
+        prog.close()
+    recs = pstore.records()
+    in_design = [recs[k] for k in keyed if k in recs]
+    n_left = len(keyed) - len(in_design)
+    return SweepResult(
+        study=study, store=store_path, n_points=len(keyed), n_resumed=n_resumed,
+        n_computed=state["computed"], n_failed=sum(r.get("status") != "ok" for r in in_design),
+        n_left=n_left, interrupted=bool(state["interrupted"] or n_left > 0), executor=executor,
+        wall_time=state["wall"], startup_time=state["startup"], work_time=state["work"],
+        worker_restarts=state["restarts"])

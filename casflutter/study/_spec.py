@@ -1,0 +1,307 @@
+"""Study definitions: the swept parameters, the design (grid or Latin hypercube), the evaluator.
+
+A study file is TOML::
+
+    [study]
+    name = "hp1_mass_damping"
+    evaluator = "truth_flutter"     # a registered evaluator or "package.module:function"
+    design = "grid"                 # "grid" (full factorial) or "lhs" (Latin hypercube)
+    samples = 64                    # lhs only
+    seed = 0                        # lhs only
+    outputs = ["Vf", "frequency_hz"]  # optional: columns to keep (default: all)
+    workers = 2                     # optional: local worker processes
+    scheduler = "tcp://host:8786"   # optional: an existing Dask scheduler
+
+    [settings]                      # evaluator settings held fixed over the study
+    problem = "typical_section"
+
+    [parameters]                    # one entry per swept parameter
+    mu = [10.0, 20.0, 40.0]                       # explicit values
+    zeta = {low = 0.0, high = 0.02, num = 3}      # linspace (grid) / range (lhs)
+    sigma = {low = 0.2, high = 0.6, num = 5, scale = "log"}
+    order = {low = 0, high = 4, integer = true}   # integers (lhs rounds, grid steps 1)
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from ..errors import ConfigError
+
+__all__ = ["Parameter", "Study", "load_study", "point_key"]
+
+_DESIGNS = ("grid", "lhs")
+
+
+def _jsonable(value: Any) -> Any:
+    """Plain JSON types (numpy scalars to Python numbers)."""
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (np.floating,)):
+        return float(value)
+    if isinstance(value, Mapping):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    return value
+
+
+def point_key(evaluator: str, settings: Mapping[str, Any], params: Mapping[str, Any]) -> str:
+    """Stable hash of one point (evaluator, fixed settings and swept values).
+
+    Two points with the same key are the same computation: the store skips a key that is
+    already finished.  Floats are hashed through their shortest round-trip ``repr``.
+    """
+    blob = json.dumps({"evaluator": evaluator, "settings": _jsonable(dict(settings)),
+                       "params": _jsonable(dict(params))}, sort_keys=True,
+                      separators=(",", ":"))
+    return hashlib.sha256(blob.encode()).hexdigest()[:20]
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One swept parameter.
+
+    Attributes
+    ----------
+    name : str
+        Parameter name passed to the evaluator.
+    values : tuple or None
+        Explicit values (grid: used as they are; lhs: one value chosen per stratum).
+    low, high : float or None
+        Range (when ``values`` is not given).
+    num : int
+        Number of grid values over ``[low, high]`` (grid design only).
+    scale : str
+        ``"linear"`` or ``"log"`` spacing/sampling of the range.
+    integer : bool
+        Round to integers (ROM orders, controller order).
+    """
+
+    name: str
+    values: tuple | None = None
+    low: float | None = None
+    high: float | None = None
+    num: int = 5
+    scale: str = "linear"
+    integer: bool = False
+
+    def __post_init__(self):
+        if self.values is not None:
+            if len(self.values) == 0:
+                raise ConfigError(f"parameter {self.name!r}: the list of values is empty")
+            return
+        if self.low is None or self.high is None:
+            raise ConfigError(f"parameter {self.name!r}: give a list of values or a table "
+                              "{low = ..., high = ..., num = ...}")
+        if not float(self.high) >= float(self.low):
+            raise ConfigError(f"parameter {self.name!r}: need high >= low, got "
+                              f"low={self.low}, high={self.high}")
+        if self.scale not in ("linear", "log"):
+            raise ConfigError(f"parameter {self.name!r}: scale must be 'linear' or 'log', got "
+                              f"{self.scale!r}")
+        if self.scale == "log" and float(self.low) <= 0:
+            raise ConfigError(f"parameter {self.name!r}: a log scale needs low > 0")
+        if int(self.num) < 1:
+            raise ConfigError(f"parameter {self.name!r}: num must be >= 1")
+
+    @classmethod
+    def from_toml(cls, name: str, spec: Any) -> "Parameter":
+        """From a TOML value: a list of values, a single value, or a range table."""
+        if isinstance(spec, list):
+            return cls(name, values=tuple(spec))
+        if isinstance(spec, (int, float, str, bool)):
+            return cls(name, values=(spec,))
+        if isinstance(spec, Mapping):
+            allowed = {"low", "high", "num", "scale", "integer", "values"}
+            bad = set(spec) - allowed
+            if bad:
+                raise ConfigError(f"parameter {name!r}: unknown key(s) {sorted(bad)}; allowed: "
+                                  f"{sorted(allowed)}")
+            vals = spec.get("values")
+            return cls(name, values=None if vals is None else tuple(vals), low=spec.get("low"),
+                       high=spec.get("high"), num=int(spec.get("num", 5)),
+                       scale=str(spec.get("scale", "linear")),
+                       integer=bool(spec.get("integer", False)))
+        raise ConfigError(f"parameter {name!r}: {spec!r} is neither a list of values nor a "
+                          "{low, high, num} table")
+
+    def _cast(self, x):
+        return int(round(x)) if self.integer else float(x)
+
+    def grid_values(self) -> list:
+        """The values of a full-grid design."""
+        if self.values is not None:
+            return list(self.values)
+        lo, hi = float(self.low), float(self.high)
+        if self.integer:
+            return list(range(int(math.ceil(lo)), int(math.floor(hi)) + 1))
+        n = int(self.num)
+        if self.scale == "log":
+            return [float(v) for v in np.geomspace(lo, hi, n)]
+        return [float(v) for v in np.linspace(lo, hi, n)]
+
+    def from_unit(self, u: np.ndarray) -> list:
+        """Map samples ``u`` in ``[0, 1)`` to parameter values (Latin-hypercube design)."""
+        if self.values is not None:
+            idx = np.minimum((u * len(self.values)).astype(int), len(self.values) - 1)
+            return [self.values[i] for i in idx]
+        lo, hi = float(self.low), float(self.high)
+        if self.integer:  # equal-probability integers lo..hi
+            n = int(math.floor(hi)) - int(math.ceil(lo)) + 1
+            return [int(math.ceil(lo)) + int(min(k, n - 1)) for k in (u * n).astype(int)]
+        if self.scale == "log":
+            x = np.exp(np.log(lo) + u * (np.log(hi) - np.log(lo)))
+        else:
+            x = lo + u * (hi - lo)
+        return [self._cast(v) for v in x]
+
+
+@dataclass(frozen=True)
+class Study:
+    """A parameter study: what to evaluate, at which points, and where.
+
+    Attributes
+    ----------
+    name : str
+        Name of the study (default file stem), used for output file names.
+    evaluator : str
+        Registered evaluator name (:func:`evaluator_names`) or ``"module:function"``.
+    parameters : tuple of Parameter
+        The swept parameters.
+    settings : dict
+        Fixed evaluator settings (problem name, speed range, plant file ...).
+    design : str
+        ``"grid"`` (full factorial) or ``"lhs"`` (Latin hypercube).
+    samples : int
+        Number of Latin-hypercube points.
+    seed : int
+        Seed of the Latin-hypercube design.
+    outputs : tuple of str
+        Output columns to keep (empty: all outputs of the evaluator).
+    workers : int
+        Default number of local worker processes.
+    scheduler : str or None
+        Address of an existing Dask scheduler (``tcp://HOST:PORT``); ``None``: local.
+    base_dir : str
+        Directory that relative paths in ``settings`` refer to (the study file's folder).
+    """
+
+    name: str
+    evaluator: str
+    parameters: tuple
+    settings: Mapping[str, Any] = field(default_factory=dict)
+    design: str = "grid"
+    samples: int = 16
+    seed: int = 0
+    outputs: tuple = ()
+    workers: int = 2
+    scheduler: str | None = None
+    base_dir: str = "."
+
+    def __post_init__(self):
+        if self.design not in _DESIGNS:
+            raise ConfigError(f"design must be one of {_DESIGNS}, got {self.design!r}")
+        if not self.parameters:
+            raise ConfigError("a study needs at least one parameter in [parameters]")
+        names = [p.name for p in self.parameters]
+        if len(set(names)) != len(names):
+            raise ConfigError(f"duplicate parameter names in {names}")
+        clash = set(names) & set(self.settings)
+        if clash:
+            raise ConfigError(f"{sorted(clash)} appear both in [parameters] and [settings]; "
+                              "keep each name in one of them")
+        if self.design == "lhs" and int(self.samples) < 1:
+            raise ConfigError(f"samples must be >= 1 for a Latin hypercube, got {self.samples}")
+        if int(self.workers) < 0:
+            raise ConfigError(f"workers must be >= 0 (0: in this process), got {self.workers}")
+
+    @property
+    def parameter_names(self) -> list[str]:
+        """Names of the swept parameters, in file order."""
+        return [p.name for p in self.parameters]
+
+    def points(self) -> list[dict[str, Any]]:
+        """The design points (each a dict ``name -> value``), in a reproducible order.
+
+        Grid: the Cartesian product of every parameter's values (last parameter fastest).
+        LHS: ``samples`` points of :class:`scipy.stats.qmc.LatinHypercube` with ``seed``.
+        """
+        if self.design == "grid":
+            axes = [p.grid_values() for p in self.parameters]
+            return [dict(zip(self.parameter_names, combo)) for combo in itertools.product(*axes)]
+        from scipy.stats import qmc  # noqa: PLC0415
+
+        u = qmc.LatinHypercube(d=len(self.parameters), seed=int(self.seed)).random(int(self.samples))
+        cols = [p.from_unit(u[:, j]) for j, p in enumerate(self.parameters)]
+        return [dict(zip(self.parameter_names, row)) for row in zip(*cols)]
+
+    def resolved_settings(self) -> dict[str, Any]:
+        """``settings`` with the study's ``base_dir`` added (key ``"_base_dir"``) for
+        evaluators that read files relative to the study file."""
+        out = dict(self.settings)
+        out.setdefault("_base_dir", str(self.base_dir))
+        return out
+
+    def key(self, point: Mapping[str, Any]) -> str:
+        """Hash key of one point (see :func:`point_key`)."""
+        return point_key(self.evaluator, self.settings, point)
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], *, name: str = "study",
+                  base_dir: str | Path = ".") -> "Study":
+        """From the parsed TOML tables ``study``, ``settings``, ``parameters``."""
+        allowed_top = {"study", "settings", "parameters"}
+        bad = set(data) - allowed_top
+        if bad:
+            raise ConfigError(f"unknown table(s) {sorted(bad)} in the study file; allowed: "
+                              f"{sorted(allowed_top)}")
+        st = dict(data.get("study", {}))
+        allowed = {"name", "evaluator", "design", "samples", "seed", "outputs", "workers",
+                   "scheduler"}
+        bad = set(st) - allowed
+        if bad:
+            raise ConfigError(f"unknown key(s) {sorted(bad)} in [study]; allowed: {sorted(allowed)}")
+        if "evaluator" not in st:
+            raise ConfigError("[study] needs evaluator = \"NAME\" (e.g. \"truth_flutter\")")
+        params = tuple(Parameter.from_toml(k, v) for k, v in data.get("parameters", {}).items())
+        return cls(name=str(st.get("name", name)), evaluator=str(st["evaluator"]),
+                   parameters=params, settings=dict(data.get("settings", {})),
+                   design=str(st.get("design", "grid")), samples=int(st.get("samples", 16)),
+                   seed=int(st.get("seed", 0)), outputs=tuple(st.get("outputs", ())),
+                   workers=int(st.get("workers", 2)),
+                   scheduler=st.get("scheduler") or None, base_dir=str(base_dir))
+
+
+def load_study(path: str | Path) -> Study:
+    """Read a study TOML file (module docstring for the format).
+
+    Raises
+    ------
+    ConfigError
+        Missing file, malformed TOML or an invalid entry (the message names it).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"study file {path} not found")
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"study file {path} is not valid TOML: {exc}") from None
+    return Study.from_dict(data, name=path.stem, base_dir=path.resolve().parent)
+
+
+def _check_names(names: Sequence[str], valid: Sequence[str], what: str) -> None:
+    bad = [n for n in names if n not in valid]
+    if bad:
+        raise ConfigError(f"unknown {what} {bad}; valid: {', '.join(valid)}")
