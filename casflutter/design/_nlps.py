@@ -50,6 +50,15 @@ def _tril_sx(name: str, n: int, strict: bool = False) -> tuple[ca.SX, ca.SX]:
     return M, v
 
 
+def _tril_mx(v: ca.MX, n: int, strict: bool = False) -> ca.MX:
+    """Lower-triangular MX matrix filled column by column from ``v``."""
+    idx = [(i, j) for j in range(n) for i in range(n) if (i > j if strict else i >= j)]
+    if not idx:
+        return ca.MX.zeros(n, n)
+    sp = ca.Sparsity.triplet(n, n, [i for i, _ in idx], [j for _, j in idx])
+    return ca.densify(ca.MX(sp, v))
+
+
 def _tril_vals(M: np.ndarray, strict: bool = False) -> np.ndarray:
     n = M.shape[0]
     return np.array([M[i, j] for j in range(n) for i in range(n) if (i > j if strict else i >= j)])
@@ -171,93 +180,98 @@ class HinfNLP:
         P0 = self.plants[0]
         nw, nz, m, p = P0.dims
         self.m, self.p, self.nw, self.nz = m, p, nw, nz
-        self.use_right = nw <= nz          # G = TᴴT (nw×nw) else TTᴴ (nz×nz)
-        q = nw if self.use_right else nz
-        self.q = q
-        g = _Gain(m, p)
-        t = ca.SX.sym("t")
-        gref = ca.SX.sym("gref")
-        beta = ca.SX.sym("beta")
-        rho = ca.SX.sym("rho")
-        xs, gs, ps = [g.d, t], [], []
-        I_q = ca.SX.eye(q)
-        self.layout = []
+        self.fix_input = nw <= nz   # fix the direction of the smaller side
+        d = ca.MX.sym("d", m * p)
+        Kc = ca.MX.sym("Kc", m * p)
+        S = ca.MX.sym("S", m * p)
+        K = ca.reshape(Kc + S * d, m, p)
+        t = ca.MX.sym("t")
+        gref = ca.MX.sym("gref")
+        beta = ca.MX.sym("beta")
+        rho = ca.MX.sym("rho")
+        xs, gs, ps = [d, t], [], []
         for j, P in enumerate(self.plants):
             n = P.nx
-            Acl, Bcl, Ccl, Dcl = _closed(P, g.K)
-            om = ca.SX.sym(f"om{j}", self.nslots)
-            xsc = ca.SX.sym(f"xs{j}", self.nslots)
-            ps += [om, xsc]
+            Acl = P.A + ca.mtimes([ca.DM(P.B2), K, ca.DM(P.C2)])
+            Bcl = P.B1 + ca.mtimes([ca.DM(P.B2), K, ca.DM(P.D21)])
+            Ccl = (P.C1 + ca.mtimes([ca.DM(P.D12), K, ca.DM(P.C2)])) / gref
+            Dcl = (P.D11 + ca.mtimes([ca.DM(P.D12), K, ca.DM(P.D21)])) / gref
+            om = ca.MX.sym(f"om{j}", self.nslots)
+            U = ca.MX.sym(f"U{j}", 2 * nz, self.nslots)   # [Re u; Im u] per slot
+            V = ca.MX.sym(f"V{j}", 2 * nw, self.nslots)   # [Re v; Im v] per slot
+            ps += [om, ca.vec(U), ca.vec(V)]
+            In = ca.DM.eye(n)
             for i in range(self.nslots):
-                Xr = ca.SX.sym(f"Xr{j}_{i}", n, nw)
-                Xi = ca.SX.sym(f"Xi{j}_{i}", n, nw)
-                Tr = ca.SX.sym(f"Tr{j}_{i}", nz, nw)
-                Ti = ca.SX.sym(f"Ti{j}_{i}", nz, nw)
-                Lr, lrv = _tril_sx(f"Lr{j}_{i}", q)
-                Li, liv = _tril_sx(f"Li{j}_{i}", q, strict=True)
-                xs += [ca.vec(Xr), ca.vec(Xi), ca.vec(Tr), ca.vec(Ti), lrv, liv]
-                e1 = -Acl @ Xr - om[i] * Xi - Bcl / xsc[i]
-                e2 = om[i] * Xr - Acl @ Xi
-                e3 = Tr - (xsc[i] * (Ccl @ Xr) + Dcl) / gref
-                e4 = Ti - xsc[i] * (Ccl @ Xi) / gref
-                if self.use_right:
-                    Gr = Tr.T @ Tr + Ti.T @ Ti
-                    Gi = Tr.T @ Ti - Ti.T @ Tr
+                # real form of (jωI - Acl)
+                M = ca.blockcat([[-Acl, -om[i] * In], [om[i] * In, -Acl]])
+                if self.fix_input:
+                    # ‖T(jω) v‖² with v the top right singular vector at the current K
+                    vr, vi = V[:nw, i], V[nw:, i]
+                    x = ca.solve(M, ca.vertcat(Bcl @ vr, Bcl @ vi))
+                    yr = Ccl @ x[:n] + Dcl @ vr
+                    yi = Ccl @ x[n:] + Dcl @ vi
                 else:
-                    Gr = Tr @ Tr.T + Ti @ Ti.T
-                    Gi = Ti @ Tr.T - Tr @ Ti.T
-                LLr = Lr @ Lr.T + Li @ Li.T
-                LLi = Li @ Lr.T - Lr @ Li.T
-                e5 = _sym_lower(t ** 2 * I_q - Gr - LLr)
-                e6 = _sym_lower(-Gi - LLi, strict=True)
-                gs += [ca.vec(e1), ca.vec(e2), ca.vec(e3), ca.vec(e4), e5, e6]
-            R, rv = _tril_sx(f"R{j}", n)
-            W, wv = _tril_sx(f"W{j}", n)
+                    # ‖T(jω)ᴴ u‖² with u the top left singular vector: Tᴴu = Bᴴ(jωI-A)⁻ᴴCᴴu + Dᴴu
+                    ur, ui = U[:nz, i], U[nz:, i]
+                    x = ca.solve(M.T, ca.vertcat(Ccl.T @ ur, Ccl.T @ ui))
+                    yr = Bcl.T @ x[:n] + Dcl.T @ ur
+                    yi = Bcl.T @ x[n:] + Dcl.T @ ui
+                gs.append(t ** 2 - ca.sumsqr(yr) - ca.sumsqr(yi))
+            rv = ca.MX.sym(f"R{j}", n * (n + 1) // 2)
+            wv = ca.MX.sym(f"W{j}", n * (n + 1) // 2)
+            R, W = _tril_mx(rv, n), _tril_mx(wv, n)
             Pm = R @ R.T
             E = Acl.T @ Pm + Pm @ Acl + 2 * beta * Pm + W @ W.T
             xs += [rv, wv]
             gs += [_sym_lower(E), ca.trace(Pm) - n]
         x = ca.vertcat(*xs)
-        f = t + 0.5 * rho * ca.sumsqr(g.d)
-        pvec = ca.vertcat(g.Kc, g.S, gref, beta, rho, *ps)
+        f = t + 0.5 * rho * ca.sumsqr(d)
+        pvec = ca.vertcat(Kc, S, gref, beta, rho, *ps)
         self.nd = m * p
         self.nx_nlp = x.numel()
-        self.ng_nlp = ca.vertcat(*gs).numel()
-        self.solver: NLPSolver = make_solver({"x": x, "f": f, "g": ca.vertcat(*gs), "p": pvec},
+        g = ca.vertcat(*gs)
+        self.ng_nlp = g.numel()
+        # which constraints are the frequency inequalities (g >= 0), the rest are equalities
+        self.ineq = np.zeros(self.ng_nlp, dtype=bool)
+        k = 0
+        for P in self.plants:
+            self.ineq[k:k + self.nslots] = True
+            k += self.nslots + P.nx * (P.nx + 1) // 2 + 1
+        self.solver: NLPSolver = make_solver({"x": x, "f": f, "g": g, "p": pvec},
                                              self.options, name="hinf_minimax")
 
-    def initial_point(self, Kc: np.ndarray, omegas: Sequence[np.ndarray], gref: float,
-                      beta: float):
-        """A feasible starting point at ``Kc`` (exact X, T, Cholesky factors, Lyapunov pair)."""
-        x0 = [np.zeros(self.nd)]
-        xscales = []
-        blocks = []
-        tmax = 0.0
-        Ts_all = []
+    def slots(self, Kc: np.ndarray, omegas: Sequence[np.ndarray], rel: float = 0.9):
+        """Frequency slots ``(ω, u, v)``: at each frequency the singular pairs with
+        ``σ_i >= rel σ_1`` (the local model of the peak), truncated/padded to ``nslots``."""
+        out = []
         for j, P in enumerate(self.plants):
             A, B, C, D = P.closed_loop(Kc)
             n = P.nx
-            xsj, Tj, Xj = [], [], []
+            items = []
             for w in omegas[j]:
-                X = np.linalg.solve(1j * w * np.eye(n) - A, B)
-                s = max(np.max(np.abs(X)), 1e-12)
-                T = (C @ X + D) / gref
-                xsj.append(s)
-                Xj.append(X / s)
-                Tj.append(T)
-                tmax = max(tmax, np.linalg.norm(T, 2))
-            xscales.append(np.array(xsj))
-            Ts_all.append((Xj, Tj))
-        t0 = 1.02 * tmax + 1e-3
+                T = C @ np.linalg.solve(1j * w * np.eye(n) - A, B) + D
+                Us, sv, Vh = np.linalg.svd(T)
+                Vs = Vh.conj().T
+                r = int(np.sum(sv >= rel * sv[0]))
+                items.append((w, Us[:, 0], Vs[:, 0], sv[0]))
+                if r >= 2:
+                    # near-multiple σ_max: sample the top-2 singular subspace (local model)
+                    items.append((w, Us[:, 1], Vs[:, 1], sv[1]))
+                    for c in (1.0, -1.0, 1j, -1j):
+                        items.append((w, (Us[:, 0] + c * Us[:, 1]) / np.sqrt(2),
+                                      (Vs[:, 0] + c * Vs[:, 1]) / np.sqrt(2), sv[0]))
+            items = items[:self.nslots]
+            while len(items) < self.nslots:
+                items.append(items[-1])
+            out.append(items)
+        return out
+
+    def initial_point(self, Kc: np.ndarray, slots, gref: float, beta: float):
+        """A feasible starting point at ``Kc`` (the Lyapunov pair) and the parameters."""
+        tmax = max(it[3] for sl in slots for it in sl) / gref
+        t0 = 1.001 * tmax + 1e-6
+        blocks, pars = [], []
         for j, P in enumerate(self.plants):
-            Xj, Tj = Ts_all[j]
-            for X, T in zip(Xj, Tj):
-                G = T.conj().T @ T if self.use_right else T @ T.conj().T
-                M = t0 ** 2 * np.eye(self.q) - G
-                L = np.linalg.cholesky(0.5 * (M + M.conj().T))
-                blocks += [X.real.ravel(order="F"), X.imag.ravel(order="F"),
-                           T.real.ravel(order="F"), T.imag.ravel(order="F"),
-                           _tril_vals(L.real), _tril_vals(L.imag, strict=True)]
             A = P.closed_loop(Kc)[0]
             n = P.nx
             Pm = _lyap(A + beta * np.eye(n), np.eye(n))
@@ -266,8 +280,12 @@ class HinfNLP:
             R = np.linalg.cholesky(Pm * scale)
             W = np.sqrt(scale) * np.eye(n)
             blocks += [_tril_vals(R), _tril_vals(W)]
+            om = np.array([it[0] for it in slots[j]])
+            U = np.array([np.concatenate([it[1].real, it[1].imag]) for it in slots[j]]).T
+            V = np.array([np.concatenate([it[2].real, it[2].imag]) for it in slots[j]]).T
+            pars += [om, U.ravel(order="F"), V.ravel(order="F")]
         x0 = np.concatenate([np.zeros(self.nd), [t0]] + blocks)
-        return x0, xscales
+        return x0, pars
 
     def solve(self, Kc: np.ndarray, S: np.ndarray, delta: float, omegas: Sequence[np.ndarray],
               gref: float, beta: float, rho: float = 1e-4, t_floor: float = 0.7):
@@ -276,14 +294,14 @@ class HinfNLP:
         Returns ``(Kbar_new, t_grid * gref, NLPResult)``; ``t_grid * gref`` is the *gridded*
         bound, never reported as the norm.
         """
-        x0, xscales = self.initial_point(Kc, omegas, gref, beta)
+        slots = self.slots(Kc, omegas)
+        x0, pars = self.initial_point(Kc, slots, gref, beta)
         lbx = np.full(x0.size, -np.inf)
         ubx = np.full(x0.size, np.inf)
         lbx[:self.nd], ubx[:self.nd] = -delta, delta
-        lbx[self.nd] = t_floor   # the gridded bound may fall by at most 1 - t_floor per solve
-        p = np.concatenate([Kc.ravel(order="F"), S.ravel(order="F"), [gref, beta, rho]]
-                           + [v for j in range(len(self.plants))
-                              for v in (np.asarray(omegas[j], float), xscales[j])])
-        res = self.solver(x0, lbx=lbx, ubx=ubx, lbg=0.0, ubg=0.0, p=p, accept_acceptable=True)
+        lbx[self.nd] = t_floor   # the model bound may fall by at most 1 - t_floor per solve
+        p = np.concatenate([Kc.ravel(order="F"), S.ravel(order="F"), [gref, beta, rho]] + pars)
+        ubg = np.where(self.ineq, np.inf, 0.0)
+        res = self.solver(x0, lbx=lbx, ubx=ubx, lbg=0.0, ubg=ubg, p=p, accept_acceptable=True)
         d = res.x[:self.nd].reshape((self.m, self.p), order="F")
         return Kc + S * d, float(res.x[self.nd]) * gref, res

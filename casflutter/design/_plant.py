@@ -251,10 +251,8 @@ def sigma_max_grid(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray,
                    omega: Sequence[float]) -> np.ndarray:
     """Largest singular value of ``C (jωI - A)^-1 B + D`` on a grid (numpy, for grid selection)."""
     n = A.shape[0]
-    out = np.empty(len(omega))
-    # Hessenberg-free direct solves are fine for the small orders here
-    I = np.eye(n)
-    for i, w in enumerate(omega):
-        H = C @ np.linalg.solve(1j * w * I - A, B) + D
-        out[i] = np.linalg.norm(H, 2)
-    return out
+    omega = np.asarray(omega, dtype=float)
+    M = 1j * omega[:, None, None] * np.eye(n)[None] - A[None]
+    X = np.linalg.solve(M, np.broadcast_to(B.astype(complex), (len(omega),) + B.shape))
+    H = C[None] @ X + D[None]
+    return np.linalg.svd(H, compute_uv=False)[:, 0]
