@@ -525,8 +525,8 @@ def synthesize(plants, nmeas: int, ncon: int, order: int, *, starts: int = 3, se
     if not given and starts == 0:
         raise ConfigError("starts=0 needs at least one initial controller")
     ipopt = {"ipopt.max_iter": 80, "ipopt.max_wall_time": 3.0,
-             "ipopt.hessian_approximation": "limited-memory", "ipopt.tol": 1e-8, "ipopt.acceptable_tol": 1e-5,
-             "ipopt.mu_strategy": "adaptive"}
+             "ipopt.hessian_approximation": "limited-memory", "ipopt.tol": 1e-8,
+             "ipopt.acceptable_tol": 1e-5, "ipopt.mu_strategy": "adaptive"}
     ipopt.update(opts.ipopt)
     stab = StabilizationNLP(prob.aug, ipopt)
     hinf = HinfNLP(prob.aug, opts.nslots, ipopt)

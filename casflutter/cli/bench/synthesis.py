@@ -14,6 +14,7 @@ import json
 import multiprocessing
 import sys
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -115,8 +116,10 @@ def _handler(args: argparse.Namespace) -> int:
     jobs = [(f, orders, args.starts, args.seed, args.time_limit, args.hinfsyn_timeout)
             for f in files]
     if args.jobs > 1:
-        with multiprocessing.get_context("spawn").Pool(args.jobs) as pool:
-            chunks = pool.starmap(run_plant, jobs)
+        # non-daemonic workers: each may start the time-limited hinfsyn child process
+        with ProcessPoolExecutor(args.jobs, mp_context=multiprocessing.get_context("spawn")) \
+                as pool:
+            chunks = list(pool.map(run_plant, *zip(*jobs)))
     else:
         chunks = [run_plant(*j) for j in jobs]
     records = [r for c in chunks for r in c]

@@ -1,0 +1,184 @@
+"""Tests of the fixed-order H∞ synthesis (casflutter.design, paper §III.C).
+
+Truth used: closed-form optima of first-order plants, the published static γ of COMPleib
+AC15 (HIFOO 3.501 / hinfstruct), the LMI full-order optimum γ* as a lower bound, and exact
+norms computed by python-control/SLICOT (independent of the optimiser).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import control
+import numpy as np
+import pytest
+
+from casflutter.design import (SynthesisOptions, load_compleib, partition, synthesize,
+                               verify_closed_loop)
+from casflutter.errors import ConfigError, DimensionError, SynthesisError
+
+ROOT = Path(__file__).resolve().parents[2]
+COMPLEIB = ROOT / "problems" / "compleib"
+
+
+def first_order_plant(a: float, rho: float = 1.0) -> control.StateSpace:
+    """ẋ = a x + w + u, z = [x; ρu], y = x  (inputs [w, u], outputs [z1, z2, y])."""
+    return control.ss([[a]], [[1.0, 1.0]], [[1.0], [0.0], [1.0]],
+                      [[0.0, 0.0], [0.0, rho], [0.0, 0.0]])
+
+
+def first_order_optimum(a: float, rho: float = 1.0) -> tuple[float, float]:
+    """Static optimum of :func:`first_order_plant` for a < 0.
+
+    With u = -κ x the loop is [1; -ρκ]/(s + κ - a): γ(κ) = sqrt(1 + ρ²κ²)/(κ - a), peak at
+    ω = 0; dγ/dκ = 0 gives κ* = -1/(ρ² a).
+    """
+    kappa = -1.0 / (rho ** 2 * a)
+    return -kappa, np.sqrt(1 + rho ** 2 * kappa ** 2) / (kappa - a)
+
+
+def gamma_of_static(a: float, kappa: float, rho: float = 1.0) -> float:
+    return np.sqrt(1 + rho ** 2 * kappa ** 2) / (kappa - a)
+
+
+# --------------------------------------------------------------------------- analytic
+
+
+def test_static_first_order_matches_closed_form():
+    P = first_order_plant(-1.0)
+    k_opt, g_opt = first_order_optimum(-1.0)          # k = -1, γ = 1/√2
+    res = synthesize(P, 1, 1, 0, starts=2, seed=1)
+    assert res.success and res.order == 0
+    assert res.controller.nstates == 0
+    np.testing.assert_allclose(res.gamma, g_opt, rtol=1e-4)
+    np.testing.assert_allclose(float(res.controller.D[0, 0]), k_opt, rtol=2e-2)
+    assert res.gamma >= g_opt * (1 - 1e-9)            # nothing beats the optimum
+    np.testing.assert_allclose(res.delta_bound, 1.0 / res.gamma)
+
+
+def test_multi_plant_worst_case_is_analytic_and_above_each_plant():
+    a1, a2 = -1.0, -2.0
+    P1, P2 = first_order_plant(a1), first_order_plant(a2)
+    g1 = first_order_optimum(a1)[1]
+    g2 = first_order_optimum(a2)[1]
+    res = synthesize([P1, P2], 1, 1, 0, starts=2, seed=0)
+    # γ(κ; a1) > γ(κ; a2) for every κ, so the worst case is plant 1 and the optimum κ = 1
+    np.testing.assert_allclose(res.gamma, g1, rtol=1e-4)
+    assert res.gamma >= max(g1, g2) * (1 - 1e-9)
+    kappa = -float(res.controller.D[0, 0])
+    np.testing.assert_allclose(res.gammas, [gamma_of_static(a1, kappa),
+                                            gamma_of_static(a2, kappa)], rtol=1e-8)
+
+
+def test_unstabilisable_plant_raises_with_best_abscissa():
+    # the unstable mode +1 is not controllable from u: no controller of any order helps
+    A = np.diag([1.0, -1.0])
+    B = np.array([[1.0, 0.0], [0.0, 1.0]])        # [w, u]
+    C = np.array([[1.0, 0.0], [0.0, 0.0], [1.0, 1.0]])
+    D = np.array([[0.0, 0.0], [0.0, 1.0], [0.0, 0.0]])
+    P = control.ss(A, B, C, D)
+    with pytest.raises(SynthesisError) as info:
+        synthesize(P, 1, 1, 1, starts=2, seed=0, options=SynthesisOptions(max_stab_rounds=8))
+    np.testing.assert_allclose(info.value.best_spectral_abscissa, 1.0, rtol=1e-6)
+
+
+def test_seed_determinism():
+    P, nmeas, ncon, _ = load_compleib(COMPLEIB / "AC4.json")
+    opts = SynthesisOptions(max_outer=15)
+    r1 = synthesize(P, nmeas, ncon, 1, starts=2, seed=7, options=opts)
+    r2 = synthesize(P, nmeas, ncon, 1, starts=2, seed=7, options=opts)
+    assert r1.gamma == r2.gamma
+    for M1, M2 in zip((r1.controller.A, r1.controller.B, r1.controller.C, r1.controller.D),
+                      (r2.controller.A, r2.controller.B, r2.controller.C, r2.controller.D)):
+        np.testing.assert_array_equal(M1, M2)
+
+
+# --------------------------------------------------------------------------- COMPleib
+
+
+def test_every_compleib_plant_loads_with_declared_sizes():
+    files = sorted(f for f in COMPLEIB.glob("*.json") if f.name != "reference.json")
+    assert len(files) == 12
+    for f in files:
+        P, nmeas, ncon, meta = load_compleib(f)
+        part = partition(P, nmeas, ncon)
+        assert part.nx == meta["nx"]
+        assert part.dims == (meta["nw"], meta["nz"], meta["nu"], meta["ny"])
+        assert meta["gamma_full_order_lmi"] > 0
+        alpha = np.max(np.linalg.eigvals(part.A).real)
+        assert (alpha < 0) == meta["open_loop_stable"], f.name
+
+
+def test_ac4_unstable_plant_is_stabilised_and_gamma_is_the_exact_norm():
+    P, nmeas, ncon, meta = load_compleib(COMPLEIB / "AC4.json")
+    assert not meta["open_loop_stable"]
+    res = synthesize(P, nmeas, ncon, 1, starts=1, seed=0)
+    # independent closed loop (python-control interconnection) and SLICOT norm
+    K = res.controller
+    cl = control.interconnect(
+        [control.ss(P.A, P.B, P.C, P.D, inputs=["w1", "w2", "u"],
+                    outputs=["z1", "z2", "y1", "y2"], name="P"),
+         control.ss(K.A, K.B, K.C, K.D, inputs=["y1", "y2"], outputs=["u"], name="K")],
+        inplist=["w1", "w2"], outlist=["z1", "z2"])
+    assert np.max(control.poles(cl).real) < 0
+    gamma_slicot = float(control.linfnorm(cl)[0])
+    np.testing.assert_allclose(res.gamma, gamma_slicot, rtol=1e-6)
+    assert res.gamma >= meta["gamma_full_order_lmi"] * (1 - 1e-3)
+    g_check, _, alpha = verify_closed_loop(P, K, nmeas, ncon)
+    np.testing.assert_allclose(g_check, res.gamma, rtol=1e-9)
+    assert alpha < 0
+
+
+def test_ac15_static_reaches_published_value():
+    P, nmeas, ncon, meta = load_compleib(COMPLEIB / "AC15.json")
+    best_published = min(meta["published_static"].values())          # hinfstruct 15.2
+    res = synthesize(P, nmeas, ncon, 0, starts=3, seed=0)
+    assert res.gamma <= best_published * 1.005
+    assert res.gamma >= meta["gamma_full_order_lmi"] * (1 - 1e-3)      # γ* bounds every order
+    assert all(s.stabilized for s in res.starts)
+
+
+def test_higher_order_from_lower_order_controller_never_worse():
+    P, nmeas, ncon, _ = load_compleib(COMPLEIB / "AC4.json")
+    r0 = synthesize(P, nmeas, ncon, 0, starts=1, seed=0)
+    r1 = synthesize(P, nmeas, ncon, 1, starts=0, initial=r0.controller, seed=0)
+    assert r1.controller.nstates == 1
+    assert r1.gamma <= r0.gamma * (1 + 1e-9)
+
+
+# --------------------------------------------------------------------------- errors
+
+
+def test_invalid_inputs_are_named():
+    P = first_order_plant(-1.0)
+    with pytest.raises(ConfigError, match="order"):
+        synthesize(P, 1, 1, -1)
+    with pytest.raises(ConfigError, match="tol"):
+        SynthesisOptions(tol=2.0)
+    with pytest.raises(DimensionError, match="nmeas"):
+        synthesize(P, 3, 1, 0)
+    Pd = control.ss(P.A, P.B, P.C, [[0.0, 0.0], [0.0, 1.0], [0.0, 0.5]])   # D22 != 0
+    with pytest.raises(DimensionError, match="D22"):
+        synthesize(Pd, 1, 1, 0)
+    P2 = control.ss([[-1.0]], [[1.0, 1.0, 1.0]], [[1.0], [0.0], [1.0]], np.zeros((3, 3)))
+    with pytest.raises(DimensionError, match="differ"):
+        synthesize([P, P2], 1, 1, 0)
+
+
+def test_bench_cli_writes_records(tmp_path):
+    from casflutter.cli import main
+
+    plant = tmp_path / "AC4.json"
+    plant.write_text((COMPLEIB / "AC4.json").read_text())
+    out = tmp_path / "out.json"
+    rc = main(["bench", "synthesis", "--plants", str(plant), "--orders", "0,1", "--out",
+               str(out), "--starts", "1", "--hinfsyn-timeout", "0"])
+    assert rc == 0
+    recs = json.loads(out.read_text())
+    assert [r["order"] for r in recs] == [0, 1]
+    for r in recs:
+        assert {"plant", "order", "gamma", "gamma_lower_bound", "stable", "status", "starts",
+                "wall_time_s"} <= set(r)
+        assert r["stable"] and r["gamma_lower_bound"] is None   # no reference.json beside it
+    assert recs[1]["gamma"] <= recs[0]["gamma"] * (1 + 1e-9)
