@@ -9,11 +9,16 @@
   Parquet with pyarrow) and summary plots.
 - :func:`flutter_sensitivity`: dVf/dp by eigenvalue perturbation at the crossing
   (paper Sec. III-B), checked by :func:`flutter_speed_fd`.
-- :func:`cached_solver`: one parametric CasADi solver per worker process and structure.
+- :func:`flutter_sensitivity_nlp`: the same derivatives from the parametric sensitivity of
+  the Hopf-point NLP (:func:`hopf_point`, CasADi).
+- :func:`cached_solver`: one parametric CasADi solver per worker process and structure
+  (the ``truth_hopf`` evaluator builds its NLP once per worker).
 """
 
 from ._evaluators import (Evaluator, evaluator_names, get_evaluator, register_evaluator,
                           synthesis_gamma, truth_flutter)
+from ._hopf import (HopfPoint, flutter_sensitivity_nlp, hopf_point, quadratic_coefficients,
+                    truth_hopf)
 from ._runner import Progress, SweepResult, evaluate_point, run_sweep
 from ._sensitivity import (FlutterSensitivity, ParameterSensitivity, flutter_sensitivity,
                            flutter_speed_fd)
@@ -30,4 +35,5 @@ __all__ = [
     "sweep_table", "write_table", "plot_sweep",
     "flutter_sensitivity", "flutter_speed_fd", "FlutterSensitivity", "ParameterSensitivity",
     "cached_solver", "solver_builds", "clear_solver_cache",
+    "hopf_point", "HopfPoint", "quadratic_coefficients", "flutter_sensitivity_nlp", "truth_hopf",
 ]

@@ -12,6 +12,9 @@ failure (the runner records the error and carries on).  Built-in evaluators:
 ``synthesis``
     Fixed-order H∞ synthesis (:func:`casflutter.design.synthesize`) on a COMPleib-format plant
     file: verified γ vs controller ``order`` (and ``seed``, ``starts``).
+``truth_hopf``
+    The same flutter speed as the root of the Hopf system, a parametric CasADi NLP built once
+    per worker process and reused for every point (:func:`casflutter.study.truth_hopf`).
 ``rom_flutter``
     The ROM route of the pipeline, registered only when ``casflutter.pipeline`` provides it.
 
@@ -274,6 +277,22 @@ register_evaluator("synthesis", synthesis_gamma,
                             "converged", "statuses", "synthesis_time"),
                    description="fixed-order H-infinity synthesis on a COMPleib plant (gamma vs order)",
                    modules=("casflutter.design",))
+
+
+
+def _truth_hopf(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dict[str, Any]:
+    """See :func:`casflutter.study.truth_hopf` (imported lazily)."""
+    from ._hopf import truth_hopf  # noqa: PLC0415
+
+    return truth_hopf(params, settings)
+
+
+register_evaluator("truth_hopf", _truth_hopf,
+                   outputs=("Vf", "omega_f", "frequency_hz", "return_status", "iterations",
+                            "solve_time", "solver_builds", "pid", "hopf_time"),
+                   description="truth flutter speed by the Hopf-point NLP (one cached "
+                               "parametric CasADi solver per worker)",
+                   modules=("casflutter.truth", "casflutter.study._hopf"))
 
 
 def _maybe_register_pipeline() -> None:
