@@ -238,7 +238,8 @@ def synthesis_gamma(params: Mapping[str, Any], settings: Mapping[str, Any]) -> d
     -------
     dict
         ``gamma`` (verified, exact norm), ``delta_bound`` (= 1/γ), ``spectral_abscissa``,
-        ``success``, ``converged``, ``statuses`` (Ipopt, best start), ``synthesis_time``.
+        ``success``, ``converged``, ``n_solves`` / ``n_solve_succeeded`` / ``last_status``
+        (Ipopt statuses of the best start, verbatim), ``synthesis_time``.
 
     Notes
     -----
@@ -263,7 +264,9 @@ def synthesis_gamma(params: Mapping[str, Any], settings: Mapping[str, Any]) -> d
     res = synthesize(P, nmeas, ncon, order, starts=starts, seed=seed, options=merged or None)
     return {"gamma": res.gamma, "delta_bound": res.delta_bound,
             "spectral_abscissa": res.spectral_abscissa, "success": res.success,
-            "converged": res.converged, "statuses": ";".join(res.statuses),
+            "converged": res.converged, "n_solves": len(res.statuses),
+            "n_solve_succeeded": sum(st == "Solve_Succeeded" for st in res.statuses),
+            "last_status": res.statuses[-1] if res.statuses else None,
             "synthesis_time": time.perf_counter() - t0}
 
 
@@ -274,7 +277,8 @@ register_evaluator("truth_flutter", truth_flutter,
                    modules=("casflutter.truth", "casflutter.aeroelastic"))
 register_evaluator("synthesis", synthesis_gamma,
                    outputs=("gamma", "delta_bound", "spectral_abscissa", "success",
-                            "converged", "statuses", "synthesis_time"),
+                            "converged", "n_solves", "n_solve_succeeded", "last_status",
+                            "synthesis_time"),
                    description="fixed-order H-infinity synthesis on a COMPleib plant (gamma vs order)",
                    modules=("casflutter.design",))
 
@@ -295,14 +299,61 @@ register_evaluator("truth_hopf", _truth_hopf,
                    modules=("casflutter.truth", "casflutter.study._hopf"))
 
 
+def rom_flutter_evaluator(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dict[str, Any]:
+    """The ROM route of :func:`casflutter.pipeline.rom_flutter` at one point.
+
+    Parameters
+    ----------
+    params, settings : mapping
+        ``problem``; any truth parameter; any :class:`casflutter.pipeline.RomSettings` field
+        (``V0`` nominal speed, ``na``/``nb`` ROM orders, ``n_speeds``, ``dt``, ``duration``,
+        ``band`` ...); ``parametric`` (bool, default False: also the parametric ROM).
+
+    Returns
+    -------
+    dict
+        ``Vf_truth``, ``Vf_rom``, ``Vf_frozen``, ``Vf_parametric``, ``omega_f_rom``,
+        ``rom_error``, ``scaling_error``, ``identification_error``, ``parametric_error``,
+        ``rom_stable``, ``rom_status`` and ``time_<stage>`` per pipeline stage.
+    """
+    from dataclasses import fields  # noqa: PLC0415
+
+    from ..pipeline import RomSettings, rom_flutter, rom_settings  # noqa: PLC0415
+    from ..truth import PROBLEMS  # noqa: PLC0415
+
+    merged = {**settings, **params}
+    merged.pop("_base_dir", None)
+    name = str(merged.pop("problem", "typical_section"))
+    parametric = bool(merged.pop("parametric", False))
+    rom_keys = {f.name for f in fields(RomSettings)}
+    overrides = {k: merged.pop(k) for k in list(merged) if k in rom_keys}
+    if name not in PROBLEMS:
+        raise ConfigError(f"unknown problem {name!r}; available: {', '.join(PROBLEMS)}")
+    cls = PROBLEMS[name]
+    truth = cls(cls.Params().with_updates(**merged))  # unknown names raise ConfigError
+    res = rom_flutter(truth, rom_settings(name, **overrides), parametric=parametric)
+    out = {"Vf_truth": res.truth.Vf, "Vf_rom": res.rom.Vf, "Vf_frozen": res.frozen.Vf,
+           "Vf_parametric": None if res.parametric is None else res.parametric.Vf,
+           "omega_f_rom": res.rom.omega_f, "rom_error": res.rom_error,
+           "scaling_error": res.scaling_error, "identification_error": res.identification_error,
+           "parametric_error": res.parametric_error, "rom_stable": res.rom_stable,
+           "rom_status": res.rom.status}
+    out.update({f"time_{k}": v for k, v in res.timings.items()})
+    return out
+
+
 def _maybe_register_pipeline() -> None:
-    """Register ``rom_flutter`` when the pipeline provides a ROM flutter evaluator."""
+    """Register ``rom_flutter`` when :mod:`casflutter.pipeline` provides the ROM route."""
     if "rom_flutter" in _REGISTRY:
         return
     try:
-        mod = importlib.import_module("casflutter.pipeline._rom_flutter")
+        from ..pipeline import rom_flutter, rom_settings  # noqa: F401, PLC0415
     except ImportError:
         return
-    fn = getattr(mod, "evaluate", None) or getattr(mod, "rom_flutter", None)
-    if callable(fn):
-        register_evaluator("rom_flutter", fn, description="ROM route: identify, realize, find Vf")
+    register_evaluator("rom_flutter", rom_flutter_evaluator,
+                       outputs=("Vf_truth", "Vf_rom", "Vf_frozen", "Vf_parametric",
+                                "rom_error", "scaling_error", "identification_error",
+                                "parametric_error", "rom_stable", "rom_status"),
+                       description="ROM route (chirp data, HWL ROM, ERA/Tustin, V^2-scaled "
+                                   "loop) vs the truth flutter speed",
+                       modules=("casflutter.pipeline",))

@@ -376,7 +376,9 @@ def run_sweep(study: Study, *, store: str | Path | None = None, workers: int | N
     scheduler = scheduler if scheduler is not None else study.scheduler
     workers = study.workers if workers is None else int(workers)
     if scheduler is not None:
-        executor = f"dask({getattr(scheduler, 'scheduler', None) and scheduler.scheduler.address or scheduler})"
+        address = scheduler if isinstance(scheduler, str) else getattr(
+            getattr(scheduler, "scheduler", None), "address", repr(scheduler))
+        executor = f"dask({address})"
     elif workers == 0:
         executor = "inline"
     else:

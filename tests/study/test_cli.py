@@ -77,3 +77,12 @@ def test_bench_sweep_writes_json(tmp_path, capsys):
         assert data[key]["work_time"] > 0
     np.testing.assert_allclose(data["speedup_2_vs_1"], data["local_1_workers"]["wall_time"]
                                / data["local_2_workers"]["wall_time"])
+
+
+def test_sensitivity_example_config_runs(capsys):
+    from pathlib import Path
+
+    cfg = Path(__file__).resolve().parents[2] / "problems" / "studies" / "sensitivity_hp1.toml"
+    assert main(["sensitivity", str(cfg), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["params"]["zeta"] == 0.01 and len(data["sensitivities"]) == 7

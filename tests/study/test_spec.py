@@ -1,5 +1,7 @@
 """Study definitions: grid and Latin-hypercube designs, keys, validation."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -72,10 +74,15 @@ def test_load_study_and_validation(tmp_path):
         load_study(tmp_path / "missing.toml")
 
 
-@pytest.mark.parametrize("name", ["typical_section_grid.toml", "typical_section_lhs.toml",
-                                  "typical_section_hopf.toml"])
-def test_example_studies_load(name):
-    from pathlib import Path
+STUDIES = Path(__file__).resolve().parents[2] / "problems" / "studies"
 
-    st = load_study(Path(__file__).resolve().parents[2] / "problems" / "studies" / name)
-    assert len(st.points()) >= 12
+
+@pytest.mark.parametrize("path", sorted(p.name for p in STUDIES.glob("*.toml")
+                                        if not p.name.startswith("sensitivity")))
+def test_example_studies_load(path):
+    from casflutter.study import get_evaluator
+
+    st = load_study(STUDIES / path)
+    assert st.name == Path(path).stem
+    assert len(st.points()) >= 3
+    get_evaluator(st.evaluator)  # registered

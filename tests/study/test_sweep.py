@@ -219,3 +219,40 @@ def test_dask_local_cluster_gives_the_same_results(tmp_path):
         np.testing.assert_allclose(recs[k]["outputs"]["Vf"], inline[k]["outputs"]["Vf"],
                                    rtol=1e-12)
     assert len({r["worker"] for r in recs.values()}) >= 1
+
+
+def test_rom_flutter_evaluator_passes_the_pipeline_through(tmp_path):
+    pipeline = pytest.importorskip("casflutter.pipeline")
+    from casflutter.truth import load_problem
+
+    st = Study(name="rom", evaluator="rom_flutter",
+               parameters=(Parameter("V0", values=(1.8,)),),
+               settings={"problem": "typical_section", "n_grid": 61})
+    res = run_sweep(st, store=tmp_path / "r.jsonl", workers=0, progress=False)
+    rec = next(iter(res.records().values()))
+    assert rec["status"] == "ok", rec.get("error")
+    direct = pipeline.rom_flutter(load_problem("typical_section"),
+                                  pipeline.rom_settings("typical_section", V0=1.8, n_grid=61),
+                                  parametric=False)
+    out = rec["outputs"]
+    np.testing.assert_allclose(out["Vf_truth"], direct.truth.Vf, rtol=1e-12)
+    np.testing.assert_allclose(out["Vf_rom"], direct.rom.Vf, rtol=1e-9)
+    np.testing.assert_allclose(out["rom_error"], direct.rom_error, rtol=1e-6)
+
+
+def test_synthesis_evaluator_gamma_vs_order(tmp_path):
+    from casflutter.design import load_compleib
+    from casflutter.study import load_study
+
+    root = Path(__file__).resolve().parents[2] / "problems"
+    st = load_study(root / "studies" / "compleib_ac4_orders.toml")
+    st = Study(**{**st.__dict__, "parameters": (Parameter("order", values=(0,)),),
+                  "settings": {**st.settings, "starts": 1}})
+    res = run_sweep(st, store=tmp_path / "s.jsonl", workers=0, progress=False)
+    rec = next(iter(res.records().values()))
+    assert rec["status"] == "ok", rec.get("error")
+    out = rec["outputs"]
+    _, _, _, meta = load_compleib(root / "compleib" / "AC4.json")
+    assert out["success"] and out["spectral_abscissa"] < 0
+    assert out["gamma"] >= meta["gamma_full_order_lmi"] * (1 - 1e-6)  # full order bounds it
+    np.testing.assert_allclose(out["delta_bound"], 1.0 / out["gamma"], rtol=1e-12)
