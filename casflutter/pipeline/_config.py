@@ -1,0 +1,235 @@
+"""The TOML configuration of ``casflutter run`` (issue: the paper's wing end to end).
+
+Every choice of the pipeline lives in one file, validated *before* any work starts: unknown
+keys, wrong types and impossible values fail with a :class:`~casflutter.errors.ConfigError`
+that names the key and what is allowed.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import asdict, dataclass, field, fields, is_dataclass
+from pathlib import Path
+from typing import Any, get_args, get_origin, get_type_hints
+
+from .._resources import problems_dir
+from ..errors import ConfigError
+
+__all__ = ["RunConfig", "load_config", "default_config_path"]
+
+
+@dataclass(frozen=True)
+class ProblemSection:
+    """``[problem]``: which truth and its parameter overrides."""
+
+    name: str = "seed_wing"
+    #: parameter overrides, ``{name = value}`` (validated by the truth's parameter class)
+    set: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class DataSection:
+    """``[data]``: chirp records of the truth at the nominal speed (paper §IV.A)."""
+
+    V0: float = 0.69
+    dt: float = 0.005
+    duration: float = 20.0
+    band_hz: list = field(default_factory=lambda: [0.5, 45.0])
+    amplitude_u: float = 1.0
+    amplitude_v: float = 1.0
+    records: int = 1
+
+
+@dataclass(frozen=True)
+class RomSection:
+    """``[rom]``: HWL orders (mu, na, nb, r, p, q), stage-2 criterion, order of Σf."""
+
+    orders: list = field(default_factory=lambda: [3, 1, 1, 1, 2, 2])
+    criterion: str = "prediction"
+    regularization: float = 0.0
+    nf: Any = 15
+
+
+@dataclass(frozen=True)
+class FlutterSection:
+    """``[flutter]``: speed-index range of the Hopf search."""
+
+    vrange: list = field(default_factory=lambda: [0.05, 2.5])
+    n_grid: int = 121
+
+
+@dataclass(frozen=True)
+class LcoSection:
+    """``[lco]``: nonlinear ROM simulation at Vf (paper Fig. 9)."""
+
+    duration: float = 20.0
+    initial_deflection: float = 0.05
+    speed_factor: float = 1.0
+
+
+@dataclass(frozen=True)
+class ControllerSection:
+    """``[controller]``: fixed-order robust synthesis on the LFT at Vf (paper §III.C)."""
+
+    order: int = 3
+    starts: int = 4
+    time_limit: float = 60.0
+
+
+@dataclass(frozen=True)
+class SuppressionSection:
+    """``[suppression]``: closed-loop truth simulation with the gain ramped 0 -> 1 and released
+    (paper Fig. 11)."""
+
+    speed_factor: float = 1.0
+    settle: float = 10.0
+    ramp: float = 5.0
+    hold: float = 10.0
+    release: float = 10.0
+
+
+@dataclass(frozen=True)
+class SolverSection:
+    """``[solver]``: flat Ipopt options for every NLP (``"ipopt.tol" = 1e-8``)."""
+
+    ipopt: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    """The whole configuration; each field is one TOML table."""
+
+    problem: ProblemSection = field(default_factory=ProblemSection)
+    data: DataSection = field(default_factory=DataSection)
+    rom: RomSection = field(default_factory=RomSection)
+    flutter: FlutterSection = field(default_factory=FlutterSection)
+    lco: LcoSection = field(default_factory=LcoSection)
+    controller: ControllerSection = field(default_factory=ControllerSection)
+    suppression: SuppressionSection = field(default_factory=SuppressionSection)
+    solver: SolverSection = field(default_factory=SolverSection)
+    seed: int = 0
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+_POSITIVE = {"dt", "duration", "settle", "ramp", "hold", "release", "time_limit", "V0",
+             "speed_factor"}
+
+
+def _check_value(path: str, name: str, value, typ):
+    origin = get_origin(typ) or typ
+    if typ is Any:
+        return value
+    if origin is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ConfigError(f"{path}: expected a number, got {type(value).__name__} {value!r}")
+        value = float(value)
+        if name in _POSITIVE and not value > 0:
+            raise ConfigError(f"{path} = {value}: must be > 0")
+        if name == "regularization" and value < 0:
+            raise ConfigError(f"{path} = {value}: must be >= 0")
+        return value
+    if origin is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(f"{path}: expected an integer, got {type(value).__name__} {value!r}")
+        return value
+    if origin is str:
+        if not isinstance(value, str):
+            raise ConfigError(f"{path}: expected a string, got {type(value).__name__} {value!r}")
+        return value
+    if origin is list:
+        if not isinstance(value, list):
+            raise ConfigError(f"{path}: expected a list, got {type(value).__name__} {value!r}")
+        return value
+    if origin is dict:
+        if not isinstance(value, dict):
+            raise ConfigError(f"{path}: expected a table, got {type(value).__name__} {value!r}")
+        return value
+    return value
+
+
+def _build(cls, table: dict, prefix: str):
+    hints = get_type_hints(cls)
+    allowed = [f.name for f in fields(cls)]
+    unknown = [k for k in table if k not in allowed]
+    if unknown:
+        where = f"[{prefix}]" if prefix else "top level"
+        raise ConfigError(f"unknown key {unknown[0]!r} in {where}; allowed: {', '.join(allowed)}")
+    kwargs = {}
+    for f in fields(cls):
+        if f.name not in table:
+            continue
+        value = table[f.name]
+        path = f"{prefix}.{f.name}" if prefix else f.name
+        typ = hints[f.name]
+        if is_dataclass(typ):
+            if not isinstance(value, dict):
+                raise ConfigError(f"[{path}] must be a table, got {value!r}")
+            kwargs[f.name] = _build(typ, value, path)
+        else:
+            kwargs[f.name] = _check_value(path, f.name, value, typ)
+    return cls(**kwargs)
+
+
+def _semantic_checks(cfg: RunConfig) -> None:
+    o = cfg.rom.orders
+    if len(o) != 6 or not all(isinstance(x, int) and not isinstance(x, bool) for x in o):
+        raise ConfigError(f"rom.orders = {o!r}: give six integers [mu, na, nb, r, p, q]")
+    from ..ident import HWLOrders
+    try:
+        HWLOrders.from_tuple(o)
+    except ValueError as exc:
+        raise ConfigError(f"rom.orders = {o!r}: {exc}") from None
+    if cfg.rom.criterion not in ("prediction", "simulation"):
+        raise ConfigError(f"rom.criterion = {cfg.rom.criterion!r}: allowed 'prediction', "
+                          "'simulation'")
+    nf = cfg.rom.nf
+    if not (nf == "auto" or (isinstance(nf, int) and not isinstance(nf, bool) and nf >= 1)):
+        raise ConfigError(f"rom.nf = {nf!r}: a positive integer or \"auto\"")
+    band = cfg.data.band_hz
+    if len(band) != 2 or not 0 <= band[0] < band[1]:
+        raise ConfigError(f"data.band_hz = {band!r}: [low, high] with 0 <= low < high")
+    if band[1] >= 0.5 / cfg.data.dt:
+        raise ConfigError(f"data.band_hz upper edge {band[1]} Hz is above the Nyquist frequency "
+                          f"{0.5 / cfg.data.dt:g} Hz of data.dt = {cfg.data.dt}")
+    if cfg.data.duration / cfg.data.dt < 200:
+        raise ConfigError(f"data.duration / data.dt = {cfg.data.duration / cfg.data.dt:.0f} "
+                          "samples: at least 200 are needed")
+    vr = cfg.flutter.vrange
+    if len(vr) != 2 or not 0 <= vr[0] < vr[1]:
+        raise ConfigError(f"flutter.vrange = {vr!r}: [low, high] with 0 <= low < high")
+    if cfg.controller.order < 0:
+        raise ConfigError(f"controller.order = {cfg.controller.order}: must be >= 0")
+    if cfg.controller.starts < 1:
+        raise ConfigError(f"controller.starts = {cfg.controller.starts}: must be >= 1")
+    if cfg.data.records < 1:
+        raise ConfigError(f"data.records = {cfg.data.records}: must be >= 1")
+    from ..truth import problem_names
+    if cfg.problem.name not in problem_names():
+        raise ConfigError(f"problem.name = {cfg.problem.name!r}: allowed "
+                          f"{', '.join(problem_names())}")
+
+
+def default_config_path() -> Path:
+    """The default configuration shipped with the package (the seed wing)."""
+    return problems_dir() / "seed_wing" / "run.toml"
+
+
+def load_config(path=None, **overrides) -> RunConfig:
+    """Read and validate a run configuration (default: the seed wing's).
+
+    ``overrides`` replace top-level fields (e.g. ``seed=3``).
+    """
+    path = Path(path) if path is not None else default_config_path()
+    if not path.exists():
+        raise ConfigError(f"configuration file {path} does not exist")
+    try:
+        with open(path, "rb") as fh:
+            table = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML ({exc})") from None
+    table.update({k: v for k, v in overrides.items() if v is not None})
+    cfg = _build(RunConfig, table, "")
+    _semantic_checks(cfg)
+    return cfg
