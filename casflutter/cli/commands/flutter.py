@@ -1,0 +1,186 @@
+"""``casflutter flutter``: truth, ROM and parametric-ROM flutter speeds of a problem.
+
+Runs :func:`casflutter.pipeline.rom_flutter` (the paper's ROM route at one speed with the V²
+scaling, and the parametric ROM interpolated in V) beside the full-order truth, prints the
+flutter and divergence speeds in the problem's own units (or writes JSON to stdout) and
+saves the V–g / V–f figure.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+
+__all__ = ["register", "run", "summarize"]
+
+
+def register(subparsers) -> None:
+    """Add the ``flutter`` sub-command."""
+    p = subparsers.add_parser(
+        "flutter", help="flutter speed of the truth, the single-speed ROM and the parametric ROM",
+        description="Identify an HWL ROM from chirp data of the truth at one speed, close the "
+                    "loop with the paper's V^2 scaling and find its flutter speed; do the same "
+                    "with a parametric ROM interpolated in V; compare with the truth.  Speeds "
+                    "in the problem's unit (speed index for the typical section, m/s for the "
+                    "Goland wing).")
+    p.add_argument("problem", help="problem name (see `casflutter problems`)")
+    p.add_argument("--set", dest="sets", action="append", default=[], metavar="NAME=VALUE",
+                   help="change a problem parameter (repeatable)")
+    p.add_argument("--vrange", nargs=2, type=float, metavar=("LO", "HI"), default=None,
+                   help="speed range of the analysis, in the problem's speed unit")
+    p.add_argument("--v0", type=float, default=None,
+                   help="nominal speed of the single-speed ROM, in the problem's speed unit")
+    p.add_argument("--no-parametric", action="store_true",
+                   help="skip the parametric ROM (its block is then null)")
+    p.add_argument("--figure", default=None, metavar="PATH",
+                   help="where to save the V-g/V-f figure (default PROBLEM_flutter.png; "
+                        "'none' to skip)")
+    p.add_argument("--json", action="store_true", help="write the result as JSON to stdout")
+    p.set_defaults(func=run)
+
+
+def _speed_conv(truth):
+    """(V -> problem unit, problem unit -> V, unit name)."""
+    if hasattr(truth, "airspeed") and hasattr(truth, "speed_index"):
+        return truth.airspeed, truth.speed_index, "m/s"
+    return float, float, "speed index " + truth.modal_structure().speed_index
+
+
+def _freq_unit(truth) -> tuple[float, str]:
+    ms = truth.modal_structure()
+    if ms.time_unit == "1/omega_theta":
+        return 1.0, "Omega/omega_theta"
+    return 1.0, f"rad/{ms.time_unit}"
+
+
+def _block(res, truth, to_unit, fscale) -> dict | None:
+    if res is None:
+        return None
+    names = truth.modal_structure().mode_names
+    mode = None
+    if res.flutter_mode is not None and 0 <= res.flutter_mode < len(names):
+        mode = names[res.flutter_mode]
+    return {"V_flutter": None if res.Vf is None else to_unit(res.Vf),
+            "omega_flutter": None if res.omega_f is None else res.omega_f * fscale,
+            "mode": mode,
+            "V_divergence": None if res.divergence is None else to_unit(res.divergence.V),
+            "status": res.status,
+            "unstable_at_start": bool(res.unstable_at_start),
+            "message": res.message}
+
+
+def summarize(result, truth, problem: str) -> dict:
+    """The JSON document of ``casflutter flutter`` for a :class:`RomFlutterResult`."""
+    to_unit, _, vunit = _speed_conv(truth)
+    fscale, funit = _freq_unit(truth)
+    rom = _block(result.rom, truth, to_unit, fscale)
+    rom["rom_stable"] = bool(result.rom_stable)
+    s = result.settings
+    warn = []
+    if not result.rom_stable:
+        warn.append("the single-speed ROM is unstable on its own (ΣAE unstable at V = 0): "
+                    "its crossings are not flutter onsets")
+    for key, r in (("truth", result.truth), ("rom", result.rom),
+                   ("parametric_rom", result.parametric)):
+        if r is not None and r.Vf is None:
+            warn.append(f"{key}: {r.message}")
+
+    def err(x):
+        return None if x is None else float(x)
+
+    return {
+        "problem": problem,
+        "truth": _block(result.truth, truth, to_unit, fscale),
+        "rom": rom,
+        "parametric_rom": _block(result.parametric, truth, to_unit, fscale),
+        "frozen_aero_truth": _block(result.frozen, truth, to_unit, fscale),
+        "units": {"V_flutter": vunit, "V_divergence": vunit, "omega_flutter": funit},
+        "rom_V0": to_unit(s.V0),
+        "V_range": [to_unit(v) for v in s.V_range],
+        "parametric_speeds": (None if result.parametric_rom is None
+                              else [to_unit(v) for v in result.parametric_rom.speeds]),
+        "relative_errors": {"rom": err(result.rom_error),
+                            "rom_vs_frozen": err(result.identification_error),
+                            "v2_scaling": err(result.scaling_error),
+                            "parametric_rom": err(result.parametric_error)},
+        "explanation": result.explanation(),
+        "timings": {k: float(v) for k, v in result.timings.items()},
+        "warnings": warn,
+    }
+
+
+def _figure(result, path: str, omega_max: float) -> None:
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from ...report import plot_vg_vf
+
+    panels = [("truth", result.truth), ("ROM at V0 (V² scaling)", result.rom)]
+    if result.parametric is not None:
+        panels.append(("parametric ROM", result.parametric))
+    fig, axes = plt.subplots(2, len(panels), sharex=True, figsize=(5.0 * len(panels), 6.5),
+                             squeeze=False)
+    for k, (title, res) in enumerate(panels):
+        tr = res.tracking
+        # the structural branches and slow aerodynamic lags; not the fast ROM poles near -2/dt
+        keep = [b for b in tr.upper_branches()
+                if np.max(np.abs(tr.eigenvalues[:, b])) < 3.0 * omega_max]
+        plot_vg_vf(res, branches=keep, ax=(axes[0, k], axes[1, k]))
+        axes[0, k].set_title(f"{title}\n{axes[0, k].get_title()}", fontsize="medium")
+        if k:
+            axes[0, k].get_legend() and axes[0, k].get_legend().remove()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _fmt(x, unit="") -> str:
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "none in range"
+    return f"{x:.6g}{unit}"
+
+
+def run(args) -> int:
+    """Handler: run the route, print or write JSON, save the figure."""
+    from ...pipeline import rom_flutter, rom_settings
+    from ...truth import load_problem
+
+    truth = load_problem(args.problem, args.sets)
+    _, from_unit, vunit = _speed_conv(truth)
+    over = {}
+    if args.vrange is not None:
+        lo, hi = args.vrange
+        over["V_range"] = (from_unit(lo), from_unit(hi))
+    if args.v0 is not None:
+        over["V0"] = from_unit(args.v0)
+    settings = rom_settings(args.problem, **over)
+    result = rom_flutter(truth, settings, parametric=not args.no_parametric)
+    doc = summarize(result, truth, args.problem)
+    fig_path = args.figure if args.figure is not None else f"{args.problem}_flutter.png"
+    if fig_path.lower() != "none":
+        _figure(result, fig_path, float(truth.modal_structure().omega.max()))
+        doc["figure"] = fig_path
+    else:
+        doc["figure"] = None
+    if args.json:
+        json.dump(doc, sys.stdout, indent=2)
+        sys.stdout.write("\n")
+        return 0
+    u = doc["units"]
+    print(f"{args.problem}: flutter speed ({u['V_flutter']}), frequency ({u['omega_flutter']})")
+    print(f"  {'':16} {'V_flutter':>14} {'omega_flutter':>14} {'mode':>12} {'V_divergence':>14}")
+    for key, label in (("truth", "truth"), ("rom", f"ROM at V0={doc['rom_V0']:.4g}"),
+                       ("frozen_aero_truth", "frozen-aero truth"),
+                       ("parametric_rom", "parametric ROM")):
+        b = doc[key]
+        if b is None:
+            continue
+        print(f"  {label:16} {_fmt(b['V_flutter']):>14} {_fmt(b['omega_flutter']):>14} "
+              f"{str(b['mode']):>12} {_fmt(b['V_divergence']):>14}")
+    print(f"  {doc['explanation']}")
+    for w in doc["warnings"]:
+        print(f"  warning: {w}")
+    if doc["figure"]:
+        print(f"  V-g/V-f figure: {doc['figure']}")
+    return 0
