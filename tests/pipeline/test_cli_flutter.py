@@ -1,0 +1,78 @@
+"""``casflutter flutter``: JSON keys and units, figure, nulls outside the range, bad --set."""
+
+import json
+
+import pytest
+from numpy.testing import assert_allclose
+
+from casflutter.cli import main
+from casflutter.truth import TypicalSection, problem_definition
+
+BLOCK_KEYS = {"V_flutter", "omega_flutter", "mode", "V_divergence"}
+
+
+@pytest.fixture(scope="module")
+def ts_json(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("flutter_cli")
+    fig = tmp / "ts.png"
+    import contextlib
+    import io
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        rc = main(["flutter", "typical_section", "--json", "--figure", str(fig)])
+    return rc, json.loads(buf.getvalue()), fig
+
+
+def test_json_keys_units_and_figure(ts_json):
+    rc, doc, fig = ts_json
+    assert rc == 0
+    for key in ("truth", "rom", "parametric_rom"):
+        assert BLOCK_KEYS <= set(doc[key])
+    assert doc["units"]["V_flutter"].startswith("speed index")
+    assert doc["units"]["omega_flutter"] == "Omega/omega_theta"
+    ref = problem_definition("typical_section")["reference"]["jones"]
+    assert_allclose(doc["truth"]["V_flutter"], ref["flutter_speed"], rtol=ref["rtol"])
+    assert_allclose(doc["truth"]["omega_flutter"], ref["flutter_frequency_ratio"],
+                    rtol=ref["rtol"])
+    assert doc["truth"]["mode"] == doc["parametric_rom"]["mode"] == "pitch"
+    assert_allclose(doc["parametric_rom"]["V_flutter"], doc["truth"]["V_flutter"], rtol=0.01)
+    assert_allclose(doc["truth"]["V_divergence"], TypicalSection().params.divergence_speed,
+                    rtol=1e-7)
+    assert doc["rom"]["rom_stable"] is True
+    assert fig.is_file() and fig.stat().st_size > 10_000
+
+
+def test_text_output_and_no_crossing_gives_nulls(tmp_path, capsys):
+    rc = main(["flutter", "typical_section", "--vrange", "0.5", "1.5", "--no-parametric",
+               "--figure", "none", "--json"])
+    assert rc == 0
+    doc = json.loads(capsys.readouterr().out)
+    for key in ("truth", "rom"):
+        assert doc[key]["V_flutter"] is None and doc[key]["omega_flutter"] is None
+        assert doc[key]["mode"] is None and doc[key]["V_divergence"] is None
+        assert doc[key]["status"] == "no_crossing"
+    assert doc["parametric_rom"] is None and doc["figure"] is None
+    assert any("no eigenvalue crosses" in w for w in doc["warnings"])
+    rc = main(["flutter", "typical_section", "--vrange", "0.5", "1.5", "--no-parametric",
+               "--figure", str(tmp_path / "f.png")])
+    out = capsys.readouterr().out
+    assert rc == 0 and "none in range" in out and (tmp_path / "f.png").is_file()
+
+
+def test_goland_speeds_in_metres_per_second(capsys):
+    rc = main(["flutter", "goland", "--set", "n_bending=2", "--set", "n_torsion=2",
+               "--vrange", "50", "100", "--no-parametric", "--figure", "none", "--json"])
+    assert rc == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["units"] == {"V_flutter": "m/s", "V_divergence": "m/s", "omega_flutter": "rad/s"}
+    assert_allclose(doc["V_range"], [50.0, 100.0], rtol=1e-12)
+    assert doc["truth"]["V_flutter"] is None  # Goland flutters at ~137 m/s
+
+
+def test_unknown_set_lists_the_valid_names(capsys):
+    rc = main(["flutter", "typical_section", "--set", "mass_ratio=3"])
+    err = capsys.readouterr().err
+    assert rc == 1
+    assert "mass_ratio" in err and "valid names" in err
+    for name in ("mu", "r2", "sigma", "omega_theta"):
+        assert name in err
