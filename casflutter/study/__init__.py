@@ -11,12 +11,15 @@
   (paper Sec. III-B), checked by :func:`flutter_speed_fd`.
 - :func:`flutter_sensitivity_nlp`: the same derivatives from the parametric sensitivity of
   the Hopf-point NLP (:func:`hopf_point`, CasADi).
+- :func:`gamma_sensitivity`: dγ*/dp of fixed-order H∞ synthesis at its solution (envelope
+  theorem of the minimax NLP, CasADi AD), checked against closed-form optima.
 - :func:`cached_solver`: one parametric CasADi solver per worker process and structure
   (the ``truth_hopf`` evaluator builds its NLP once per worker).
 """
 
 from ._evaluators import (Evaluator, evaluator_names, get_evaluator, register_evaluator,
                           synthesis_gamma, truth_flutter)
+from ._gamma import GammaSensitivity, gamma_sensitivity
 from ._hopf import (HopfPoint, flutter_sensitivity_nlp, hopf_point, quadratic_coefficients,
                     truth_hopf)
 from ._runner import Progress, SweepResult, evaluate_point, run_sweep
@@ -35,5 +38,6 @@ __all__ = [
     "sweep_table", "write_table", "plot_sweep",
     "flutter_sensitivity", "flutter_speed_fd", "FlutterSensitivity", "ParameterSensitivity",
     "cached_solver", "solver_builds", "clear_solver_cache",
+    "gamma_sensitivity", "GammaSensitivity",
     "hopf_point", "HopfPoint", "quadratic_coefficients", "flutter_sensitivity_nlp", "truth_hopf",
 ]
