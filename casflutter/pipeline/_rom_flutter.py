@@ -45,7 +45,7 @@ import numpy as np
 from scipy.interpolate import BarycentricInterpolator
 
 from ..aeroelastic import AeroelasticSystem, FlutterResult, ModalStructure, find_flutter
-from ..errors import ConfigError
+from ..errors import ConfigError, DimensionError
 from ..ident import HWLModel
 from ..realize import canonical_realization, lag_coefficients, realize, tustin_to_continuous
 from ._rom_data import RomIdentification, identify_common_denominator, truth_records
@@ -276,7 +276,6 @@ class ParametricROM:
             raise ConfigError(f"the ROMs have different orders {orders}; identify them alike")
         N = ids[0].model.n_modes
         if N != self.structure.n_modes:
-            from ..errors import DimensionError
             raise DimensionError(f"the ROMs have {N} outputs but Σs has "
                                  f"{self.structure.n_modes} modes; they must be equal")
         a = np.array([i.a for i in ids])
