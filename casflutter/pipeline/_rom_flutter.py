@@ -53,7 +53,6 @@ from ._rom_data import RomIdentification, identify_common_denominator, truth_rec
 __all__ = ["RomSettings", "rom_settings", "structure_of", "truth_flutter", "frozen_aero_truth",
            "rom_system", "ParametricROM", "RomFlutterResult", "rom_flutter"]
 
-_PROBLEMS_DIR = Path(__file__).resolve().parents[2] / "problems"
 
 
 @dataclass(frozen=True)
@@ -155,7 +154,13 @@ def rom_settings(problem: str, problems_dir=None, **overrides) -> RomSettings:
     """
     valid = [f.name for f in fields(RomSettings)]
     values = dict(_DEFAULTS.get(problem, {}))
-    path = Path(problems_dir or _PROBLEMS_DIR) / problem / "problem.toml"
+    if problems_dir is None:
+        from .._resources import problems_dir as _default_dir
+        try:
+            problems_dir = _default_dir()
+        except FileNotFoundError:  # no definitions installed: built-in defaults only
+            problems_dir = Path(".")
+    path = Path(problems_dir) / problem / "problem.toml"
     if path.is_file():
         with open(path, "rb") as fh:
             values.update(tomllib.load(fh).get("rom", {}))
