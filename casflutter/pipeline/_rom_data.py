@@ -22,7 +22,12 @@ same two rates on every strip, so the aerodynamic transfer matrix has one scalar
 denominator: the model's ``A^(m)`` are ``a_m I``.  With full ``N x N`` matrices ``A^(m)``
 the regression is rank-deficient on the typical section (the lag enters through a rank-one
 matrix; measured condition number ~1e16) and :func:`casflutter.ident.identify` refuses
-it, correctly.  :func:`identify_common_denominator` solves the constrained least-squares
+it, correctly; lower orders are identified but inadequate (measured at V0 = 1.8 / 110 m/s
+with these records: the paper's orders ``(3, 1, 1, 1, 2, 2)`` give an unstable Σf on both
+problems; ``(1, 2, 2, 0, 1, 1)`` gives an unstable Σf on the typical section and, on the
+Goland wing, a stable one with 0.025% prediction error whose flutter speed is nevertheless
+16% below that of the frozen-aerodynamics truth it should reproduce).
+:func:`identify_common_denominator` solves the constrained least-squares
 problem (variable projection: the scalar ``a_m`` from the residual orthogonal to the input
 regressors, then the input matrices) and returns a standard :class:`HWLModel` with
 orders ``(mu, na, nb, r, p, q) = (1, na, nb - 1, 0, 1, 1)``.  On BDF2 data the fit is exact
