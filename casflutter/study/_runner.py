@@ -246,8 +246,9 @@ def _run_local(study, todo, store, progress, workers, max_points, state) -> None
             state["wall"] += time.perf_counter() - t_work
         except KeyboardInterrupt:
             state["interrupted"] = True
+            procs = list((getattr(ex, "_processes", None) or {}).values())
             ex.shutdown(wait=False, cancel_futures=True)
-            for proc in list(getattr(ex, "_processes", {}).values()):  # stop running points
+            for proc in procs:  # stop the points still running (their results are lost)
                 proc.terminate()
             raise
         finally:

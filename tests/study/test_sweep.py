@@ -256,3 +256,37 @@ def test_synthesis_evaluator_gamma_vs_order(tmp_path):
     assert out["success"] and out["spectral_abscissa"] < 0
     assert out["gamma"] >= meta["gamma_full_order_lmi"] * (1 - 1e-6)  # full order bounds it
     np.testing.assert_allclose(out["delta_bound"], 1.0 / out["gamma"], rtol=1e-12)
+
+
+def test_ctrl_c_stops_the_sweep_and_the_same_command_resumes(tmp_path):
+    study = tmp_path / "sq.toml"
+    study.write_text(f'[study]\nname = "sq"\nevaluator = "{EVALS}:square"\nworkers = 2\n'
+                     '[settings]\nsleep = 0.1\n'
+                     '[parameters]\nx = {low = 0, high = 15, integer = true}\n')
+    out = tmp_path / "out"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
+    cmd = [sys.executable, "-c", "import sys; from casflutter.cli import main; "
+           "sys.exit(main(sys.argv[1:]))", "sweep", str(study), "--out", str(out),
+           "--no-plot"]
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    store = out / "sq.jsonl"
+    t0 = time.time()
+    while time.time() - t0 < 90:
+        if store.exists() and len(store.read_text().splitlines()) >= 3:
+            break
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)  # Ctrl-C to the driver only
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "run the same command again to resume" in err
+    stored = PointStore(store).records()
+    assert 3 <= len(stored) < 16
+    done = subprocess.run(cmd + ["--workers", "0", "--json"], env=env, capture_output=True,
+                          text=True, timeout=120)
+    summary = json.loads(done.stdout)
+    assert (summary["resumed"], summary["computed"], summary["left"]) == (
+        len(stored), 16 - len(stored), 0)
+    valid = list(PointStore(store))
+    assert len({r["key"] for r in valid}) == 16 == len(valid)
+    assert sorted(r["outputs"]["y"] for r in valid) == [x * x for x in range(16)]
