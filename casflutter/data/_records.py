@@ -317,6 +317,26 @@ class IOData:
                             None if r.v is None else r.v / sv, r.name) for r in self.records)
         return IOData(recs, self.dt, self.output_names, self.u_names, self.v_name, self.meta)
 
+    def window(self, start: int, stop: int | None = None) -> "IOData":
+        """Samples ``start:stop`` of every record (e.g. to drop transient periods)."""
+        cut = lambda x: None if x is None else x[start:stop]  # noqa: E731
+        recs = tuple(Record(r.y[start:stop], cut(r.u), cut(r.v), r.name) for r in self.records)
+        return IOData(recs, self.dt, self.output_names, self.u_names, self.v_name, self.meta)
+
+    def decimated(self, factor: int) -> "IOData":
+        """Every channel low-pass filtered (zero phase, ``scipy.signal.decimate``) and kept
+        every ``factor``-th sample; ``dt`` grows by ``factor``."""
+        from scipy.signal import decimate
+
+        if not isinstance(factor, int) or factor < 1:
+            raise DataError(f"decimation factor {factor!r} must be a positive integer")
+        if factor == 1:
+            return self
+        dec = lambda x: None if x is None else decimate(x, factor, axis=0, zero_phase=True)  # noqa: E731
+        recs = tuple(Record(dec(r.y), dec(r.u), dec(r.v), r.name) for r in self.records)
+        return IOData(recs, self.dt * factor, self.output_names, self.u_names, self.v_name,
+                      self.meta)
+
     def split(self, fraction: float) -> tuple["IOData", "IOData"]:
         """Split every record at ``fraction`` of its length into (estimation, validation)."""
         if not 0 < fraction < 1:
