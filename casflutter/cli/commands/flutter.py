@@ -110,7 +110,7 @@ def summarize(result, truth, problem: str) -> dict:
     }
 
 
-def _figure(result, path: str, omega_max: float) -> None:
+def _figure(result, path: str, omega_max: float, xlabel: str) -> None:
     import matplotlib.pyplot as plt
     import numpy as np
 
@@ -123,10 +123,15 @@ def _figure(result, path: str, omega_max: float) -> None:
                              squeeze=False)
     for k, (title, res) in enumerate(panels):
         tr = res.tracking
-        # the structural branches and slow aerodynamic lags; not the fast ROM poles near -2/dt
+        # the lightly damped oscillatory (structural) branches; not the real aerodynamic
+        # lags nor the fast ROM poles near -2/dt
+        lam = tr.eigenvalues
         keep = [b for b in tr.upper_branches()
-                if np.max(np.abs(tr.eigenvalues[:, b])) < 3.0 * omega_max]
+                if np.max(np.abs(lam[:, b])) < 3.0 * omega_max
+                and np.min(tr.damping_ratio[:, b]) < 0.9
+                and np.mean(lam[:, b].imag) > 0.02 * omega_max]
         plot_vg_vf(res, branches=keep, ax=(axes[0, k], axes[1, k]))
+        axes[1, k].set_xlabel(xlabel)
         axes[0, k].set_title(f"{title}\n{axes[0, k].get_title()}", fontsize="medium")
         if k:
             axes[0, k].get_legend() and axes[0, k].get_legend().remove()
@@ -159,7 +164,8 @@ def run(args) -> int:
     doc = summarize(result, truth, args.problem)
     fig_path = args.figure if args.figure is not None else f"{args.problem}_flutter.png"
     if fig_path.lower() != "none":
-        _figure(result, fig_path, float(truth.modal_structure().omega.max()))
+        _figure(result, fig_path, float(truth.modal_structure().omega.max()),
+                "speed index " + truth.modal_structure().speed_index.split(",")[0])
         doc["figure"] = fig_path
     else:
         doc["figure"] = None
