@@ -3,8 +3,9 @@
 Every finished point is appended to the :class:`PointStore` the moment its result arrives,
 so an interrupted sweep (Ctrl-C, a killed driver or worker) resumes without recomputing or
 losing a point.  An evaluator that raises gives a ``"failed"`` record with the error text
-and the sweep goes on; a point that kills its worker process is retried once in a
-fresh process and, if it kills that one too, recorded as failed.
+and the sweep goes on; when a worker process dies, a fresh pool retries the lost points,
+and if a worker dies again the remaining points run one at a time, so that the point that
+kills its worker is identified and recorded as failed.
 """
 
 from __future__ import annotations
@@ -209,10 +210,9 @@ def _dead_worker_record(key: str, params: Mapping[str, Any], err: BaseException)
 
 
 def _run_local(study, todo, store, progress, workers, max_points, state) -> None:
-    """Process pool; a broken pool is replaced and its lost points are re-run in isolation."""
+    """Process pool; a broken pool is replaced once, then the lost points run one by one."""
     settings = study.resolved_settings()
     ctx = get_context("spawn")
-    suspects: dict[str, dict] = {}
     remaining = dict(todo)
     while remaining:
         t_start = time.perf_counter()
@@ -258,32 +258,40 @@ def _run_local(study, todo, store, progress, workers, max_points, state) -> None
         state["restarts"] += 1
         if state["restarts"] < 2:
             continue  # a worker died: a fresh pool retries the lost points once
-        # it died again: re-run each remaining point alone to find the culprit(s)
-        suspects.update(remaining)
-        for k, p in list(suspects.items()):
-            rec = _isolated(study, k, p, settings, ctx, state)
+        # it died again: one point at a time in a single worker finds the culprit(s)
+        _run_one_by_one(study, remaining, store, progress, settings, ctx, max_points, state)
+        break
+
+
+def _run_one_by_one(study, remaining, store, progress, settings, ctx, max_points,
+                    state) -> None:
+    """Points one at a time in a single worker process (replaced when it dies, and then
+    the point it was computing is recorded as failed)."""
+    t0 = time.perf_counter()
+    ex = None
+    try:
+        for k, p in list(remaining.items()):
+            if ex is None:
+                ex = ProcessPoolExecutor(max_workers=1, mp_context=ctx, initializer=_warm,
+                                         initargs=(study.evaluator,))
+            try:
+                rec = ex.submit(evaluate_point, study.evaluator, p, settings, k).result()
+            except BrokenProcessPool as exc:
+                rec = _dead_worker_record(k, p, exc)
+                ex.shutdown(wait=True)
+                ex = None
             store.append(rec)
-            remaining.pop(k, None)
-            suspects.pop(k)
+            remaining.pop(k)
             progress.update(rec)
+            state["work"] += rec.get("work_time") or 0.0
             state["computed"] += 1
             if max_points is not None and state["computed"] >= max_points:
                 state["interrupted"] = True
                 return
-        break
-
-
-def _isolated(study, key, params, settings, ctx, state) -> dict:
-    """One point in its own single-worker pool; a second death records the point failed."""
-    t0 = time.perf_counter()
-    with ProcessPoolExecutor(max_workers=1, mp_context=ctx) as ex:
-        try:
-            rec = ex.submit(evaluate_point, study.evaluator, params, settings, key).result()
-        except BrokenProcessPool as exc:
-            rec = _dead_worker_record(key, params, exc)
-    state["wall"] += time.perf_counter() - t0
-    state["work"] += rec.get("work_time") or 0.0
-    return rec
+    finally:
+        if ex is not None:
+            ex.shutdown(wait=True)
+        state["wall"] += time.perf_counter() - t0
 
 
 def _run_dask(study, todo, store, progress, scheduler, max_points, state) -> None:
