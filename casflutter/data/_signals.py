@@ -14,9 +14,9 @@ def chirp_excitation(n_samples: int, dt: float, n_channels: int = 1, *,
                      taper: float = 0.05, seed: int | None = 0) -> np.ndarray:
     """Band-limited linear chirps, one per channel, mutually decorrelated.
 
-    Each channel sweeps ``band`` (Hz) once over the record, starting from a different,
-    seeded point of the sweep (cyclic shift) and phase, so that the channels are not
-    collinear; a cosine taper of relative length ``taper`` at both ends keeps the
+    Each channel sweeps ``band`` (Hz) up and down with a continuous instantaneous frequency
+    (no phase jumps), at a channel-specific, seeded rate and phase, alternately starting at
+    the low and the high edge, so that the channels are not collinear; a cosine taper of relative length ``taper`` at both ends keeps the
     spectrum inside the band.
 
     Parameters
@@ -52,10 +52,16 @@ def chirp_excitation(n_samples: int, dt: float, n_channels: int = 1, *,
     amp = np.broadcast_to(np.asarray(amplitude, dtype=float), (n_channels,))
     out = np.empty((n_samples, n_channels))
     for c in range(n_channels):
-        shift = (c / max(n_channels, 1) + 0.25 * rng.random()) % 1.0
-        tau = (t + shift * T) % T
-        # instantaneous frequency f0 + (f1 - f0) * tau / T; phase is its integral
-        phase = 2 * np.pi * (f0 * tau + 0.5 * (f1 - f0) * tau ** 2 / T)
+        # channel c sweeps up (even c) or down (odd c), with its own seeded sweep rate
+        # (a fraction of the band covered twice or more) and phase: smooth, no jumps
+        cycles = 1 + c // 2 + rng.random()
+        Tc = T / cycles
+        tau = t % (2 * Tc)
+        tri = np.where(tau < Tc, tau, 2 * Tc - tau)  # triangle sweep: continuous frequency
+        if c % 2:
+            tri = Tc - tri
+        freq = f0 + (f1 - f0) * tri / Tc
+        phase = 2 * np.pi * np.cumsum(freq) * dt
         out[:, c] = amp[c] * np.sin(phase + 2 * np.pi * rng.random())
     n_tap = int(round(taper * n_samples))
     if n_tap > 0:
