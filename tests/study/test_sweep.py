@@ -258,6 +258,7 @@ def test_synthesis_evaluator_gamma_vs_order(tmp_path):
     np.testing.assert_allclose(out["delta_bound"], 1.0 / out["gamma"], rtol=1e-12)
 
 
+@pytest.mark.slow
 def test_ctrl_c_stops_the_sweep_and_the_same_command_resumes(tmp_path):
     study = tmp_path / "sq.toml"
     study.write_text(f'[study]\nname = "sq"\nevaluator = "{EVALS}:square"\nworkers = 2\n'
