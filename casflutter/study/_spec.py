@@ -31,7 +31,7 @@ import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, Mapping
 
 import numpy as np
 
@@ -300,8 +300,3 @@ def load_study(path: str | Path) -> Study:
         raise ConfigError(f"study file {path} is not valid TOML: {exc}") from None
     return Study.from_dict(data, name=path.stem, base_dir=path.resolve().parent)
 
-
-def _check_names(names: Sequence[str], valid: Sequence[str], what: str) -> None:
-    bad = [n for n in names if n not in valid]
-    if bad:
-        raise ConfigError(f"unknown {what} {bad}; valid: {', '.join(valid)}")
