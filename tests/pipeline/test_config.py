@@ -1,0 +1,52 @@
+"""Run configuration: bad configs fail before any work, naming the key and what is allowed."""
+
+import pytest
+
+from casflutter.errors import ConfigError
+from casflutter.pipeline import RunConfig, load_config
+
+
+def _write(tmp_path, text):
+    p = tmp_path / "run.toml"
+    p.write_text(text)
+    return p
+
+
+def test_defaults_are_the_paper_choices():
+    cfg = RunConfig()
+    assert cfg.rom.orders == [3, 1, 1, 1, 2, 2]
+    assert cfg.data.V0 == 0.69 and cfg.controller.order == 3
+
+
+@pytest.mark.parametrize("text,match", [
+    ("[rom]\nordres = [3,1,1,1,2,2]\n", r"unknown key 'ordres' in \[rom\]; allowed: orders"),
+    ("colour = 1\n", r"unknown key 'colour' in top level; allowed: problem"),
+    ("[data]\ndt = 'fast'\n", r"data.dt: expected a number, got str"),
+    ("[data]\ndt = -0.1\n", r"data.dt = -0.1: must be > 0"),
+    ("[controller]\norder = 2.5\n", r"controller.order: expected an integer"),
+    ("[rom]\norders = [3,1,1]\n", r"rom.orders .*six integers"),
+    ("[rom]\norders = [0,1,1,1,2,2]\n", r"rom.orders .*mu must be >= 1"),
+    ("[rom]\nnf = 'many'\n", r"rom.nf = 'many'"),
+    ("[rom]\ncriterion = 'magic'\n", r"allowed 'prediction', 'simulation'"),
+    ("[data]\nband_hz = [1.0, 500.0]\n", r"above the Nyquist"),
+    ("[flutter]\nvrange = [2.0, 1.0]\n", r"flutter.vrange"),
+    ("[problem]\nname = 'concorde'\n", r"problem.name = 'concorde': allowed .*typical_section"),
+    ("[data\n", r"not valid TOML"),
+    ("rom = 3\n", r"\[rom\] must be a table"),
+])
+def test_bad_configs_are_named(tmp_path, text, match):
+    with pytest.raises(ConfigError, match=match):
+        load_config(_write(tmp_path, text))
+
+
+def test_missing_file():
+    with pytest.raises(ConfigError, match="does not exist"):
+        load_config("/nonexistent/run.toml")
+
+
+def test_cli_fails_before_work(tmp_path, capsys):
+    from casflutter.cli import main
+    rc = main(["run", str(_write(tmp_path, "[rom]\nordres = 1\n")), "--out", str(tmp_path / "o")])
+    assert rc == 1
+    assert "unknown key 'ordres'" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
