@@ -242,8 +242,8 @@ def flutter_sensitivity(problem: str = "typical_section",
     for n in names:
         dA, kind = _matrix_derivative(problem, nominal, n, Vf, rel_step, A0)
         dl_dp = dlam(dA)
-        dVf = -dl_dp.real / dl_dV.real
-        dom = np.sign(lam_c.imag) * (dl_dp.imag + dl_dV.imag * dVf)
+        dVf = -dl_dp.real / dl_dV.real + 0.0  # no "-0" in the tables
+        dom = float(np.sign(lam_c.imag) * (dl_dp.imag + dl_dV.imag * dVf)) + 0.0
         p0 = float(nominal[n])
         norm, by = ((p0 / Vf) * dVf, "value") if p0 != 0 else (dVf / Vf, "unit")
         sens.append(ParameterSensitivity(name=n, value=p0, dVf_dp=float(dVf),
