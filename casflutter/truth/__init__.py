@@ -8,17 +8,24 @@ own linear state space in the speed index ``V`` gives the true flutter speed.
   two-lag form, optional flap and polynomial pitch stiffness (Hodges & Pierce HP-1 default).
 - :class:`GolandWing` -- cantilever beam with assumed bending/torsion modes and strip-theory
   Jones aerodynamics (Goland 1945), with a trailing-edge flap of our own.
+- :class:`SeedWing` -- the paper's wind-tunnel wing with tip store (five modes at the
+  paper's frequencies, strip theory with Wagner lags per strip, saturating lift, flap,
+  tip-store accelerometers), nonlinear, calibrated to the paper's Vf and LCO.
 """
 
 from ._aero import JONES_A, JONES_B, jones_C, strip_coefficients, theodorsen_T
 from ._base import AeroelasticTruth, AeroMatrices, ModalStructure, SimulationResult
 from ._goland import GolandParams, GolandWing
+from ._seed_wing import (SEED_FREQUENCIES_HZ, SEED_MODE_NAMES, SEED_SENSOR_ROWS, SEED_U_REF,
+                         SeedWing, SeedWingParams)
 from ._registry import PROBLEMS, load_problem, problem_definition, problem_names
 from ._typical_section import TypicalSection, TypicalSectionParams
 
 __all__ = [
     "AeroelasticTruth", "AeroMatrices", "ModalStructure", "SimulationResult",
     "TypicalSection", "TypicalSectionParams", "GolandWing", "GolandParams",
+    "SeedWing", "SeedWingParams", "SEED_FREQUENCIES_HZ", "SEED_MODE_NAMES", "SEED_SENSOR_ROWS",
+    "SEED_U_REF",
     "PROBLEMS", "problem_names", "load_problem", "problem_definition",
     "JONES_A", "JONES_B", "jones_C", "theodorsen_T", "strip_coefficients",
 ]

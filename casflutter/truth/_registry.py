@@ -8,6 +8,7 @@ from pathlib import Path
 from ..errors import ConfigError
 from ._base import AeroelasticTruth
 from ._goland import GolandWing
+from ._seed_wing import SeedWing
 from ._typical_section import TypicalSection
 
 __all__ = ["PROBLEMS", "problem_names", "load_problem", "problem_definition"]
@@ -16,6 +17,7 @@ __all__ = ["PROBLEMS", "problem_names", "load_problem", "problem_definition"]
 PROBLEMS: dict[str, type[AeroelasticTruth]] = {
     "typical_section": TypicalSection,
     "goland": GolandWing,
+    "seed_wing": SeedWing,
 }
 
 _PROBLEMS_DIR = Path(__file__).resolve().parents[2] / "problems"

@@ -1,0 +1,447 @@
+"""The seed wing: the paper's wind-tunnel wing with tip store (§IV, Table I, Fig. 5-6).
+
+The wing's CFD/FEA are not available, so this is a full-order *nonlinear* truth of our own,
+built in the spirit of the textbook problems and calibrated to the paper's published
+figures.  Everything below that is not a number printed in the paper is OUR choice and is
+documented with its reason in :class:`SeedWingParams`.
+
+Structure (paper eq. 6, FEA modal basis given directly)
+-------------------------------------------------------
+Five modes with EXACTLY the paper's frequencies (Fig. 6): 1st bending 2.19 Hz, 1st lateral
+(in-plane) 10.07 Hz, 2nd bending 13.55 Hz, 1st torsion 16.48 Hz, 3rd bending 38.09 Hz.  The
+modal coordinates ``u`` are mass-normalised (generalised mass ``modal_mass`` for every
+mode), so the structure is ``u'' + 2 zeta omega u' + omega^2 u = Q / modal_mass``.  Each mode
+has a spanwise shape in the three physical deflections of the elastic axis, vertical
+bending ``h(y)`` (positive down), lateral (chordwise, positive aft) ``e(y)`` and twist
+``theta(y)`` (nose up):
+
+    h_i(y) = H_i phi_{r(i)}(y),   e_i(y) = E_i phi_1(y),   theta_i(y) = T_i sin(pi y / 2L),
+
+with ``phi_r`` the clamped--free Euler--Bernoulli shapes normalised to 1 at the tip (the
+paper's bending frequencies 2.19 : 13.55 : 38.09 = 1 : 6.19 : 17.4 are within 1.5 % of the
+uniform clamped--free ratios 1 : 6.27 : 17.55, so these shapes are apt).  The tip amplitudes
+are fixed by the paper's accelerometer rows (§IV), which are the tip-store values of the
+shapes: Acc2 (lateral) reads ``e(L)``, so ``E_i = Hs[1, i]``; Acc1 (vertical, ``acc1_offset``
+aft of the elastic axis) reads ``h(L) + acc1_offset theta(L) = Hs[0, i]``, so
+``H_i = Hs[0, i] - acc1_offset T_i``.  The twists ``T_i`` are: ``T_4 = Hs[0, 3] /
+acc1_offset`` (torsion is pure twist, ``H_4 = 0``), ``T_1 = T_3 = T_5 = 0`` (bending modes are
+untwisted) and ``T_2 = lateral_twist``: the tip store hangs below the wing plane, so when
+it swings sideways in the lateral mode its inertia twists the tip -- the store-induced
+lateral--torsion coupling that gives the otherwise aerodynamically silent in-plane mode its
+aerodynamic forces, and with them the flutter of the mode-2 branch (paper Fig. 10).
+
+Aerodynamics (strip theory, Wagner lag states per strip, saturating lift)
+------------------------------------------------------------------------
+``n_strips`` equal spanwise strips of Theodorsen's thin-airfoil theory (plunge ``h``, pitch
+``theta``, trailing-edge flap ``v`` on the strips inside the flap span) with the circulatory
+part through R. T. Jones' two-lag Wagner function, one pair of lag states per strip.  The
+lagged effective downwash ``Q_eff`` of each strip passes through a softening lift curve
+that saturates,
+
+    c_l = lift_slope * alpha_sat * tanh(alpha_eff / alpha_sat),   alpha_eff = Q_eff / U,
+
+(the source of the LCO above flutter), and the same saturated circulation carries the
+leading-edge suction (Garrick 1936), a chordwise force ``X = suction * rho U b
+lift_slope * (alpha_sat tanh(alpha_eff / alpha_sat))^2 * U`` (forward, per span) that acts on
+the lateral deflection ``e``.  The suction is quadratic in the angle, so it vanishes in the
+linearisation (flutter) but it makes the lateral mode's generalised force visibly nonlinear
+in the chirp responses (paper Fig. 7: "less than 1 % error in all except the 2nd mode").
+The flap is massless and prescribed; the tip store is aerodynamically inert.
+
+Conventions: time in seconds; speed index ``V = U / U_ref`` with ``U_ref = 28.9 m/s``
+(Table I: ``V0 = 0.69`` at 20 m/s, ``Vf = 1.20`` at 34.7 m/s); flow constant ``alpha =
+rho U_ref^2 b L / modal_mass`` so that ``alpha V^2 y = Q / modal_mass`` with ``y = Q /
+(rho U^2 b L)`` the generalised-force coefficient returned by :meth:`SeedWing.aero_forces`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.interpolate import make_interp_spline
+
+from ..errors import DataError, DimensionError
+from ._aero import JONES_A, JONES_B, check_timepts, integrate_lags, sample_derivatives, \
+    strip_coefficients
+from ._base import AeroelasticTruth, AeroMatrices, SimulationResult, _as_1d, _as_2d
+from ._goland import _bending_shapes
+from ._params import ParamsMixin, require
+
+__all__ = ["SeedWingParams", "SeedWing", "SEED_FREQUENCIES_HZ", "SEED_SENSOR_ROWS",
+           "SEED_MODE_NAMES", "SEED_U_REF"]
+
+#: Paper Fig. 6: modal frequencies [Hz] of the five FEA modes.
+SEED_FREQUENCIES_HZ = (2.19, 10.07, 13.55, 16.48, 38.09)
+#: Paper Fig. 6: the modes, in order.
+SEED_MODE_NAMES = ("bending 1", "lateral 1", "bending 2", "torsion 1", "bending 3")
+#: Paper §IV: the accelerometer rows in modal coordinates (Acc1 bending/torsion, Acc2 lateral).
+SEED_SENSOR_ROWS = ((0.1299, -0.0006, -0.2866, -0.1130, 0.0766),
+                    (-0.0021, 0.1364, 0.0141, 0.0021, -0.0020))
+#: Table I: airspeed per unit speed index [m/s] (20 m/s <-> 0.69, 34.7 m/s <-> 1.20).
+SEED_U_REF = 28.9
+
+_BENDING_ORDER = (1, 1, 2, 1, 3)  # clamped-free shape carrying each mode's vertical part
+
+
+def _p(default, unit, doc):
+    return field(default=default, metadata={"unit": unit, "doc": doc})
+
+
+@dataclass(frozen=True)
+class SeedWingParams(ParamsMixin):
+    """Seed-wing parameters.
+
+    Geometry and air are plausible values for a low-speed wind-tunnel wing (the paper does
+    not print them); the calibrated constants (``modal_mass``, ``zeta``, ``zeta_lateral``,
+    ``lateral_twist``, ``alpha_sat``, ``suction``) were chosen so that the ROM pipeline
+    lands on the paper's published figures (see ``problems/seed_wing/problem.toml`` for the
+    calibration record).
+    """
+
+    semispan: float = _p(0.50, "m", "semispan L (our choice: a 1 m wing span model)")
+    chord: float = _p(0.10, "m", "chord 2b (our choice; aspect ratio 5 per half wing)")
+    ea_chord: float = _p(0.35, "-", "elastic axis, fraction of chord from the leading edge "
+                         "(our choice: ahead of mid-chord, aft of the aerodynamic centre)")
+    rho: float = _p(1.225, "kg/m^3", "air density (sea level; Mach 0.06 tunnel)")
+    lift_slope: float = _p(2 * np.pi, "1/rad", "linear lift-curve slope")
+    U_ref: float = _p(SEED_U_REF, "m/s", "airspeed per unit speed index (Table I)")
+    modal_mass: float = _p(0.00198, "kg", "generalised mass of every mass-normalised mode "
+                           "(CALIBRATED: sets alpha, the aerodynamic-to-structural scale)")
+    zeta: float = _p(0.02, "-", "structural damping ratio of modes 1, 3, 4, 5 "
+                     "(CALIBRATED: typical of a wind-tunnel model)")
+    zeta_lateral: float = _p(0.01, "-", "structural damping ratio of the lateral mode 2 "
+                             "(CALIBRATED)")
+    lateral_twist: float = _p(0.5, "rad", "tip twist of the lateral mode per unit modal "
+                              "coordinate: store-induced lateral--torsion coupling (CALIBRATED)")
+    acc1_offset: float = _p(0.08, "m", "Acc1 position aft of the elastic axis on the store "
+                            "(our choice; gives a radius of gyration ~0.4 b)")
+    alpha_sat: float = _p(0.15, "rad", "saturation angle of the lift curve "
+                          "c_l = a alpha_sat tanh(alpha/alpha_sat) (CALIBRATED: LCO)")
+    suction: float = _p(1.0, "-", "leading-edge suction efficiency (CALIBRATED: mode-2 "
+                        "nonlinearity)")
+    flap_chord: float = _p(0.25, "-", "flap chord fraction (hinge at 75 % chord)")
+    flap_span_start: float = _p(0.5, "-", "flap inboard end, fraction of semispan")
+    flap_span_end: float = _p(0.9, "-", "flap outboard end, fraction of semispan")
+    n_strips: int = _p(10, "-", "number of aerodynamic strips")
+
+    def _validate(self) -> None:
+        for name in ("semispan", "chord", "rho", "lift_slope", "U_ref", "modal_mass",
+                     "alpha_sat", "acc1_offset"):
+            require(getattr(self, name) > 0, f"{name} = {getattr(self, name)} must be positive")
+        require(0 < self.ea_chord < 1, f"ea_chord = {self.ea_chord} must lie in (0, 1)")
+        require(self.zeta >= 0 and self.zeta_lateral >= 0,
+                f"damping ratios zeta = {self.zeta}, zeta_lateral = {self.zeta_lateral} "
+                "must be >= 0")
+        require(self.suction >= 0, f"suction = {self.suction} must be >= 0")
+        require(0 < self.flap_chord < 1, f"flap_chord = {self.flap_chord} must lie in (0, 1)")
+        require(0 <= self.flap_span_start < self.flap_span_end <= 1,
+                f"need 0 <= flap_span_start ({self.flap_span_start}) < flap_span_end "
+                f"({self.flap_span_end}) <= 1")
+        require(2 <= self.n_strips <= 100, f"n_strips = {self.n_strips} must be in 2..100")
+
+    @property
+    def b(self) -> float:
+        """Semichord [m]."""
+        return 0.5 * self.chord
+
+    @property
+    def a(self) -> float:
+        """Elastic axis in semichords aft of mid-chord."""
+        return 2.0 * self.ea_chord - 1.0
+
+
+class SeedWing(AeroelasticTruth):
+    """Full-order nonlinear truth of the paper's wind-tunnel wing (module docstring).
+
+    Parameters
+    ----------
+    params : SeedWingParams, optional
+        Defaults to the calibrated wing.
+
+    Notes
+    -----
+    The modal coordinates are the physical coordinates of the base class (``Phi = I``).
+    :meth:`state_matrix` / :meth:`statespace` are the linearisation about the undeflected
+    wing (``tanh'(0) = 1``, suction vanishes); :meth:`aero_forces` and :meth:`simulate` keep
+    the saturating lift and the suction.
+    """
+
+    Params = SeedWingParams
+    name = "seed_wing"
+
+    def __init__(self, params: SeedWingParams | None = None) -> None:
+        p = SeedWingParams() if params is None else params
+        L, ns = p.semispan, p.n_strips
+        self._dy = L / ns
+        ys = (np.arange(ns) + 0.5) * self._dy
+        self._ys = ys
+        phi, _ = _bending_shapes(np.concatenate([ys, [L]]), L, 3)
+        phi = phi / phi[:, -1:]  # tip value 1
+        tw = np.sin(0.5 * np.pi * ys / L)
+        Hs = np.asarray(SEED_SENSOR_ROWS, float)
+        T = np.array([0.0, p.lateral_twist, 0.0, Hs[0, 3] / p.acc1_offset, 0.0])
+        H = Hs[0] - p.acc1_offset * T
+        E = Hs[1].copy()
+        #: (N, ns) strip values of each mode's plunge, twist, lateral deflection
+        self._h = np.array([H[i] * phi[_BENDING_ORDER[i] - 1, :-1] for i in range(5)])
+        self._th = np.outer(T, tw)
+        self._e = np.outer(E, phi[0, :-1])
+        self._tip = {"H": H, "T": T, "E": E}
+        frac = ys / L
+        self._flap = ((frac >= p.flap_span_start) & (frac <= p.flap_span_end)).astype(float)
+        super().__init__(p)
+
+    # conventions --------------------------------------------------------------------
+    def speed_index(self, U: float) -> float:
+        """Speed index ``V = U / U_ref`` for an airspeed ``U`` [m/s]."""
+        return float(U) / self.params.U_ref
+
+    def airspeed(self, V: float) -> float:
+        """Airspeed ``U = V U_ref`` [m/s] for a speed index ``V``."""
+        return float(V) * self.params.U_ref
+
+    @property
+    def alpha(self) -> float:
+        """Flow constant of eq. (6): ``rho U_ref^2 b L / modal_mass`` [1/s^2]."""
+        p = self.params
+        return p.rho * p.U_ref ** 2 * p.b * p.semispan / p.modal_mass
+
+    def _zeta(self) -> np.ndarray:
+        p = self.params
+        z = np.full(5, p.zeta)
+        z[1] = p.zeta_lateral
+        return z
+
+    def _structure_matrices(self):
+        w = 2 * np.pi * np.asarray(SEED_FREQUENCIES_HZ)
+        return np.eye(5), np.diag(w ** 2)
+
+    def strip_shapes(self) -> dict[str, np.ndarray]:
+        """Strip positions and the modes' plunge, twist and lateral deflections there.
+
+        Returns
+        -------
+        dict
+            ``"y"`` ``(ns,)`` strip mid-span positions [m]; ``"h"``, ``"theta"``, ``"e"``
+            ``(N, ns)`` per unit modal coordinate [m, rad, m]; ``"flap"`` ``(ns,)`` 1 on
+            flapped strips; ``"tip"`` the tip amplitudes ``H, T, E`` of the shapes.
+        """
+        return {"y": self._ys.copy(), "h": self._h.copy(), "theta": self._th.copy(),
+                "e": self._e.copy(), "flap": self._flap.copy(),
+                "tip": {k: v.copy() for k, v in self._tip.items()}}
+
+    # aerodynamics ---------------------------------------------------------------------
+    def _strips(self, V: float):
+        p = self.params
+        U = self.airspeed(V)
+        sc = strip_coefficients(rho=p.rho, b=p.b, U=U, a=p.a, c=1.0 - 2.0 * p.flap_chord,
+                                lift_slope=p.lift_slope)
+        return U, sc
+
+    def aero_matrices(self, V: float) -> AeroMatrices:
+        """Linearised strip-theory Jones/Wagner operator at ``V`` (per unit modal mass).
+
+        One downwash ``Q`` (and its two Jones lag states) per strip: ``ng = n_strips``.
+        """
+        p = self.params
+        V = self._check_V(V)
+        U, sc = self._strips(V)
+        h, th, fl, dy = self._h, self._th, self._flap, self._dy
+        m = p.modal_mass
+        # generalised force Q_i = sum_s dy (-L_s h_i(s) + M_s theta_i(s))
+        Cx = dy * (-h @ (sc.La1 * th.T) + th @ (sc.Ma1 * th.T))
+        Mx = dy * (-h @ (sc.Lh2 * h.T + sc.La2 * th.T) + th @ (sc.Mh2 * h.T + sc.Ma2 * th.T))
+        Fv = dy * (th @ fl) * sc.Mb0
+        Fv1 = dy * (-(h @ fl) * sc.Lb1 + (th @ fl) * sc.Mb1)
+        Fv2 = dy * (-(h @ fl) * sc.Lb2 + (th @ fl) * sc.Mb2)
+        W = dy * (-sc.Lc * h + sc.Mc * th)
+        Gx = sc.Qa0 * th.T
+        Gx1 = sc.Qh1 * h.T + sc.Qa1 * th.T
+        Gv = sc.Qb0 * fl
+        Gv1 = sc.Qb1 * fl
+        return AeroMatrices(Kx=np.zeros((5, 5)), Cx=Cx / m, Mx=Mx / m, Fv=Fv / m, Fv1=Fv1 / m,
+                            Fv2=Fv2 / m, W=W / m, Gx=Gx, Gx1=Gx1, Gv=Gv, Gv1=Gv1,
+                            lams=tuple(bj * U / p.b for bj in JONES_B))
+
+    def _nonlinear_circulation(self, geff: np.ndarray, U: float) -> tuple[np.ndarray, np.ndarray]:
+        """Saturated effective downwash and the suction force per strip (per unit modal mass).
+
+        Parameters
+        ----------
+        geff : numpy.ndarray
+            ``(..., ns)`` lagged effective downwash ``Q_eff`` [m/s].
+        U : float
+            Airspeed [m/s].
+
+        Returns
+        -------
+        gsat : numpy.ndarray
+            ``U alpha_sat tanh(Q_eff / (U alpha_sat))``: replaces ``Q_eff`` in the
+            circulatory lift and moment.
+        qx : numpy.ndarray
+            ``(..., N)`` generalised forces of the leading-edge suction on the lateral
+            deflection, per unit modal mass.
+        """
+        p = self.params
+        s = U * p.alpha_sat
+        gsat = s * np.tanh(geff / s)
+        # X forward (towards -e): -X e_i; X = suction rho b lift_slope gsat^2 per span
+        X = p.suction * p.rho * p.b * p.lift_slope * gsat ** 2
+        qx = -(X @ self._e.T) * self._dy / p.modal_mass
+        return gsat, qx
+
+    def aero_forces(self, timepts: np.ndarray, u: np.ndarray, v: np.ndarray | None,
+                    V: float, *, udot: np.ndarray | None = None,
+                    uddot: np.ndarray | None = None, vdot: np.ndarray | None = None,
+                    vddot: np.ndarray | None = None, linear: bool = False) -> np.ndarray:
+        """Nonlinear generalised aerodynamic forces ``y`` for prescribed modal motion and flap.
+
+        As :meth:`AeroelasticTruth.aero_forces` (same arguments, same derivative handling,
+        flow at rest before ``timepts[0]``), with the saturating lift and the leading-edge
+        suction of the module docstring; ``y`` is normalised so that eq. (6),
+        ``u'' + 2 zeta omega u' + omega^2 u = alpha V^2 y``, holds exactly.
+
+        Parameters
+        ----------
+        linear : bool
+            Return the linearised forces instead (the operator of :meth:`aero_matrices`).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(K, 5)`` generalised-force coefficients ``y = Q / (rho U^2 b L)``.
+        """
+        if linear:
+            return super().aero_forces(timepts, u, v, V, udot=udot, uddot=uddot, vdot=vdot,
+                                       vddot=vddot)
+        V = self._check_V(V)
+        dt = check_timepts(timepts)
+        t = np.asarray(timepts, float)
+        K, N = t.size, self.n_modes
+        u = _as_2d("u", u, K, N)
+        v = np.zeros(K) if v is None else _as_1d("v", v, K)
+        if udot is None or uddot is None:
+            d1, d2 = sample_derivatives(t, u, 2)
+            udot = d1 if udot is None else udot
+            uddot = d2 if uddot is None else uddot
+        udot, uddot = _as_2d("udot", udot, K, N), _as_2d("uddot", uddot, K, N)
+        if vdot is None or vddot is None:
+            d1, d2 = sample_derivatives(t, v, 2)
+            vdot = d1 if vdot is None else vdot
+            vddot = d2 if vddot is None else vddot
+        vdot, vddot = _as_1d("vdot", vdot, K), _as_1d("vddot", vddot, K)
+        am = self.aero_matrices(V)
+        g = u @ am.Gx.T + udot @ am.Gx1.T + np.outer(v, am.Gv) + np.outer(vdot, am.Gv1)
+        gd = udot @ am.Gx.T + uddot @ am.Gx1.T + np.outer(vdot, am.Gv) + np.outer(vddot, am.Gv1)
+        zs = integrate_lags(g, gd, dt, am.lams)
+        geff = (1.0 - sum(JONES_A)) * g
+        for A, lam, z in zip(JONES_A, am.lams, zs):
+            geff = geff + A * lam * z
+        gsat, qx = self._nonlinear_circulation(geff, self.airspeed(V))
+        f = (udot @ am.Cx.T + uddot @ am.Mx.T + np.outer(v, am.Fv) + np.outer(vdot, am.Fv1)
+             + np.outer(vddot, am.Fv2) + gsat @ am.W.T + qx)
+        return f / (self.alpha * V * V)
+
+    # nonlinear simulation --------------------------------------------------------------
+    def simulate(self, timepts: np.ndarray, x0: np.ndarray, V: float,
+                 v: np.ndarray | None = None, *, rtol: float = 1e-8,
+                 atol: float = 1e-11, linear: bool = False) -> SimulationResult:
+        """Time simulation of the full nonlinear truth (structure + strip aerodynamics).
+
+        Parameters
+        ----------
+        timepts : numpy.ndarray
+            ``(K,)`` increasing output times [s].
+        x0 : numpy.ndarray
+            ``[u, u']`` (length 10; flow at rest) or the full state ``[u, u', z1, z2]``
+            (length ``10 + 4 n_strips``).
+        V : float
+            Speed index.
+        v : numpy.ndarray, optional
+            ``(K,)`` flap angle [rad] at ``timepts`` (quintic spline); zero if omitted.
+        rtol, atol : float
+            ``solve_ivp`` (DOP853) tolerances.
+        linear : bool
+            Integrate the linearised truth instead (:meth:`state_matrix`).
+
+        Returns
+        -------
+        SimulationResult
+            ``y`` are the (nonlinear) generalised-force coefficients of eq. (6).
+        """
+        t = np.asarray(timepts, float)
+        if t.ndim != 1 or t.size < 2 or np.any(np.diff(t) <= 0):
+            raise DataError("timepts must be a 1-D increasing array of at least 2 samples")
+        V = self._check_V(V)
+        c = self._coupled(V)
+        am, Minv, N, ng = c["am"], c["Minv"], c["N"], c["ng"]
+        nx = 2 * N + 2 * ng
+        x0 = np.asarray(x0, float).reshape(-1)
+        if x0.size == 2 * N:
+            x0 = np.concatenate([x0, np.zeros(nx - 2 * N)])
+        if x0.size != nx:
+            raise DimensionError(f"x0 must have length 2N = {2 * N} or {nx} (with lag states), "
+                                 f"got {x0.size}")
+        if v is None:
+            vs, vfun = np.zeros(t.size), None
+        else:
+            vs = _as_1d("v", v, t.size)
+            if t.size < 6:
+                raise DataError("a flap history needs at least 6 samples")
+            vfun = make_interp_spline(t, vs, k=5)
+            vd1, vd2 = vfun.derivative(1), vfun.derivative(2)
+        U = self.airspeed(V)
+        w2 = self._omega ** 2
+        c2 = 2 * self._zeta() * self._omega
+        a0 = 1.0 - sum(JONES_A)
+        lam1, lam2 = am.lams
+        A1, A2 = JONES_A
+        Gx, Gx1, Gv, Gv1 = am.Gx, am.Gx1, am.Gv, am.Gv1
+
+        def forces(tt, s):
+            uu, ud = s[:N], s[N:2 * N]
+            z1, z2 = s[2 * N:2 * N + ng], s[2 * N + ng:]
+            if vfun is None:
+                vv = vdv = vddv = 0.0
+            else:
+                vv, vdv, vddv = float(vfun(tt)), float(vd1(tt)), float(vd2(tt))
+            g = Gx @ uu + Gx1 @ ud + Gv * vv + Gv1 * vdv
+            geff = a0 * g + A1 * lam1 * z1 + A2 * lam2 * z2
+            if linear:
+                gs, qx = geff, 0.0
+            else:
+                gs, qx = self._nonlinear_circulation(geff, U)
+            # (I - Mx) u'' = -w2 u - c2 u' + Cx u' + Fv v + Fv1 v' + Fv2 v'' + W gs + qx
+            rhs_f = (am.Cx @ ud + am.Fv * vv + am.Fv1 * vdv + am.Fv2 * vddv + am.W @ gs + qx)
+            acc = Minv @ (-w2 * uu - c2 * ud + rhs_f)
+            return acc, g, rhs_f + am.Mx @ acc
+
+        def rhs(tt, s):
+            acc, g, _ = forces(tt, s)
+            return np.concatenate([s[N:2 * N], acc, -lam1 * s[2 * N:2 * N + ng] + g,
+                                   -lam2 * s[2 * N + ng:] + g])
+
+        sol = solve_ivp(rhs, (t[0], t[-1]), x0, method="DOP853", t_eval=t, rtol=rtol,
+                        atol=atol)
+        S = sol.y.T
+        if S.shape[0] != t.size:
+            S = np.vstack([S, np.full((t.size - S.shape[0], nx), np.nan)])
+        acc = np.full((t.size, N), np.nan)
+        Q = np.full((t.size, N), np.nan)
+        for k, (tt, s) in enumerate(zip(t, S)):
+            if np.all(np.isfinite(s)):
+                acc[k], _, Q[k] = forces(tt, s)
+        return SimulationResult(timepts=t, states=S, u=S[:, :N], udot=S[:, N:2 * N],
+                                uddot=acc, y=Q / (self.alpha * V * V), v=vs, V=V,
+                                success=bool(sol.success), message=str(sol.message),
+                                nfev=int(sol.nfev))
+
+    def _names(self) -> dict:
+        return {"mode_names": SEED_MODE_NAMES,
+                "coordinate_names": tuple(f"u{i + 1} ({n})" for i, n in enumerate(SEED_MODE_NAMES)),
+                "sensor_rows": np.asarray(SEED_SENSOR_ROWS, float),
+                "sensor_names": ("Acc1 (bending/torsion)", "Acc2 (lateral)"),
+                "time_unit": "s",
+                "speed_index": "V = U / U_ref, U_ref = 28.9 m/s (Table I)"}

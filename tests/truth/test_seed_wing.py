@@ -1,0 +1,269 @@
+"""The seed-wing truth (the paper's wind-tunnel wing, §IV): structure, forces, flutter, LCO.
+
+References: the paper's Table I, Fig. 6 (modal frequencies), §IV (sensor rows), §IV.A
+(Vf = 1.20 on the mode-2 branch, LCO at 8.5 Hz, fit error < 1 % except mode 2), copied into
+``problems/seed_wing/problem.toml``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+from scipy.linalg import expm
+
+from casflutter.aeroelastic import dominant_frequency, find_flutter
+from casflutter.errors import ConfigError, DimensionError
+from casflutter.truth import (SEED_FREQUENCIES_HZ, SEED_SENSOR_ROWS, SeedWing, SeedWingParams,
+                              load_problem, problem_definition, problem_names)
+
+REF = problem_definition("seed_wing")["reference"]
+PAPER = REF["paper"]
+TOL = REF["tolerances"]
+V0 = PAPER["V0"]
+
+
+@pytest.fixture(scope="module")
+def wing() -> SeedWing:
+    return SeedWing()
+
+
+def _mode_states(N: int = 5):
+    return [np.array([i, N + i]) for i in range(N)]
+
+
+def _frozen_matrix(wing: SeedWing, V0: float):
+    """A(V) of the truth with its aerodynamics frozen at V0 and scaled by (V/V0)^2.
+
+    Built here from the truth's own linear operator (independently of the pipeline): the
+    structure of eq. 6 fed with ``alpha V^2 y`` where ``y`` is the V0 operator -- exactly
+    what a ROM identified at V0 represents in ΣAE(V) (paper eq. 8).
+    """
+    A0 = wing.state_matrix(V0)
+    N = wing.n_modes
+    w2 = wing.modal_structure().omega ** 2
+    c2 = 2 * wing.modal_structure().zeta * wing.modal_structure().omega
+    am = wing.aero_matrices(V0)
+    Minv0 = np.linalg.inv(np.eye(N) - am.Mx)
+    struct = np.zeros((N, A0.shape[0]))
+    struct[:, :N] = -np.diag(w2)
+    struct[:, N:2 * N] = -np.diag(c2)
+    aero0 = np.linalg.solve(Minv0, A0[N:2 * N]) - struct  # (I - Mx) u'' - structural part
+
+    def fn(V):
+        s = (V / V0) ** 2
+        A = A0.copy()
+        A[N:2 * N] = np.linalg.solve(np.eye(N) - s * am.Mx, struct + s * aero0)
+        return A
+
+    return fn
+
+
+# ---- structure and problem definition ---------------------------------------------------
+def test_registered_with_published_reference_values(wing):
+    assert "seed_wing" in problem_names()
+    assert isinstance(load_problem("seed_wing"), SeedWing)
+    assert_allclose(PAPER["frequencies_hz"], SEED_FREQUENCIES_HZ, rtol=0, atol=0)
+    assert_allclose(PAPER["sensor_rows"], SEED_SENSOR_ROWS, rtol=0, atol=0)
+    # Table I: V0 = 0.69 <-> 20 m/s and Vf = 1.20 <-> 34.7 m/s with the speed-index scale
+    assert_allclose(wing.airspeed(PAPER["V0"]), PAPER["nominal_airspeed"], rtol=3e-3)
+    assert_allclose(wing.airspeed(PAPER["flutter_speed_index"]), PAPER["flutter_airspeed"],
+                    rtol=1e-3)
+    # the definition's [parameters] are the class defaults
+    params = problem_definition("seed_wing")["parameters"]
+    assert SeedWingParams(**params) == SeedWingParams()
+
+
+def test_modal_frequencies_are_exactly_the_papers(wing):
+    ms = wing.modal_structure()
+    assert_allclose(ms.omega / (2 * np.pi), PAPER["frequencies_hz"], rtol=1e-14)
+    assert ms.mode_names == tuple(PAPER["mode_names"])
+    assert ms.n_modes == PAPER["n_modes"]
+    assert_allclose(ms.zeta, [0.02, 0.01, 0.02, 0.02, 0.02])
+    # eq. 6 normalisation: alpha V^2 = rho U^2 b L / modal_mass
+    p = wing.params
+    V = 0.9
+    assert_allclose(ms.alpha * V ** 2, p.rho * wing.airspeed(V) ** 2 * p.b * p.semispan
+                    / p.modal_mass, rtol=1e-14)
+
+
+def test_in_vacuo_state_matrix_is_eq6(wing):
+    """With the air removed the linear truth is eq. 6 with the paper's frequencies."""
+    tiny = wing.with_updates(rho=1e-12)
+    lam = np.linalg.eigvals(tiny.state_matrix(1.0))
+    osc = np.sort(np.abs(lam[lam.imag > 1.0].imag))
+    w = 2 * np.pi * np.asarray(SEED_FREQUENCIES_HZ)
+    z = wing.modal_structure().zeta
+    assert_allclose(osc, w * np.sqrt(1 - z ** 2), rtol=1e-9)
+
+
+def test_sensor_rows_and_tip_store_shapes(wing):
+    ms = wing.modal_structure()
+    assert_allclose(ms.sensor_rows, PAPER["sensor_rows"], rtol=0, atol=0)
+    assert ms.sensor_rows.shape == (PAPER["n_sensors"], 5)
+    sh = wing.strip_shapes()
+    tip = sh["tip"]
+    # Acc1 (vertical, acc1_offset aft of the elastic axis) and Acc2 (lateral) at the store
+    assert_allclose(tip["H"] + wing.params.acc1_offset * tip["T"], SEED_SENSOR_ROWS[0],
+                    atol=1e-15)
+    assert_allclose(tip["E"], SEED_SENSOR_ROWS[1], atol=1e-15)
+    # cantilever: every deflection grows from the clamped root to the tip store
+    for key in ("h", "theta", "e"):
+        a = np.abs(sh[key])
+        assert np.all(a[:, 0] <= 0.1 * np.max(a, axis=1) + 1e-15)
+    # Acc2 is dominated by the lateral mode, Acc1 by bending and torsion (paper §IV)
+    assert np.argmax(np.abs(ms.sensor_rows[1])) == 1
+    assert abs(ms.sensor_rows[0, 1]) < 0.01 * np.max(np.abs(ms.sensor_rows[0]))
+    ss = wing.statespace(V0)
+    assert ss.noutputs == 5 + 2 and ss.ninputs == 1 + 5
+    assert ss.nstates == 10 + 2 * wing.params.n_strips + 2  # [u, u', z1, z2, v, v']
+
+
+def test_parameters_are_checked():
+    with pytest.raises(ConfigError, match="modal_mass"):
+        SeedWingParams(modal_mass=-1.0)
+    with pytest.raises(ConfigError, match="flap_span_start"):
+        SeedWingParams(flap_span_start=0.9, flap_span_end=0.5)
+    with pytest.raises(ConfigError, match="valid names"):
+        SeedWing().with_updates(stiffness=1.0)
+    with pytest.raises(DimensionError, match="x0"):
+        SeedWing().simulate(np.linspace(0, 0.1, 11), np.zeros(7), V0)
+
+
+# ---- forces ------------------------------------------------------------------------------
+def test_forces_close_the_linear_loop_at_small_amplitude(wing):
+    """Motion from the linear state matrix, fed to the nonlinear aero_forces, satisfies eq. 6.
+
+    The free response ``x(t) = expm(A t) x0`` of ``state_matrix(V)`` gives exact ``u, u', u''``;
+    ``aero_forces`` (nonlinear, at 1e-6 amplitude) must return ``y`` with
+    ``u'' + 2 zeta omega u' + omega^2 u = alpha V^2 y``: the forces and the linear state
+    matrix are one model.
+    """
+    V = 1.0
+    A = wing.state_matrix(V)
+    N = 5
+    dt = 5e-4
+    t = np.arange(4000) * dt
+    x0 = np.zeros(A.shape[0])
+    x0[:N] = 1e-6 * np.array([1.0, -0.7, 0.5, 0.3, -0.2])
+    E = expm(A * dt)
+    X = np.empty((t.size, A.shape[0]))
+    X[0] = x0
+    for k in range(1, t.size):
+        X[k] = E @ X[k - 1]
+    Xd = X @ A.T
+    u, ud, udd = X[:, :N], X[:, N:2 * N], Xd[:, N:2 * N]
+    y = wing.aero_forces(t, u, None, V, udot=ud, uddot=udd, vdot=np.zeros(t.size),
+                         vddot=np.zeros(t.size))
+    ms = wing.modal_structure()
+    lhs = udd + ud * 2 * ms.zeta * ms.omega + u * ms.omega ** 2
+    rhs = ms.alpha * V ** 2 * y
+    assert_allclose(rhs[20:], lhs[20:], atol=2e-4 * np.max(np.abs(lhs)))
+
+
+def test_nonlinear_forces_agree_with_the_simulation(wing):
+    """aero_forces (prescribed motion) and simulate (coupled) are the same nonlinear model."""
+    V = 1.0
+    t = np.arange(0, 1.0, 5e-4)
+    x0 = np.zeros(10)
+    x0[1] = 0.3  # lateral mode and torsion: large enough to saturate the tip strips
+    x0[3] = 0.1
+    v = 0.02 * np.sin(2 * np.pi * 5 * t) * np.minimum(t / 0.1, 1.0)
+    sim = wing.simulate(t, x0, V, v=v, rtol=1e-10, atol=1e-13)
+    assert sim.success
+    y = wing.aero_forces(t, sim.u, v, V, udot=sim.udot, uddot=sim.uddot)
+    lin = wing.aero_forces(t, sim.u, v, V, udot=sim.udot, uddot=sim.uddot, linear=True)
+    scale = np.max(np.abs(sim.y), axis=0)
+    # the simulation starts with the flow at rest, as aero_forces assumes
+    assert_allclose(y[30:-30], sim.y[30:-30], atol=2e-3 * scale.max())
+    # and the nonlinearity is not negligible here
+    assert np.max(np.abs(lin - y)) > 0.05 * scale.max()
+
+
+def test_mode_two_is_the_visibly_nonlinear_one(wing):
+    """Chirp responses at V0: only the lateral mode's force departs visibly from linear.
+
+    Paper §IV.A / Fig. 7: the ROM fits every mode within 1 % except mode 2, which shows
+    pronounced nonlinear behaviour.  The truth's own nonlinear share of ``y`` (nonlinear
+    minus linearised forces, relative norm) is the floor of any ROM's fit error.
+    """
+    dt = 0.002
+    t = np.arange(4000) * dt
+    rng = np.random.default_rng(5)
+    T = t[-1]
+    # equal chirps, the torsion one halved: its twist per unit coordinate (1.41 rad) is about
+    # three times the others', so this evens out the peak local incidence
+    amplitude = [0.01, 0.01, 0.01, 0.005, 0.01]
+    u = np.zeros((t.size, 5))
+    for j in range(5):
+        f0, f1 = 0.5, 45.0
+        ph = 2 * np.pi * (f0 * t + 0.5 * (f1 - f0) * t ** 2 / T) + 2 * np.pi * rng.random()
+        u[:, j] = amplitude[j] * np.sin(ph) * np.sin(np.pi * t / T) ** 2
+    y = wing.aero_forces(t, u, None, V0)
+    lin = wing.aero_forces(t, u, None, V0, linear=True)
+    k = slice(20, -20)
+    share = 100 * np.linalg.norm(y[k] - lin[k], axis=0) / np.linalg.norm(y[k], axis=0)
+    others = np.delete(share, 1)
+    assert np.all(others < PAPER["fit_error_percent_max"]), share
+    assert share[1] > 2 * PAPER["fit_error_percent_max"], share
+    assert share[1] > 5 * np.max(others), share
+
+
+# ---- flutter and LCO ----------------------------------------------------------------------
+def test_truth_flutter_is_on_the_lateral_branch(wing):
+    res = find_flutter(wing.state_matrix, (0.4, 1.6), n_grid=25, mode_states=_mode_states(),
+                       omega=wing.modal_structure().omega)
+    assert res.status == "flutter"
+    assert res.flutter_mode + 1 == PAPER["flutter_mode"]
+    # full-order truth: above the paper's (ROM) 1.20 by the V^2 frozen-time-scale error
+    assert_allclose(res.Vf, REF["calibrated"]["truth_flutter_speed_index"], atol=5e-3)
+    assert abs(res.frequency_hz - PAPER["lco_frequency_hz"]) < TOL["lco_frequency_hz"]
+    # stable at the nominal speed
+    assert np.max(np.linalg.eigvals(wing.state_matrix(V0)).real) < 0
+
+
+def test_frozen_aerodynamics_flutter_at_the_papers_speed(wing):
+    """The ROM route's ΣAE(V) is the truth's V0 aerodynamics scaled by V^2: Vf = 1.20."""
+    fn = _frozen_matrix(wing, V0)
+    assert_allclose(fn(V0), wing.state_matrix(V0), atol=1e-9 * np.abs(wing.state_matrix(V0)).max())
+    res = find_flutter(fn, (0.4, 1.6), n_grid=25, mode_states=_mode_states(),
+                       omega=wing.modal_structure().omega)
+    assert res.status == "flutter"
+    assert res.flutter_mode + 1 == PAPER["flutter_mode"]
+    assert abs(res.Vf - PAPER["flutter_speed_index"]) < TOL["flutter_speed_index"]
+
+
+def test_lco_above_flutter(wing):
+    """Nonlinear truth above flutter: bounded LCO at the paper's 8.5 Hz (Fig. 9)."""
+    V = 1.5
+    assert np.max(np.linalg.eigvals(wing.state_matrix(V)).real) > 0  # linearly unstable
+    t = np.arange(0, 12.0, 0.002)
+    x0 = np.zeros(10)
+    x0[1] = 0.01
+    sim = wing.simulate(t, x0, V, rtol=1e-7, atol=1e-10)
+    assert sim.success
+    acc = sim.uddot @ wing.modal_structure().sensor_rows.T  # accelerometers
+    late = t >= 8.0
+    mid = (t >= 4.0) & (t < 8.0)
+    amp_late = np.max(np.abs(sim.u[late]), axis=0)
+    amp_mid = np.max(np.abs(sim.u[mid]), axis=0)
+    assert_allclose(amp_late, amp_mid, rtol=0.02)  # settled: neither growing nor decaying
+    assert amp_late[1] > 5 * x0[1]  # grew from the perturbation, then saturated
+    f_hz, _, _ = dominant_frequency(t[late], acc[late, 1])
+    assert abs(f_hz - PAPER["lco_frequency_hz"]) < TOL["lco_frequency_hz"]
+
+
+def test_rom_route_lands_on_the_papers_flutter_speed(wing):
+    """The pipeline's ROM route (chirps at V0, linear ROM, ERA + Tustin, ΣAE, Hopf)."""
+    pipeline = pytest.importorskip("casflutter.pipeline")
+    s = pipeline.rom_settings("seed_wing")
+    assert s.V0 == V0
+    data = pipeline.truth_records(wing, s.V0, dt=s.dt, duration=s.duration, band=s.band,
+                                  amplitude=s.amplitude, taper=s.taper, flap=s.flap)
+    ident = pipeline.identify_common_denominator(data, s.na, s.nb)
+    assert ident.stable
+    system = pipeline.rom_system(ident.model, pipeline.structure_of(wing))
+    res = find_flutter(system, (0.4, 1.6), n_grid=25)
+    assert res.status == "flutter"
+    assert res.flutter_mode + 1 == PAPER["flutter_mode"]
+    assert abs(res.Vf - PAPER["flutter_speed_index"]) < TOL["flutter_speed_index"]
