@@ -10,19 +10,26 @@ subject to, for every plant, ``(Acl + βI)ᵀP + P(Acl + βI) + I = 0`` with ``P
 ``tr P <= c``.  A positive definite ``P`` exists iff ``α(Acl) < -β``; bounding ``tr P``
 turns ``-β`` into the smoothed spectral abscissa, a smooth upper bound of ``α``.
 
-*H∞ phase* (epigraph minimax, paper §III.C): minimise ``t`` subject to, for every plant
-``j`` and frequency slot ``ω_i``,
+*H∞ phase* (epigraph minimax, paper §III.C, a local model in the spirit of Apkarian & Noll
+2006): minimise ``t`` subject to, for every plant ``j`` and slot ``(ω_i, v_i)``,
 
-* ``(jω_i I - Acl) X = Bcl`` and ``T = Ccl X + Dcl`` (lifted frequency response, the complex
-  numbers in real and imaginary parts),
-* ``t² I - TᴴT = LLᴴ`` with ``L`` complex lower triangular (an exact, smooth form of
-  ``σ_max(T(jω_i)) <= t``; ``TTᴴ`` when it is the smaller matrix),
+* ``‖T_j(jω_i; K) v_i‖² <= t²`` where ``T`` is the *exact* closed-loop frequency response as
+  a function of ``K`` (the complex solve written in its real 2n×2n form inside the CasADi
+  graph) and ``v_i`` the top right singular vector at the current controller (``‖Tᴴu‖``
+  with the left vector when ``nz < nw``).  By the envelope theorem this is a first-order
+  exact, smooth model of ``σ_max(T(jω_i; K))``; near-multiple ``σ_max`` are covered by
+  sampling the top-2 singular subspace;
 * ``Aclᵀ P + P Acl + 2βP + WWᵀ = 0``, ``P = RRᵀ``, ``tr P = n`` — a Lyapunov certificate
-  of ``α(Acl) <= -β``: every feasible point is stable, so the phase cannot leave the
-  stability region.
+  of ``α(Acl) <= -β``: every feasible point is stable;
+* a trust region ``|d| <= Δ`` and a floor on ``t`` (the model is trusted locally only).
 
-Every equation is polynomial (at most cubic) in the variables, so exact Hessians in SX
-are cheap and sparse.
+The driver (:mod:`._synthesis`) accepts a step only after the exact H∞ norm (Hamiltonian
+method) has decreased and the loop is verified stable by eigenvalues; it then re-selects the
+slots around the exact peak frequencies (adaptive grid).
+
+An earlier formulation with lifted responses ``X`` and Cholesky slacks ``t²I - TᴴT = LLᴴ``
+(exact at every slot) was measured to stall Ipopt near the optimum (rank-deficient ``L`` at
+active slots: restoration phases, 10–20 s per solve on AC15/HE4), hence this design.
 """
 
 from __future__ import annotations
@@ -57,6 +64,40 @@ def _tril_mx(v: ca.MX, n: int, strict: bool = False) -> ca.MX:
         return ca.MX.zeros(n, n)
     sp = ca.Sparsity.triplet(n, n, [i for i, _ in idx], [j for _, j in idx])
     return ca.densify(ca.MX(sp, v))
+
+
+def _psd_conditions(t2, Yr, Yi) -> ca.MX:
+    """Smooth, exact conditions for ``t² I - YᴴY ⪰ 0`` with ``Y = Yr + jYi`` (``r <= 3``
+    columns): the coefficients of the characteristic polynomial of the Hermitian
+    ``H = t² I - YᴴY`` (sums of principal minors) are all ``>= 0`` iff its (real) eigenvalues
+    are ``>= 0`` (Descartes).  Uses the real symmetric 2r×2r embedding ``[[Hr, -Hi], [Hi, Hr]]``
+    whose eigenvalues are those of ``H`` twice; computed on ``H`` directly for r <= 3."""
+    r = Yr.shape[1]
+    Gr = Yr.T @ Yr + Yi.T @ Yi
+    Gi = Yr.T @ Yi - Yi.T @ Yr
+    Hr = t2 * ca.DM.eye(r) - Gr
+    Hi = -Gi
+    if r == 1:
+        return Hr[0, 0]
+    c1 = ca.trace(Hr)
+    # 2x2 principal minors of a Hermitian matrix: h_aa h_bb - |h_ab|²
+    pairs = [(a, b) for a in range(r) for b in range(a + 1, r)]
+    m2 = [Hr[a, a] * Hr[b, b] - Hr[a, b] ** 2 - Hi[a, b] ** 2 for a, b in pairs]
+    c2 = m2[0]
+    for v in m2[1:]:
+        c2 = c2 + v
+    if r == 2:
+        return ca.vertcat(c1, c2)
+    # r == 3: det of the Hermitian 3x3 (real form of the complex determinant)
+    h11, h22, h33 = Hr[0, 0], Hr[1, 1], Hr[2, 2]
+    a12r, a12i = Hr[0, 1], Hi[0, 1]
+    a13r, a13i = Hr[0, 2], Hi[0, 2]
+    a23r, a23i = Hr[1, 2], Hi[1, 2]
+    # det = h11 h22 h33 + 2 Re(h12 h23 conj(h13)) - h11|h23|² - h22|h13|² - h33|h12|²
+    re_prod = (a12r * a23r - a12i * a23i) * a13r + (a12r * a23i + a12i * a23r) * a13i
+    c3 = (h11 * h22 * h33 + 2 * re_prod - h11 * (a23r ** 2 + a23i ** 2)
+          - h22 * (a13r ** 2 + a13i ** 2) - h33 * (a12r ** 2 + a12i ** 2))
+    return ca.vertcat(c1, c2, c3)
 
 
 def _tril_vals(M: np.ndarray, strict: bool = False) -> np.ndarray:
@@ -170,17 +211,22 @@ class HinfNLP:
         iteration by the adaptive grid.
     options : dict
         Ipopt options for :func:`casflutter._nlp.make_solver`.
+    rank : int
+        Singular directions modelled per frequency (1–3): ``t²I - YᴴY ⪰ 0`` with
+        ``Y = T(jω; K) V_r`` through the characteristic-polynomial conditions.
     """
 
     plants: Sequence[Partition]
     nslots: int
     options: dict
+    rank: int = 1
 
     def __post_init__(self):
         P0 = self.plants[0]
         nw, nz, m, p = P0.dims
         self.m, self.p, self.nw, self.nz = m, p, nw, nz
         self.fix_input = nw <= nz   # fix the direction of the smaller side
+        self.rank = min(self.rank, nw, nz)
         d = ca.MX.sym("d", m * p)
         Kc = ca.MX.sym("Kc", m * p)
         S = ca.MX.sym("S", m * p)
@@ -197,26 +243,30 @@ class HinfNLP:
             Ccl = (P.C1 + ca.mtimes([ca.DM(P.D12), K, ca.DM(P.C2)])) / gref
             Dcl = (P.D11 + ca.mtimes([ca.DM(P.D12), K, ca.DM(P.D21)])) / gref
             om = ca.MX.sym(f"om{j}", self.nslots)
-            U = ca.MX.sym(f"U{j}", 2 * nz, self.nslots)   # [Re u; Im u] per slot
-            V = ca.MX.sym(f"V{j}", 2 * nw, self.nslots)   # [Re v; Im v] per slot
+            # [vec Re V; vec Im V] per slot (top-r singular vectors, zero-padded)
+            U = ca.MX.sym(f"U{j}", 2 * nz * self.rank, self.nslots)
+            V = ca.MX.sym(f"V{j}", 2 * nw * self.rank, self.nslots)
             ps += [om, ca.vec(U), ca.vec(V)]
             In = ca.DM.eye(n)
+            r = self.rank
             for i in range(self.nslots):
                 # real form of (jωI - Acl)
                 M = ca.blockcat([[-Acl, -om[i] * In], [om[i] * In, -Acl]])
                 if self.fix_input:
-                    # ‖T(jω) v‖² with v the top right singular vector at the current K
-                    vr, vi = V[:nw, i], V[nw:, i]
-                    x = ca.solve(M, ca.vertcat(Bcl @ vr, Bcl @ vi))
-                    yr = Ccl @ x[:n] + Dcl @ vr
-                    yi = Ccl @ x[n:] + Dcl @ vi
+                    # Y = T(jω) V with V the top right singular vectors at the current K
+                    Vr = ca.reshape(V[:nw * r, i], nw, r)
+                    Vi = ca.reshape(V[nw * r:, i], nw, r)
+                    Xs = ca.solve(M, ca.vertcat(Bcl @ Vr, Bcl @ Vi))
+                    Yr = Ccl @ Xs[:n, :] + Dcl @ Vr
+                    Yi = Ccl @ Xs[n:, :] + Dcl @ Vi
                 else:
-                    # ‖T(jω)ᴴ u‖² with u the top left singular vector: Tᴴu = Bᴴ(jωI-A)⁻ᴴCᴴu + Dᴴu
-                    ur, ui = U[:nz, i], U[nz:, i]
-                    x = ca.solve(M.T, ca.vertcat(Ccl.T @ ur, Ccl.T @ ui))
-                    yr = Bcl.T @ x[:n] + Dcl.T @ ur
-                    yi = Bcl.T @ x[n:] + Dcl.T @ ui
-                gs.append(t ** 2 - ca.sumsqr(yr) - ca.sumsqr(yi))
+                    # Y = T(jω)ᴴ U with U the top left singular vectors
+                    Ur = ca.reshape(U[:nz * r, i], nz, r)
+                    Ui = ca.reshape(U[nz * r:, i], nz, r)
+                    Xs = ca.solve(M.T, ca.vertcat(Ccl.T @ Ur, Ccl.T @ Ui))
+                    Yr = Bcl.T @ Xs[:n, :] + Dcl.T @ Ur
+                    Yi = Bcl.T @ Xs[n:, :] + Dcl.T @ Ui
+                gs.append(_psd_conditions(t ** 2, Yr, Yi))
             rv = ca.MX.sym(f"R{j}", n * (n + 1) // 2)
             wv = ca.MX.sym(f"W{j}", n * (n + 1) // 2)
             R, W = _tril_mx(rv, n), _tril_mx(wv, n)
@@ -235,14 +285,14 @@ class HinfNLP:
         self.ineq = np.zeros(self.ng_nlp, dtype=bool)
         k = 0
         for P in self.plants:
-            self.ineq[k:k + self.nslots] = True
-            k += self.nslots + P.nx * (P.nx + 1) // 2 + 1
+            self.ineq[k:k + self.nslots * self.rank] = True
+            k += self.nslots * self.rank + P.nx * (P.nx + 1) // 2 + 1
         self.solver: NLPSolver = make_solver({"x": x, "f": f, "g": g, "p": pvec},
                                              self.options, name="hinf_minimax")
 
-    def slots(self, Kc: np.ndarray, omegas: Sequence[np.ndarray], rel: float = 0.9):
-        """Frequency slots ``(ω, u, v)``: at each frequency the singular pairs with
-        ``σ_i >= rel σ_1`` (the local model of the peak), truncated/padded to ``nslots``."""
+    def slots(self, Kc: np.ndarray, omegas: Sequence[np.ndarray], rel: float = 0.8):
+        """Frequency slots ``(ω, U, V)``: at each frequency the (at most ``rank``) singular
+        vectors with ``σ_i >= rel σ_1``, zero-padded (the local model of the peak)."""
         out = []
         for j, P in enumerate(self.plants):
             A, B, C, D = P.closed_loop(Kc)
@@ -252,14 +302,11 @@ class HinfNLP:
                 T = C @ np.linalg.solve(1j * w * np.eye(n) - A, B) + D
                 Us, sv, Vh = np.linalg.svd(T)
                 Vs = Vh.conj().T
-                r = int(np.sum(sv >= rel * sv[0]))
-                items.append((w, Us[:, 0], Vs[:, 0], sv[0]))
-                if r >= 2:
-                    # near-multiple σ_max: sample the top-2 singular subspace (local model)
-                    items.append((w, Us[:, 1], Vs[:, 1], sv[1]))
-                    for c in (1.0, -1.0, 1j, -1j):
-                        items.append((w, (Us[:, 0] + c * Us[:, 1]) / np.sqrt(2),
-                                      (Vs[:, 0] + c * Vs[:, 1]) / np.sqrt(2), sv[0]))
+                r = max(1, min(self.rank, int(np.sum(sv >= rel * sv[0]))))
+                Ur = np.zeros((self.nz, self.rank), complex)
+                Vr = np.zeros((self.nw, self.rank), complex)
+                Ur[:, :r], Vr[:, :r] = Us[:, :r], Vs[:, :r]
+                items.append((w, Ur, Vr, sv[0]))
             items = items[:self.nslots]
             while len(items) < self.nslots:
                 items.append(items[-1])
@@ -281,8 +328,10 @@ class HinfNLP:
             W = np.sqrt(scale) * np.eye(n)
             blocks += [_tril_vals(R), _tril_vals(W)]
             om = np.array([it[0] for it in slots[j]])
-            U = np.array([np.concatenate([it[1].real, it[1].imag]) for it in slots[j]]).T
-            V = np.array([np.concatenate([it[2].real, it[2].imag]) for it in slots[j]]).T
+            U = np.array([np.concatenate([it[1].real.ravel(order="F"),
+                                          it[1].imag.ravel(order="F")]) for it in slots[j]]).T
+            V = np.array([np.concatenate([it[2].real.ravel(order="F"),
+                                          it[2].imag.ravel(order="F")]) for it in slots[j]]).T
             pars += [om, U.ravel(order="F"), V.ravel(order="F")]
         x0 = np.concatenate([np.zeros(self.nd), [t0]] + blocks)
         return x0, pars

@@ -141,7 +141,7 @@ def register(subparsers) -> None:
     p.add_argument("--starts", type=int, default=3, help="starts per order (besides the "
                                                          "previous order's controller)")
     p.add_argument("--seed", type=int, default=0, help="seed of the random starts")
-    p.add_argument("--time-limit", type=float, default=60.0,
+    p.add_argument("--time-limit", type=float, default=120.0,
                    help="wall-time budget per plant and order in seconds")
     p.add_argument("--hinfsyn-timeout", type=float, default=10.0,
                    help="seconds allowed to control.hinfsyn for the full-order comparison "
