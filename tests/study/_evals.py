@@ -30,3 +30,11 @@ def crash_always(params, settings):
     if params["x"] == settings["crash_x"]:
         os._exit(1)
     return square(params, settings)
+
+
+def first_order_plant(params):
+    """ẋ = a x + w + u, z = [x; ρu], y = x (closed-form static optimum for a < 0)."""
+    import control
+
+    return control.ss([[params["a"]]], [[1.0, 1.0]], [[1.0], [0.0], [1.0]],
+                      [[0.0, 0.0], [0.0, params["rho"]], [0.0, 0.0]])

@@ -86,3 +86,24 @@ def test_sensitivity_example_config_runs(capsys):
     assert main(["sensitivity", str(cfg), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["params"]["zeta"] == 0.01 and len(data["sensitivities"]) == 7
+
+
+def test_sensitivity_command_gamma_table(tmp_path, capsys):
+    from . import _evals
+    from .test_gamma import gamma_star
+
+    f = tmp_path / "g.toml"
+    f.write_text(f'[gamma]\nplant = "{_evals.__name__}:first_order_plant"\nnmeas = 1\n'
+                 'ncon = 1\norder = 0\nstarts = 2\nseed = 1\ntol = 1e-8\n'
+                 '[params]\na = -1.0\nrho = 0.7\n')
+    assert main(["sensitivity", str(f), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    np.testing.assert_allclose(data["gamma"], gamma_star(-1.0, 0.7), rtol=1e-6)
+    h = 1e-5
+    fd = {"a": (gamma_star(-1 + h, 0.7) - gamma_star(-1 - h, 0.7)) / (2 * h),
+          "rho": (gamma_star(-1, 0.7 + h) - gamma_star(-1, 0.7 - h)) / (2 * h)}
+    assert [r["name"] for r in data["sensitivities"]] == ["rho", "a"]
+    for r in data["sensitivities"]:
+        np.testing.assert_allclose(r["dgamma_dp"], fd[r["name"]], rtol=1e-6)
+    assert main(["sensitivity", str(f)]) == 0
+    assert "gamma* = 0.57346234" in capsys.readouterr().out

@@ -8,11 +8,7 @@ import pytest
 from casflutter.design import synthesize, verify_closed_loop
 from casflutter.study import gamma_sensitivity
 
-
-def first_order_plant(p):
-    """ẋ = a x + w + u, z = [x; ρu], y = x (the design tests' closed-form plant)."""
-    return control.ss([[p["a"]]], [[1.0, 1.0]], [[1.0], [0.0], [1.0]],
-                      [[0.0, 0.0], [0.0, p["rho"]], [0.0, 0.0]])
+from ._evals import first_order_plant
 
 
 def gamma_star(a, rho):

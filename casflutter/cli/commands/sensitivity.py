@@ -14,6 +14,20 @@ CONFIG::
 
     [params]              # nominal point (changes from the published case)
     zeta = 0.01
+
+With a ``[gamma]`` table instead of ``[sensitivity]``, the optimal γ of fixed-order H∞
+synthesis is differentiated (:func:`casflutter.study.gamma_sensitivity`)::
+
+    [gamma]
+    plant = "package.module:function"   # params -> generalised plant StateSpace(s)
+    nmeas = 1
+    ncon = 1
+    order = 0             # controller order
+    starts = 2
+    seed = 0
+
+    [params]              # every parameter of the plant function (all differentiated)
+    a = -1.0
 """
 
 from __future__ import annotations
@@ -28,10 +42,12 @@ __all__ = ["register", "run"]
 def register(subparsers) -> None:
     """Add the ``sensitivity`` sub-command."""
     p = subparsers.add_parser(
-        "sensitivity", help="ranked flutter-speed sensitivities (eigenvalue perturbation)",
+        "sensitivity", help="ranked flutter-speed (or optimal gamma) sensitivities",
         description="Derivatives of the flutter speed and frequency with respect to the "
                     "problem parameters, by eigenvalue perturbation at the crossing, printed "
-                    "as a table ranked by normalised sensitivity (p/Vf) dVf/dp.")
+                    "as a table ranked by normalised sensitivity (p/Vf) dVf/dp; with a "
+                    "[gamma] table, derivatives of the optimal gamma of fixed-order "
+                    "synthesis.")
     p.add_argument("config", nargs="?", help="TOML file with [sensitivity] and [params]")
     p.add_argument("--problem", default=None, help="problem name (instead of / overriding CONFIG)")
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="NAME=VALUE",
@@ -56,9 +72,10 @@ def _config(args) -> tuple[dict, dict]:
             raise ConfigError(f"config file {path} not found")
         with open(path, "rb") as fh:
             cfg = tomllib.load(fh)
-        bad = set(cfg) - {"sensitivity", "params"}
+        bad = set(cfg) - {"sensitivity", "params", "gamma"}
         if bad:
-            raise ConfigError(f"unknown table(s) {sorted(bad)}; allowed: [sensitivity], [params]")
+            raise ConfigError(f"unknown table(s) {sorted(bad)}; allowed: [sensitivity] or "
+                              "[gamma], and [params]")
     sec = dict(cfg.get("sensitivity", {}))
     allowed = {"problem", "parameters", "V_min", "V_max", "n_grid", "rel_step", "check",
                "method"}
@@ -87,10 +104,60 @@ def _config(args) -> tuple[dict, dict]:
     return sec, params
 
 
+def _gamma(cfg: dict, args) -> int:
+    """The ``[gamma]`` form: synthesize, then dγ*/dp at the solution."""
+    import importlib  # noqa: PLC0415
+
+    from ...design import synthesize  # noqa: PLC0415
+    from ...errors import ConfigError  # noqa: PLC0415
+    from ...study import gamma_sensitivity  # noqa: PLC0415
+
+    g = dict(cfg["gamma"])
+    allowed = {"plant", "nmeas", "ncon", "order", "starts", "seed", "rel_step", "tol"}
+    bad = set(g) - allowed
+    if bad or not {"plant", "nmeas", "ncon"} <= set(g):
+        raise ConfigError(f"[gamma] needs plant, nmeas, ncon (optional order, starts, seed, "
+                          f"rel_step, tol); unknown: {sorted(bad)}")
+    mod, _, attr = str(g["plant"]).partition(":")
+    try:
+        plant_fn = getattr(importlib.import_module(mod), attr)
+    except (ImportError, AttributeError, ValueError) as exc:
+        raise ConfigError(f"[gamma] plant {g['plant']!r} cannot be imported ({exc}); give "
+                          "'package.module:function'") from None
+    params = {k: float(v) for k, v in cfg.get("params", {}).items()}
+    nmeas, ncon = int(g["nmeas"]), int(g["ncon"])
+    res = synthesize(plant_fn(params), nmeas, ncon, int(g.get("order", 0)),
+                     starts=int(g.get("starts", 2)), seed=int(g.get("seed", 0)),
+                     options={"tol": float(g.get("tol", 1e-6))})
+    gs = gamma_sensitivity(plant_fn, params, nmeas, ncon, res,
+                           rel_step=float(g.get("rel_step", 1e-6)))
+    rows = [{"name": n, "value": params[n], "dgamma_dp": d, "normalized": z}
+            for n, d, z in gs.ranked()]
+    if args.json:
+        print(json.dumps({"gamma": gs.gamma, "synthesis_gamma": gs.synthesis_gamma,
+                          "order": res.order, "peaks": gs.peaks,
+                          "multipliers": gs.multipliers, "kkt_residual": gs.kkt_residual,
+                          "method": gs.method, "sensitivities": rows}, indent=2))
+        return 0
+    print(f"gamma* = {gs.gamma:.8g} (order {res.order}, {len(gs.peaks)} active peak(s), "
+          f"stationarity residual {gs.kkt_residual:.1e}; {gs.method})")
+    print(f"{'rank':>4}  {'parameter':<12} {'value':>11} {'dgamma/dp':>13} {'normalised':>11}")
+    for i, r in enumerate(rows, 1):
+        print(f"{i:>4}  {r['name']:<12} {r['value']:>11.5g} {r['dgamma_dp']:>+13.6g} "
+              f"{r['normalized']:>+11.5f}")
+    return 0
+
+
 def run(args) -> int:
     """Handler: print the ranked table (and the finite-difference check)."""
     from ...study import flutter_sensitivity, flutter_sensitivity_nlp, flutter_speed_fd
 
+    if args.config:
+        with open(args.config, "rb") as fh:
+            raw = tomllib.load(fh)
+        if "gamma" in raw:
+            _config(args)  # validates the tables
+            return _gamma(raw, args)
     sec, params = _config(args)
     problem = str(sec.get("problem", "typical_section"))
     V_range = (float(sec.get("V_min", 0.02)), float(sec.get("V_max", 4.0)))
