@@ -195,7 +195,7 @@ def truth_flutter(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dic
     Returns
     -------
     dict
-        ``status`` (:class:`FlutterResult` status), ``Vf``, ``omega_f``, ``frequency_hz``,
+        ``flutter_status`` (:class:`FlutterResult` status), ``Vf``, ``omega_f``, ``frequency_hz``,
         ``flutter_mode``, ``divergence_V``, ``n_crossings``, ``flutter_time`` and, with
         ``lco_speed_ratio``, ``lco_amplitude`` (largest coordinate), one
         ``lco_amplitude_<coordinate>`` per coordinate, ``lco_settling``, ``lco_V``.
@@ -209,7 +209,7 @@ def truth_flutter(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dic
                        n_grid=int(options.get("n_grid", 81)),
                        omega=model.modal_structure().omega)
     out: dict[str, Any] = {
-        "status": res.status, "Vf": res.Vf, "omega_f": res.omega_f,
+        "flutter_status": res.status, "Vf": res.Vf, "omega_f": res.omega_f,
         "frequency_hz": res.frequency_hz, "flutter_mode": res.flutter_mode,
         "divergence_V": None if res.divergence is None else res.divergence.V,
         "n_crossings": len(res.crossings), "flutter_time": time.perf_counter() - t0}
@@ -271,7 +271,7 @@ def synthesis_gamma(params: Mapping[str, Any], settings: Mapping[str, Any]) -> d
 
 
 register_evaluator("truth_flutter", truth_flutter,
-                   outputs=("status", "Vf", "omega_f", "frequency_hz", "flutter_mode",
+                   outputs=("flutter_status", "Vf", "omega_f", "frequency_hz", "flutter_mode",
                             "divergence_V", "n_crossings", "flutter_time", "lco_amplitude"),
                    description="truth flutter speed/frequency/divergence (and LCO amplitude)",
                    modules=("casflutter.truth", "casflutter.aeroelastic"))

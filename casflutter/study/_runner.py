@@ -95,6 +95,7 @@ class Progress:
         self.interval = interval
         self.t0 = time.perf_counter()
         self._last = -1e300
+        self._t_first: float | None = None
 
     @property
     def left(self) -> int:
@@ -103,8 +104,11 @@ class Progress:
 
     def line(self) -> str:
         """The current progress line."""
-        el = time.perf_counter() - self.t0
-        rate = self.done / el if el > 0 and self.done else 0.0
+        now = time.perf_counter()
+        el = now - self.t0
+        # rate from the first finished point on (worker start-up excluded)
+        span = now - self._t_first if self._t_first is not None else 0.0
+        rate = (self.done - 1) / span if self.done >= 2 and span > 0 else 0.0
         eta = f", ETA {self.left / rate:.0f} s" if rate > 0 and self.left else ""
         width = 24
         frac = (self.skipped + self.done) / self.total if self.total else 1.0
@@ -116,6 +120,8 @@ class Progress:
     def update(self, record: Mapping[str, Any] | None = None, *, force: bool = False) -> None:
         """Count one finished record and redraw."""
         if record is not None:
+            if self._t_first is None:
+                self._t_first = time.perf_counter()
             self.done += 1
             self.failed += record.get("status") != "ok"
         if not self.enabled:

@@ -19,7 +19,8 @@ _META = ("key", "status", "error", "work_time", "worker")
 
 def sweep_table(study: Study, store: str | Path) -> list[dict[str, Any]]:
     """One row per design point that has a record: ``key, status``, the parameters, the
-    outputs (``study.outputs``, or all of them), ``error, work_time, worker``.
+    outputs (``study.outputs``, or all of them; one named like another column is prefixed
+    ``out_``), ``error, work_time, worker``.  ``status`` is ``"ok"`` or ``"failed"``.
 
     Rows follow the design order; points without a record yet are left out.
     """
@@ -42,8 +43,9 @@ def sweep_table(study: Study, store: str | Path) -> list[dict[str, Any]]:
         row: dict[str, Any] = {"key": rec["key"], "status": rec.get("status")}
         row.update(p)
         outs = rec.get("outputs", {}) or {}
-        for name in out_names:
-            row[name] = outs.get(name)
+        for name in out_names:  # an output named like a column of its own gets "out_"
+            col = f"out_{name}" if name in row or name in _META else name
+            row[col] = outs.get(name)
         row.update(error=rec.get("error"), work_time=rec.get("work_time"),
                    worker=rec.get("worker"))
         table.append(row)

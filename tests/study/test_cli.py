@@ -13,7 +13,7 @@ STUDY = """
 name = "cli_grid"
 evaluator = "truth_flutter"
 design = "grid"
-outputs = ["status", "Vf", "omega_f"]
+outputs = ["flutter_status", "Vf", "omega_f"]
 
 [settings]
 problem = "typical_section"
@@ -37,7 +37,8 @@ def test_sweep_command_runs_writes_and_resumes(tmp_path, capsys):
     assert (summary["computed"], summary["resumed"], summary["failed"], summary["left"]) == (1, 3, 0, 0)
     assert (out / "cli_grid.csv").is_file() and (out / "cli_grid.png").is_file()
     lines = (out / "cli_grid.csv").read_text().splitlines()
-    assert lines[0].startswith("key,status,mu,zeta,Vf,omega_f") and len(lines) == 5
+    assert lines[0].startswith("key,status,mu,zeta,flutter_status,Vf,omega_f") and len(lines) == 5
+    assert all(",ok," in ln and ",flutter," in ln for ln in lines[1:])
 
 
 def test_sweep_command_lists_evaluators_and_rejects_bad_files(tmp_path, capsys):

@@ -291,3 +291,15 @@ def test_ctrl_c_stops_the_sweep_and_the_same_command_resumes(tmp_path):
     valid = list(PointStore(store))
     assert len({r["key"] for r in valid}) == 16 == len(valid)
     assert sorted(r["outputs"]["y"] for r in valid) == [x * x for x in range(16)]
+
+
+def test_output_named_like_a_column_does_not_hide_the_point_status(tmp_path):
+    st = Study(name="clash", evaluator=f"{EVALS}:square",
+               parameters=(Parameter("x", values=(1.0, 2.0)),), settings={"fail": [2.0]})
+    res = run_sweep(st, store=tmp_path / "c.jsonl", workers=0, progress=False)
+    store = PointStore(res.store)
+    rec = store.records()[st.key({"x": 1.0})]
+    store.append({**rec, "outputs": {**rec["outputs"], "status": "flutter", "x": -1}})
+    rows = {r["x"]: r for r in sweep_table(st, res.store)}
+    assert rows[1.0]["status"] == "ok" and rows[1.0]["out_status"] == "flutter"
+    assert rows[1.0]["out_x"] == -1 and rows[2.0]["status"] == "failed"

@@ -87,7 +87,8 @@ def run(args) -> int:
     else:
         print(f"{study.name}: {res.n_points} points ({study.design}) on {res.executor}: "
               f"{res.n_computed} computed, {res.n_resumed} resumed, {res.n_failed} failed, "
-              f"{res.n_left} left; wall {res.wall_time:.2f} s")
+              f"{res.n_left} left; wall {res.wall_time:.2f} s (+ {res.startup_time:.2f} s "
+              "worker start-up)")
         for f in [store, *files]:
             print(f"  {f}")
         if res.n_left:
