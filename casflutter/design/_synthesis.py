@@ -95,7 +95,9 @@ class StartRecord:
     start : int
         Index of the start.
     kind : str
-        ``"given"`` (an initial controller passed in), ``"zero"`` or ``"random"``.
+        ``"given"`` (an initial controller passed in), ``"given-perturbed"`` (the same padded
+        to the order with small random couplings of the new states), ``"zero"``,
+        ``"random"``, or ``"polish(rank=r)"`` (the polishing of the best start).
     stabilized : bool
         Whether the stabilisation phase reached the required margin.
     spectral_abscissa : float
@@ -213,7 +215,12 @@ def _initial_gain(prob: _Problem, kind: str, rng: np.random.Generator,
             Ak[:ki, :ki] = G.A
             Bk[:ki] = G.B
             Ck[:, :ki] = G.C
-        return prob.from_controller(Ak, Bk, Ck, np.asarray(G.D, float).reshape(nu, ny))
+        K = prob.from_controller(Ak, Bk, Ck, np.asarray(G.D, float).reshape(nu, ny))
+        if kind == "given-perturbed":
+            scale = 1e-2 * max(np.max(np.abs(K[:nu, :ny]), initial=0.0), 1.0)
+            K[nu + ki:, :ny] += scale * np.sqrt(wk) * rng.standard_normal((k - ki, ny))
+            K[:nu, ny + ki:] += scale / np.sqrt(wk) * rng.standard_normal((nu, k - ki))
+        return K
     K = np.zeros((nu + k, ny + k))
     K[nu:, ny:] = -wk * np.eye(k)
     if kind == "random":
@@ -276,9 +283,8 @@ def _hinf_phase(prob, hinf: HinfNLP, K, alpha, opts: SynthesisOptions, statuses,
         for j, w in enumerate(pk_new):
             peak_hist[j].append(w)
         step = np.max(np.abs((Knew - K) / S))
-        if np.isfinite(g_new):
-            gap = abs(g_new - tgrid) / g_new
         if np.isfinite(g_new) and g_new < gam:
+            gap = abs(g_new - tgrid) / g_new     # model vs exact at the accepted point
             model_drop = (gam - tgrid) / gam
             ratio = (gam - g_new) / max(gam - tgrid, 1e-16 * gam)
             K, gam, alpha = Knew, g_new, prob.alpha(Knew)
@@ -389,8 +395,11 @@ def synthesize(plants, nmeas: int, ncon: int, order: int, *, starts: int = 3, se
         else np.inf
 
     rng = np.random.default_rng(seed)
-    plan = [("given", g) for g in given] + [("zero" if i == 0 else "random", None)
-                                            for i in range(starts)]
+    plan = [("given", g) for g in given]
+    # a lower-order start padded with decoupled states sits on a saddle (zero Bk, Ck for the
+    # new states): also start from a slightly perturbed copy
+    plan += [("given-perturbed", g) for g in given if control.ss(g).nstates < order and starts]
+    plan += [("zero" if i == 0 else "random", None) for i in range(starts)]
     records, gains = [], []
     best_alpha = np.inf
     for s, (kind, g) in enumerate(plan):
