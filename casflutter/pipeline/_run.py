@@ -132,7 +132,6 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
     from ..truth import load_problem
     from ..verify import verify_controller
     from ._rom_data import truth_records
-    from ._rom_flutter import truth_flutter
     from ._suppression import accelerometer_structure, suppression_run, truth_lco
 
     cfg = config if isinstance(config, RunConfig) else load_config(config)
@@ -174,8 +173,13 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
             prog.note("warning: Σf is unstable on its own (ΣAE unstable at V = 0)")
     with prog.stage(5, "flutter"):
         vr = tuple(cfg.flutter.vrange)
-        flutter = find_flutter(system, vr, n_grid=cfg.flutter.n_grid)
-        flutter_truth = truth_flutter(truth, vr, n_grid=cfg.flutter.n_grid)
+        # a bounded refinement: repeated lag eigenvalues of identical strips make the
+        # eigenvector matching ambiguous without changing any crossing
+        flutter = find_flutter(system, vr, n_grid=cfg.flutter.n_grid, max_refine=3)
+        N = truth.n_modes
+        flutter_truth = find_flutter(truth, vr, n_grid=cfg.flutter.n_grid, max_refine=3,
+                                     mode_states=[np.array([i, N + i]) for i in range(N)],
+                                     omega=ms.omega)
         objects["flutter"], objects["flutter_truth"] = flutter, flutter_truth
         if flutter.flutter is None:
             raise CasflutterError(f"the ROM has no flutter crossing in V ∈ {vr}: "

@@ -85,7 +85,10 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     Kd = control.sample_system(K, dt, method="zoh") if K.nstates else K
     Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (Kd.A, Kd.B, Kd.C, Kd.D))
     nk = Ak.shape[0] if K.nstates else 0
-    s = np.asarray(x0, dtype=float).copy()
+    nx = truth.state_matrix(V).shape[0]
+    s = np.zeros(nx)
+    x0 = np.asarray(x0, dtype=float).ravel()
+    s[:x0.size] = x0  # [u, u'] (flow at rest) or the full state
     xa = np.zeros(2)  # actuator: v, v'
     xk = np.zeros(nk)
     wa2, ca = actuator_omega ** 2, 2 * actuator_zeta * actuator_omega

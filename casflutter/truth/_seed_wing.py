@@ -101,23 +101,23 @@ class SeedWingParams(ParamsMixin):
     """
 
     semispan: float = _p(0.50, "m", "semispan L (our choice: a 1 m wing span model)")
-    chord: float = _p(0.10, "m", "chord 2b (our choice; aspect ratio 5 per half wing)")
+    chord: float = _p(0.04, "m", "chord 2b (our choice: a beam-like wing, semispan 12.5 chords)")
     ea_chord: float = _p(0.35, "-", "elastic axis, fraction of chord from the leading edge "
                          "(our choice: ahead of mid-chord, aft of the aerodynamic centre)")
     rho: float = _p(1.225, "kg/m^3", "air density (sea level; Mach 0.06 tunnel)")
     lift_slope: float = _p(2 * np.pi, "1/rad", "linear lift-curve slope")
     U_ref: float = _p(SEED_U_REF, "m/s", "airspeed per unit speed index (Table I)")
-    modal_mass: float = _p(0.00198, "kg", "generalised mass of every mass-normalised mode "
+    modal_mass: float = _p(0.001162, "kg", "generalised mass of every mass-normalised mode "
                            "(CALIBRATED: sets alpha, the aerodynamic-to-structural scale)")
     zeta: float = _p(0.02, "-", "structural damping ratio of modes 1, 3, 4, 5 "
                      "(CALIBRATED: typical of a wind-tunnel model)")
     zeta_lateral: float = _p(0.01, "-", "structural damping ratio of the lateral mode 2 "
                              "(CALIBRATED)")
-    lateral_twist: float = _p(0.5, "rad", "tip twist of the lateral mode per unit modal "
+    lateral_twist: float = _p(0.8, "rad", "tip twist of the lateral mode per unit modal "
                               "coordinate: store-induced lateral--torsion coupling (CALIBRATED)")
-    acc1_offset: float = _p(0.08, "m", "Acc1 position aft of the elastic axis on the store "
+    acc1_offset: float = _p(0.04, "m", "Acc1 position aft of the elastic axis on the store "
                             "(our choice; gives a radius of gyration ~0.4 b)")
-    alpha_sat: float = _p(0.15, "rad", "saturation angle of the lift curve "
+    alpha_sat: float = _p(0.20, "rad", "saturation angle of the lift curve "
                           "c_l = a alpha_sat tanh(alpha/alpha_sat) (CALIBRATED: LCO)")
     suction: float = _p(1.0, "-", "leading-edge suction efficiency (CALIBRATED: mode-2 "
                         "nonlinearity)")
@@ -392,31 +392,14 @@ class SeedWing(AeroelasticTruth):
                 raise DataError("a flap history needs at least 6 samples")
             vfun = make_interp_spline(t, vs, k=5)
             vd1, vd2 = vfun.derivative(1), vfun.derivative(2)
-        U = self.airspeed(V)
-        w2 = self._omega ** 2
-        c2 = 2 * self._zeta() * self._omega
-        a0 = 1.0 - sum(JONES_A)
-        lam1, lam2 = am.lams
-        A1, A2 = JONES_A
-        Gx, Gx1, Gv, Gv1 = am.Gx, am.Gx1, am.Gv, am.Gv1
+        forces_at = self._forces(V, linear)
 
         def forces(tt, s):
-            uu, ud = s[:N], s[N:2 * N]
-            z1, z2 = s[2 * N:2 * N + ng], s[2 * N + ng:]
             if vfun is None:
-                vv = vdv = vddv = 0.0
-            else:
-                vv, vdv, vddv = float(vfun(tt)), float(vd1(tt)), float(vd2(tt))
-            g = Gx @ uu + Gx1 @ ud + Gv * vv + Gv1 * vdv
-            geff = a0 * g + A1 * lam1 * z1 + A2 * lam2 * z2
-            if linear:
-                gs, qx = geff, 0.0
-            else:
-                gs, qx = self._nonlinear_circulation(geff, U)
-            # (I - Mx) u'' = -w2 u - c2 u' + Cx u' + Fv v + Fv1 v' + Fv2 v'' + W gs + qx
-            rhs_f = (am.Cx @ ud + am.Fv * vv + am.Fv1 * vdv + am.Fv2 * vddv + am.W @ gs + qx)
-            acc = Minv @ (-w2 * uu - c2 * ud + rhs_f)
-            return acc, g, rhs_f + am.Mx @ acc
+                return forces_at(s, 0.0, 0.0, 0.0)
+            return forces_at(s, float(vfun(tt)), float(vd1(tt)), float(vd2(tt)))
+
+        lam1, lam2 = am.lams
 
         def rhs(tt, s):
             acc, g, _ = forces(tt, s)
@@ -437,6 +420,56 @@ class SeedWing(AeroelasticTruth):
                                 uddot=acc, y=Q / (self.alpha * V * V), v=vs, V=V,
                                 success=bool(sol.success), message=str(sol.message),
                                 nfev=int(sol.nfev))
+
+    def _forces(self, V: float, linear: bool = False):
+        """``f(s, v, v', v'') -> (u'', g, Q)``: modal accelerations, strip downwash and
+        generalised forces of the full state ``s = [u, u', z1, z2]`` with the flap angle and
+        its rates (the right-hand side shared by :meth:`simulate` and :meth:`flap_dynamics`)."""
+        c = self._coupled(V)
+        am, Minv, N, ng = c["am"], c["Minv"], c["N"], c["ng"]
+        U = self.airspeed(V)
+        w2 = self._omega ** 2
+        c2 = 2 * self._zeta() * self._omega
+        a0 = 1.0 - sum(JONES_A)
+        lam1, lam2 = am.lams
+        A1, A2 = JONES_A
+        Gx, Gx1, Gv, Gv1 = am.Gx, am.Gx1, am.Gv, am.Gv1
+
+        def forces_at(s, vv, vdv, vddv):
+            uu, ud = s[:N], s[N:2 * N]
+            z1, z2 = s[2 * N:2 * N + ng], s[2 * N + ng:]
+            g = Gx @ uu + Gx1 @ ud + Gv * vv + Gv1 * vdv
+            geff = a0 * g + A1 * lam1 * z1 + A2 * lam2 * z2
+            if linear:
+                gs, qx = geff, 0.0
+            else:
+                gs, qx = self._nonlinear_circulation(geff, U)
+            # (I - Mx) u'' = -w2 u - c2 u' + Cx u' + Fv v + Fv1 v' + Fv2 v'' + W gs + qx
+            rhs_f = (am.Cx @ ud + am.Fv * vv + am.Fv1 * vdv + am.Fv2 * vddv + am.W @ gs + qx)
+            acc = Minv @ (-w2 * uu - c2 * ud + rhs_f)
+            return acc, g, rhs_f + am.Mx @ acc
+
+        return forces_at
+
+    def flap_dynamics(self, V: float, linear: bool = False):
+        """The nonlinear truth as ``f(s, v, v', v'') -> (ds/dt, u'')`` for a flap driven from
+        outside (a controller and actuator), e.g. closed-loop suppression simulations.
+
+        ``s = [u, u', z1, z2]`` is the full state of :meth:`simulate`.
+        """
+        V = self._check_V(V)
+        forces_at = self._forces(V, linear)
+        N = self.n_modes
+        lam1, lam2 = self.aero_matrices(V).lams
+        ng = (self.state_matrix(V).shape[0] - 2 * N) // 2
+
+        def f(s, vv, vdv, vddv):
+            acc, g, _ = forces_at(s, vv, vdv, vddv)
+            ds = np.concatenate([s[N:2 * N], acc, -lam1 * s[2 * N:2 * N + ng] + g,
+                                 -lam2 * s[2 * N + ng:] + g])
+            return ds, acc
+
+        return f
 
     def _names(self) -> dict:
         return {"mode_names": SEED_MODE_NAMES,
