@@ -116,7 +116,8 @@ class SeedWingParams(ParamsMixin):
     lateral_twist: float = _p(0.8, "rad", "tip twist of the lateral mode per unit modal "
                               "coordinate: store-induced lateral--torsion coupling (CALIBRATED)")
     acc1_offset: float = _p(0.04, "m", "Acc1 position aft of the elastic axis on the store "
-                            "(our choice; gives a radius of gyration ~0.4 b)")
+                            "(our choice: on the store just aft of the trailing edge; sets the torsion "
+                            "mode's tip twist Hs[0, 3] / acc1_offset = -2.8 rad per unit u4)")
     alpha_sat: float = _p(0.20, "rad", "saturation angle of the lift curve "
                           "c_l = a alpha_sat tanh(alpha/alpha_sat) (CALIBRATED: LCO)")
     suction: float = _p(1.0, "-", "leading-edge suction efficiency (CALIBRATED: mode-2 "
