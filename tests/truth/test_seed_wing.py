@@ -132,6 +132,25 @@ def test_parameters_are_checked():
         SeedWing().simulate(np.linspace(0, 0.1, 11), np.zeros(7), V0)
 
 
+def test_flap_dynamics_linearises_to_the_state_matrix(wing):
+    """The externally-driven right-hand side, linearised, is state_matrix (and Bflap)."""
+    V = 1.1
+    A = wing.state_matrix(V)
+    rng = np.random.default_rng(3)
+    s = 1e-3 * rng.standard_normal(A.shape[0])
+    ds, acc = wing.flap_dynamics(V, linear=True)(s, 0.0, 0.0, 0.0)
+    assert_allclose(ds, A @ s, rtol=1e-10, atol=1e-12 * np.abs(A @ s).max())
+    # nonlinear at tiny amplitude: the same to first order
+    ds_nl, _ = wing.flap_dynamics(V)(1e-6 * s, 0.0, 0.0, 0.0)
+    assert_allclose(ds_nl, 1e-6 * (A @ s), rtol=0, atol=1e-6 * 1e-4 * np.abs(A @ s).max())
+    # the flap enters as in statespace(): B columns for v'' (through the flap states)
+    ss = wing.statespace(V)
+    n = A.shape[0]
+    x = np.concatenate([np.zeros(n), [0.01, 0.0]])
+    ds_v, _ = wing.flap_dynamics(V, linear=True)(np.zeros(n), 0.01, 0.0, 0.0)
+    assert_allclose(ds_v, (np.asarray(ss.A) @ x)[:n], rtol=1e-10, atol=1e-14)
+
+
 # ---- forces ------------------------------------------------------------------------------
 def test_forces_close_the_linear_loop_at_small_amplitude(wing):
     """Motion from the linear state matrix, fed to the nonlinear aero_forces, satisfies eq. 6.
