@@ -32,12 +32,15 @@ class DataSection:
     """``[data]``: chirp records of the truth at the nominal speed (paper §IV.A)."""
 
     V0: float = 0.69
-    dt: float = 0.005
-    duration: float = 20.0
-    band_hz: list = field(default_factory=lambda: [0.5, 45.0])
-    amplitude_u: float = 1.0
-    amplitude_v: float = 1.0
-    records: int = 1
+    dt: float = 0.002
+    duration: float = 8.0
+    band_hz: list = field(default_factory=lambda: [0.2, 60.0])
+    #: chirp amplitude of each modal displacement / the flap [rad] (one channel per record)
+    amplitude: float = 0.01
+    #: samples between a motion and the force it produces in the records: 1 models the
+    #: loosely coupled CFD time march (the flow of step k sees the grid of step k-1), the
+    #: reason for the paper's input delay r = 1
+    coupling_delay: int = 1
 
 
 @dataclass(frozen=True)
@@ -64,7 +67,9 @@ class LcoSection:
 
     duration: float = 20.0
     initial_deflection: float = 0.05
-    speed_factor: float = 1.0
+    #: simulate at ``speed_factor * Vf``: exactly at the Hopf point the linear damping is zero
+    #: and the approach to the LCO is infinitely slow, so a few per cent above is the default
+    speed_factor: float = 1.05
 
 
 @dataclass(frozen=True)
@@ -79,9 +84,10 @@ class ControllerSection:
 @dataclass(frozen=True)
 class SuppressionSection:
     """``[suppression]``: closed-loop truth simulation with the gain ramped 0 -> 1 and released
-    (paper Fig. 11)."""
+    (paper Fig. 11), at ``speed_factor`` times the truth's own flutter speed (where the wing
+    itself has an LCO)."""
 
-    speed_factor: float = 1.0
+    speed_factor: float = 1.05
     settle: float = 10.0
     ramp: float = 5.0
     hold: float = 10.0
@@ -114,7 +120,7 @@ class RunConfig:
 
 
 _POSITIVE = {"dt", "duration", "settle", "ramp", "hold", "release", "time_limit", "V0",
-             "speed_factor"}
+             "speed_factor", "amplitude"}
 
 
 def _check_value(path: str, name: str, value, typ):
@@ -203,8 +209,8 @@ def _semantic_checks(cfg: RunConfig) -> None:
         raise ConfigError(f"controller.order = {cfg.controller.order}: must be >= 0")
     if cfg.controller.starts < 1:
         raise ConfigError(f"controller.starts = {cfg.controller.starts}: must be >= 1")
-    if cfg.data.records < 1:
-        raise ConfigError(f"data.records = {cfg.data.records}: must be >= 1")
+    if cfg.data.coupling_delay < 0:
+        raise ConfigError(f"data.coupling_delay = {cfg.data.coupling_delay}: must be >= 0")
     from ..truth import problem_names
     if cfg.problem.name not in problem_names():
         raise ConfigError(f"problem.name = {cfg.problem.name!r}: allowed "

@@ -100,6 +100,18 @@ def _jsonable(x: Any):
     return x
 
 
+def delayed(data, samples: int):
+    """Records whose forces lag the motion by ``samples`` (the explicit CFD coupling delay,
+    see :class:`~casflutter.pipeline._config.DataSection`)."""
+    from ..data import IOData, Record
+
+    if samples == 0:
+        return data
+    recs = tuple(Record(np.vstack([np.zeros((samples, r.n_outputs)), r.y[:-samples]]), r.u,
+                        r.v, r.name) for r in data.records)
+    return IOData(recs, data.dt, data.output_names, data.u_names, data.v_name, data.meta)
+
+
 def _flutter_summary(res, hz_per_unit: float) -> dict:
     if res.flutter is None:
         return {"V": None, "freq_hz": None, "mode": None, "status": res.status}
@@ -150,8 +162,9 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
 
     with prog.stage(1, "data"):
         d = cfg.data
-        data = truth_records(truth, d.V0, dt=d.dt, duration=d.duration,
-                             band=tuple(d.band_hz), amplitude=d.amplitude_u)
+        data = delayed(truth_records(truth, d.V0, dt=d.dt, duration=d.duration,
+                                     band=tuple(d.band_hz), amplitude=d.amplitude),
+                       d.coupling_delay)
         objects["data"] = data
     with prog.stage(2, "rom"):
         ident = identify(data, tuple(cfg.rom.orders), criterion=cfg.rom.criterion,
@@ -211,7 +224,10 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
         ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
         objects["verification"] = ver
     with prog.stage(10, "suppression"):
-        sup = suppression_run(truth, K, cfg, Vf, dt=model.dt, mode=crit)
+        # the truth flutters at its own speed: suppress its LCO there (paper Fig. 11 was
+        # measured on the real wing at an LCO condition)
+        V_lco = float(flutter_truth.Vf) if flutter_truth.flutter is not None else Vf
+        sup = suppression_run(truth, K, cfg, V_lco, dt=model.dt, mode=crit)
         objects["suppression"] = sup
     summary = _summary(cfg, ident, real, system, flutter, flutter_truth, lco, lco_truth, syn,
                        ver, sup, hz, prog)
