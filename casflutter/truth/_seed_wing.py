@@ -125,7 +125,7 @@ class SeedWingParams(ParamsMixin):
     rho: float = _p(1.225, "kg/m^3", "air density (sea level; Mach 0.06 tunnel)")
     lift_slope: float = _p(2 * np.pi, "1/rad", "linear lift-curve slope")
     U_ref: float = _p(SEED_U_REF, "m/s", "airspeed per unit speed index (Table I)")
-    modal_mass: float = _p(0.001162, "kg", "generalised mass of every mass-normalised mode "
+    modal_mass: float = _p(0.000961, "kg", "generalised mass of every mass-normalised mode "
                            "(CALIBRATED: sets alpha, the aerodynamic-to-structural scale)")
     zeta: float = _p(0.02, "-", "structural damping ratio of modes 1, 3, 4, 5 "
                      "(CALIBRATED: typical of a wind-tunnel model)")

@@ -262,46 +262,55 @@ def test_truth_flutter_is_on_the_lateral_branch(wing):
                        omega=wing.modal_structure().omega)
     assert res.status == "flutter"
     assert res.flutter_mode + 1 == PAPER["flutter_mode"]
-    # full-order truth: above the paper's (ROM) 1.20 by the V^2 frozen-time-scale error
     assert_allclose(res.Vf, REF["calibrated"]["truth_flutter_speed_index"], atol=5e-3)
+    assert abs(res.Vf - PAPER["flutter_speed_index"]) < 0.05  # near the paper's 1.20
     assert abs(res.frequency_hz - PAPER["lco_frequency_hz"]) < TOL["lco_frequency_hz"]
     # stable at the nominal speed
     assert np.max(np.linalg.eigvals(wing.state_matrix(V0)).real) < 0
 
 
-def test_frozen_aerodynamics_flutter_at_the_papers_speed(wing):
-    """The ROM route's ΣAE(V) is the truth's V0 aerodynamics scaled by V^2: Vf = 1.20."""
+def _frozen_flutter(wing):
+    return find_flutter(_frozen_matrix(wing, V0), (0.4, 1.6), n_grid=25,
+                        mode_states=_mode_states(), omega=wing.modal_structure().omega)
+
+
+def test_frozen_aerodynamics_flutter(wing):
+    """ΣAE of an exact linear ROM at V0 is the truth's V0 aerodynamics scaled by V^2."""
     fn = _frozen_matrix(wing, V0)
-    assert_allclose(fn(V0), wing.state_matrix(V0), atol=1e-9 * np.abs(wing.state_matrix(V0)).max())
-    res = find_flutter(fn, (0.4, 1.6), n_grid=25, mode_states=_mode_states(),
-                       omega=wing.modal_structure().omega)
+    A0 = wing.state_matrix(V0)
+    assert_allclose(fn(V0), A0, atol=1e-9 * np.abs(A0).max())
+    res = _frozen_flutter(wing)
     assert res.status == "flutter"
     assert res.flutter_mode + 1 == PAPER["flutter_mode"]
-    assert abs(res.Vf - PAPER["flutter_speed_index"]) < TOL["flutter_speed_index"]
+    assert_allclose(res.Vf, REF["calibrated"]["frozen_flutter_speed_index"], atol=5e-3)
 
 
-def test_lco_above_flutter(wing):
-    """Nonlinear truth above flutter: bounded LCO at the paper's 8.5 Hz (Fig. 9)."""
-    V = 1.4
+def test_lco_at_the_papers_flutter_speed(wing):
+    """Nonlinear truth at the paper's Vf = 1.20: a stable LCO at 8.5 Hz (paper Fig. 9).
+
+    The truth is linearly unstable there (its flutter is at 1.17); started below and above
+    the cycle, the response converges to the same bounded oscillation.
+    """
+    V = PAPER["flutter_speed_index"]
     assert np.max(np.linalg.eigvals(wing.state_matrix(V)).real) > 0  # linearly unstable
-    t = np.arange(0, 10.0, 0.002)
-    x0 = np.zeros(10)
-    x0[1] = 0.01
-    sim = wing.simulate(t, x0, V, rtol=1e-7, atol=1e-10)
-    assert sim.success
-    acc = sim.uddot @ wing.modal_structure().sensor_rows.T  # accelerometers
-    late = t >= 8.0
-    mid = (t >= 6.0) & (t < 8.0)
-    amp_late = np.max(np.abs(sim.u[late]), axis=0)
-    amp_mid = np.max(np.abs(sim.u[mid]), axis=0)
-    assert_allclose(amp_late, amp_mid, rtol=0.02)  # settled: neither growing nor decaying
-    assert amp_late[1] > 5 * x0[1]  # grew from the perturbation, then saturated
-    f_hz, _, _ = dominant_frequency(t[late], acc[late, 1])
-    assert abs(f_hz - PAPER["lco_frequency_hz"]) < TOL["lco_frequency_hz"]
+    t = np.arange(0, 12.0, 0.002)
+    late = t >= 10.0
+    amps = []
+    for start in (0.05, 0.2):
+        x0 = np.zeros(10)
+        x0[1] = start
+        sim = wing.simulate(t, x0, V, rtol=1e-7, atol=1e-10)
+        assert sim.success
+        amps.append(np.max(np.abs(sim.u[late, 1])))
+        acc = sim.uddot @ wing.modal_structure().sensor_rows.T  # accelerometers
+        f_hz, _, _ = dominant_frequency(t[late], acc[late, 1])
+        assert abs(f_hz - PAPER["lco_frequency_hz"]) < TOL["lco_frequency_hz"]
+    assert amps[0] > 0.05 and amps[1] < 0.2  # grew from below, decayed from above
+    assert_allclose(amps[0], amps[1], rtol=0.05)  # one attracting cycle
 
 
-def test_rom_route_lands_on_the_papers_flutter_speed(wing):
-    """The pipeline's ROM route (chirps at V0, linear ROM, ERA + Tustin, ΣAE, Hopf)."""
+def test_linear_rom_route_reproduces_the_frozen_truth(wing):
+    """The pipeline's linear ROM route (no coupling delay) is the frozen-aerodynamics truth."""
     pipeline = pytest.importorskip("casflutter.pipeline")
     s = pipeline.rom_settings("seed_wing")
     assert s.V0 == V0
@@ -313,4 +322,39 @@ def test_rom_route_lands_on_the_papers_flutter_speed(wing):
     res = find_flutter(system, (0.4, 1.6), n_grid=25)
     assert res.status == "flutter"
     assert res.flutter_mode + 1 == PAPER["flutter_mode"]
+    assert_allclose(res.Vf, _frozen_flutter(wing).Vf, rtol=0.01)
+
+
+def _delayed_truth_records(wing):
+    """The paper-route data: one chirp record per input (modes, flap), dt = 2 ms, 8 s,
+    0.2-60 Hz, amplitude 0.01, BDF2 grid rates, forces one step behind the motion (a
+    staggered CFD--CSD step; the paper's input delay r = 1)."""
+    pipeline = pytest.importorskip("casflutter.pipeline")
+    data = pipeline.truth_records(wing, V0, dt=0.002, duration=8.0, band=(0.2, 60.0),
+                                  amplitude=0.01)
+    recs = tuple(Record(np.vstack([np.zeros((1, 5)), r.y[:-1]]), r.u, r.v, r.name)
+                 for r in data.records)
+    return IOData(recs, data.dt)
+
+
+def test_paper_route_lands_on_the_papers_flutter_speed(wing):
+    """Paper §IV: HWL ROM (3,1,1,1,2,2) at V0, ERA + Tustin, ΣAE(V), Hopf: Vf = 1.20, mode 2.
+
+    This is the route ``casflutter run`` takes (one-step coupling delay); the calibrated
+    ``modal_mass`` puts it on the paper's value.  The fit is < 1 % on modes 1, 3, 4, 5.
+    """
+    pipeline = pytest.importorskip("casflutter.pipeline")
+    # a light pull towards the stage-1 estimate: with one input per record the quadratic
+    # coefficients are weakly excited and Ipopt otherwise creeps along a flat valley
+    res_id = identify(_delayed_truth_records(wing), tuple(PAPER["orders"]), regularization=1e-6)
+    assert res_id.success, res_id.return_status
+    err = res_id.fit.error_percent
+    assert np.all(np.delete(err, 1) < PAPER["fit_error_percent_max"]), err
+    assert err[1] == np.max(err), err
+    system = pipeline.rom_system(res_id.model, pipeline.structure_of(wing))
+    assert system.rom_stable
+    res = find_flutter(system, (0.6, 1.6), n_grid=21, max_refine=3)
+    assert res.status == "flutter"
+    assert res.flutter_mode + 1 == PAPER["flutter_mode"]
     assert abs(res.Vf - PAPER["flutter_speed_index"]) < TOL["flutter_speed_index"]
+    assert abs(res.frequency_hz - PAPER["lco_frequency_hz"]) < TOL["lco_frequency_hz"]
