@@ -51,11 +51,17 @@ The flap is massless and prescribed; the tip store is aerodynamically inert.
 Calibration (issue 5; measured numbers in ``problems/seed_wing/problem.toml``)
 --------------------------------------------------------------------------
 - ``modal_mass`` (hence ``alpha``): the aerodynamic-to-structural scale; set so that the
-  paper's ROM route (identification at ``V0 = 0.69``, ΣAE with the ``V^2`` scaling) finds
-  ``Vf = 1.20``.  The ROM represents the truth with its aerodynamics frozen at ``V0``; the
-  full-order truth itself flutters later (``V = 1.304``) by that frozen-time-scale error.
+  paper's route -- HWL ROM (3,1,1,1,2,2) identified at ``V0 = 0.69`` from chirp records
+  whose forces lag the motion by one step (dt = 2 ms, staggered CFD coupling, the reason
+  for ``r = 1``), ERA to ``nf = 15``, Tustin, ΣAE with the ``V^2`` scaling, Hopf -- finds
+  ``Vf = 1.20`` on the mode-2 branch.  The ROM data do not depend on ``modal_mass``, so
+  the ROM's ``Vf`` scales exactly with ``sqrt(modal_mass)``.  The full-order truth flutters
+  at 1.263 (8.6 Hz); an exact linear ROM without the delay (the truth's aerodynamics frozen
+  at ``V0``, scaled by ``V^2``) at 1.167: the frozen time scale, the one-step delay
+  (about +0.07 per millisecond of ``dt``) and the truncation to ``nf = 15`` (-0.08) all
+  move the ROM's flutter by several per cent.
 - ``lateral_twist`` (store offset): the twist that the store puts into the lateral mode;
-  it sets the frequency of the mode-2 flutter branch (8.6 Hz truth, 9.0 Hz ROM) and, with
+  it sets the frequency of the mode-2 flutter branch (8.6 Hz truth, 9.05 Hz ROM) and, with
   ``acc1_offset``, the mode's plunge ``H_2`` through the Acc1 row.
 - ``zeta`` 2 %, ``zeta_lateral`` 1 %: typical of a wind-tunnel model; the in-plane mode is
   the lightly damped one.
@@ -125,7 +131,7 @@ class SeedWingParams(ParamsMixin):
     rho: float = _p(1.225, "kg/m^3", "air density (sea level; Mach 0.06 tunnel)")
     lift_slope: float = _p(2 * np.pi, "1/rad", "linear lift-curve slope")
     U_ref: float = _p(SEED_U_REF, "m/s", "airspeed per unit speed index (Table I)")
-    modal_mass: float = _p(0.000961, "kg", "generalised mass of every mass-normalised mode "
+    modal_mass: float = _p(0.0010983, "kg", "generalised mass of every mass-normalised mode "
                            "(CALIBRATED: sets alpha, the aerodynamic-to-structural scale)")
     zeta: float = _p(0.02, "-", "structural damping ratio of modes 1, 3, 4, 5 "
                      "(CALIBRATED: typical of a wind-tunnel model)")

