@@ -137,7 +137,7 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
     write : bool
         Write files (summary, figures, report, ROM, controller).
     """
-    from ..aeroelastic import build_lft, find_flutter, simulate_loop
+    from ..aeroelastic import AeroelasticSystem, build_lft, find_flutter, simulate_loop
     from ..design import SynthesisOptions, synthesize
     from ..ident import identify
     from ..realize import realize
@@ -179,7 +179,6 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
         objects["realization"] = real
     with prog.stage(4, "structure"):
         structure = accelerometer_structure(truth)
-        from ..aeroelastic import AeroelasticSystem
         system = AeroelasticSystem.from_parts(real.sigma_f, structure, warn_unstable=False)
         objects["system"] = system
         if not system.rom_stable:
@@ -201,15 +200,27 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
         prog.note(f"ROM Vf = {Vf:.4f}, {flutter.frequency_hz * hz:.3f} Hz; truth Vf = "
                   f"{flutter_truth.Vf if flutter_truth.flutter else float('nan'):.4f}")
     with prog.stage(6, "lco"):
+        # The nonlinear ROM carries its full linear part (exact order); when Σf is truncated
+        # (the paper's nf = 15) its own Hopf point differs from Vf.  Simulate a few per cent
+        # above the Hopf point of the exact-order linearisation, where the LCO develops.
+        exact = realize(model, "auto")
+        sys_exact = AeroelasticSystem.from_parts(exact.sigma_f, structure, warn_unstable=False)
+        fl_exact = find_flutter(sys_exact, vr, n_grid=cfg.flutter.n_grid, max_refine=3)
+        objects["flutter_exact_order"] = fl_exact
+        V_hopf = float(fl_exact.Vf) if fl_exact.flutter is not None else Vf
+        V_lco = V_hopf * cfg.lco.speed_factor
         n_steps = int(round(cfg.lco.duration / model.dt))
         xs0 = np.zeros(2 * truth.n_modes)
         crit = flutter.flutter_mode if flutter.flutter_mode is not None and flutter.flutter_mode >= 0 else 0
         xs0[2 * crit] = cfg.lco.initial_deflection
-        lco = simulate_loop(model, structure, Vf * cfg.lco.speed_factor, n_steps, xs0=xs0)
+        lco = simulate_loop(model, structure, V_lco, n_steps, xs0=xs0)
         objects["lco"] = lco
-        lco_truth = truth_lco(truth, Vf * cfg.lco.speed_factor, cfg.lco.duration, crit,
+        objects["lco_speeds"] = {"V_hopf_exact_order": V_hopf, "V": V_lco}
+        lco_truth = truth_lco(truth, V_lco, cfg.lco.duration, crit,
                               cfg.lco.initial_deflection, dt=model.dt)
         objects["lco_truth"] = lco_truth
+        prog.note(f"ROM LCO at V = {V_lco:.4f} (exact-order Hopf {V_hopf:.4f}): "
+                  f"{lco.sensors.kind}, {lco.sensors.frequency_hz:.3f} Hz")
     with prog.stage(7, "lft"):
         lft = build_lft(system, Vf)
         objects["lft"] = lft
@@ -230,7 +241,7 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
         sup = suppression_run(truth, K, cfg, V_lco, dt=model.dt, mode=crit)
         objects["suppression"] = sup
     summary = _summary(cfg, ident, real, system, flutter, flutter_truth, lco, lco_truth, syn,
-                       ver, sup, hz, prog)
+                       ver, sup, hz, prog, objects.get("lco_speeds", {}))
     files: dict[str, Path] = {}
     if write:
         files = _write_outputs(out, summary, objects, cfg, prog)
@@ -238,7 +249,7 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
 
 
 def _summary(cfg, ident, real, system, flutter, flutter_truth, lco, lco_truth, syn, ver, sup,
-             hz, prog) -> dict:
+             hz, prog, objects_speeds) -> dict:
     model = ident.model
     sens = lco.sensors if getattr(lco, "sensors", None) is not None else lco.modes
     timings = dict(prog.timings)
@@ -257,7 +268,9 @@ def _summary(cfg, ident, real, system, flutter, flutter_truth, lco, lco_truth, s
         "nae": int(system.state_matrix(0.0).shape[0]),
         "flutter": _flutter_summary(flutter, hz),
         "flutter_truth": _flutter_summary(flutter_truth, hz),
-        "lco": {"freq_hz": sens.frequency_hz * hz if sens.frequency_hz is not None else None,
+        "lco": {"V": objects_speeds.get("V"),
+                "V_hopf_exact_order": objects_speeds.get("V_hopf_exact_order"),
+                "freq_hz": sens.frequency_hz * hz if sens.frequency_hz is not None else None,
                 "amplitude": list(sens.amplitude), "kind": sens.kind,
                 "truth_freq_hz": lco_truth.get("freq_hz"),
                 "truth_amplitude": lco_truth.get("amplitude"),
