@@ -13,7 +13,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	MPLBACKEND=Agg $(VENV)/bin/casflutter demo
+	MPLBACKEND=Agg $(VENV)/bin/casflutter run
 
 test: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m pytest -m "not slow" -n 2 tests

@@ -78,7 +78,18 @@ class ControllerSection:
 
     order: int = 3
     starts: int = 4
-    time_limit: float = 60.0
+    #: minimax solves per start: the deterministic budget of the synthesis
+    max_outer: int = 20
+    #: frequency slots per plant in the minimax NLP
+    nslots: int = 8
+    #: required closed-loop decay after the stabilisation phase, relative to the plant's
+    #: largest eigenvalue modulus (the Tustin realisation has poles near 2/dt: keep it small)
+    stability_margin: float = 1e-4
+    #: short stabilisation solves per start
+    max_stab_rounds: int = 8
+    #: wall-clock budget [s] for all starts, 0 for none (a time budget makes the result
+    #: depend on the machine's speed: the same seed then need not give the same controller)
+    time_limit: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -119,7 +130,7 @@ class RunConfig:
         return asdict(self)
 
 
-_POSITIVE = {"dt", "duration", "settle", "ramp", "hold", "release", "time_limit", "V0",
+_POSITIVE = {"dt", "duration", "settle", "ramp", "hold", "release", "V0",
              "speed_factor", "amplitude"}
 
 
@@ -207,6 +218,15 @@ def _semantic_checks(cfg: RunConfig) -> None:
         raise ConfigError(f"flutter.vrange = {vr!r}: [low, high] with 0 <= low < high")
     if cfg.controller.order < 0:
         raise ConfigError(f"controller.order = {cfg.controller.order}: must be >= 0")
+    if cfg.controller.time_limit < 0:
+        raise ConfigError(f"controller.time_limit = {cfg.controller.time_limit}: >= 0 (0: none)")
+    if cfg.controller.nslots < 2 or cfg.controller.max_stab_rounds < 1:
+        raise ConfigError("controller.nslots must be >= 2 and controller.max_stab_rounds >= 1")
+    if not cfg.controller.stability_margin > 0:
+        raise ConfigError(f"controller.stability_margin = {cfg.controller.stability_margin}: "
+                          "must be > 0")
+    if cfg.controller.max_outer < 1:
+        raise ConfigError(f"controller.max_outer = {cfg.controller.max_outer}: must be >= 1")
     if cfg.controller.starts < 1:
         raise ConfigError(f"controller.starts = {cfg.controller.starts}: must be >= 1")
     if cfg.data.coupling_delay < 0:

@@ -226,7 +226,10 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
         objects["lft"] = lft
     with prog.stage(8, "controller"):
         c = cfg.controller
-        opts = SynthesisOptions(time_limit=c.time_limit, ipopt=dict(cfg.solver.ipopt))
+        opts = SynthesisOptions(time_limit=c.time_limit or None, max_outer=c.max_outer,
+                                nslots=c.nslots, stability_margin=c.stability_margin,
+                                max_stab_rounds=c.max_stab_rounds,
+                                ipopt=dict(cfg.solver.ipopt))
         syn = synthesize(lft.plant_without_d22(), lft.nmeas, lft.ncon, c.order,
                          starts=c.starts, seed=cfg.seed, options=opts)
         K = lft.physical_controller(syn.controller)
