@@ -126,18 +126,19 @@ class SeedWingParams(ParamsMixin):
 
     semispan: float = _p(0.50, "m", "semispan L (our choice: a 1 m wing span model)")
     chord: float = _p(0.04, "m", "chord 2b (our choice: a beam-like wing, semispan 12.5 chords)")
-    ea_chord: float = _p(0.35, "-", "elastic axis, fraction of chord from the leading edge "
-                         "(our choice: ahead of mid-chord, aft of the aerodynamic centre)")
+    ea_chord: float = _p(0.25, "-", "elastic axis, fraction of chord from the leading edge "
+                         "(our choice: at the quarter-chord aerodynamic centre, a quarter-chord "
+                         "spar; no torsional divergence, see the module docstring)")
     rho: float = _p(1.225, "kg/m^3", "air density (sea level; Mach 0.06 tunnel)")
     lift_slope: float = _p(2 * np.pi, "1/rad", "linear lift-curve slope")
     U_ref: float = _p(SEED_U_REF, "m/s", "airspeed per unit speed index (Table I)")
-    modal_mass: float = _p(0.0010983, "kg", "generalised mass of every mass-normalised mode "
+    modal_mass: float = _p(0.0006974, "kg", "generalised mass of every mass-normalised mode "
                            "(CALIBRATED: sets alpha, the aerodynamic-to-structural scale)")
     zeta: float = _p(0.02, "-", "structural damping ratio of modes 1, 3, 4, 5 "
                      "(CALIBRATED: typical of a wind-tunnel model)")
-    zeta_lateral: float = _p(0.01, "-", "structural damping ratio of the lateral mode 2 "
+    zeta_lateral: float = _p(0.005, "-", "structural damping ratio of the lateral mode 2 "
                              "(CALIBRATED)")
-    lateral_twist: float = _p(0.8, "rad", "tip twist of the lateral mode per unit modal "
+    lateral_twist: float = _p(0.6, "rad", "tip twist of the lateral mode per unit modal "
                               "coordinate: store-induced lateral--torsion coupling (CALIBRATED)")
     acc1_offset: float = _p(0.04, "m", "Acc1 position aft of the elastic axis on the store "
                             "(our choice: on the store just aft of the trailing edge; sets the torsion "

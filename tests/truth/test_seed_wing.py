@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 from scipy.linalg import expm
+from scipy.optimize import brentq
 
 from casflutter.aeroelastic import AeroelasticSystem, dominant_frequency, find_flutter
 from casflutter.data import IOData, Record, chirp_excitation
@@ -82,7 +83,7 @@ def test_modal_frequencies_are_exactly_the_papers(wing):
     assert_allclose(ms.omega / (2 * np.pi), PAPER["frequencies_hz"], rtol=1e-14)
     assert ms.mode_names == tuple(PAPER["mode_names"])
     assert ms.n_modes == PAPER["n_modes"]
-    assert_allclose(ms.zeta, [0.02, 0.01, 0.02, 0.02, 0.02])
+    assert_allclose(ms.zeta, [0.02, 0.005, 0.02, 0.02, 0.02])
     # eq. 6 normalisation: alpha V^2 = rho U^2 b L / modal_mass
     p = wing.params
     V = 0.9
@@ -248,9 +249,13 @@ def test_mode_two_is_the_visibly_nonlinear_one(wing):
 
 
 def test_paper_orders_fit_within_one_percent_except_mode_two(wing):
-    """HWL ROM with the paper's orders (3,1,1,1,2,2): free-run error < 1 % but on mode 2."""
+    """HWL ROM with the paper's orders (3,1,1,1,2,2): free-run error < 1 % but on mode 2.
+
+    The same light regularisation as the pipeline (``problems/seed_wing/run.toml``): the
+    weakly excited quadratic coefficients otherwise leave Ipopt creeping along a flat valley.
+    """
     data = _chirp_records(wing)
-    res = identify(data, tuple(PAPER["orders"]))
+    res = identify(data, tuple(PAPER["orders"]), regularization=1e-6)
     assert res.success, res.return_status
     err = res.fit.error_percent
     assert np.all(np.delete(err, 1) < PAPER["fit_error_percent_max"]), err
@@ -264,12 +269,42 @@ def test_truth_flutter_is_on_the_lateral_branch(wing):
     assert res.status == "flutter"
     assert res.flutter_mode + 1 == PAPER["flutter_mode"]
     assert_allclose(res.Vf, REF["calibrated"]["truth_flutter_speed_index"], atol=5e-3)
-    # near the paper's 1.20: the ROM's V^2 scaling of frozen aerodynamics (and its one-step
-    # coupling delay, ERA truncation) move the ROM's flutter by several per cent
+    # within 10 % of the paper's 1.20 (the truth flutters below the ROM): the ROM's V^2
+    # scaling of frozen aerodynamics, its one-step coupling delay and the ERA truncation
+    # move the ROM's flutter by several per cent
     assert abs(res.Vf / PAPER["flutter_speed_index"] - 1) < 0.1
     assert abs(res.frequency_hz - PAPER["lco_frequency_hz"]) < TOL["lco_frequency_hz"]
     # stable at the nominal speed
     assert np.max(np.linalg.eigvals(wing.state_matrix(V0)).real) < 0
+
+
+def _static_stiffness_det(wing, V):
+    """det of the truth's static aeroelastic stiffness ``diag(omega^2) - W Gx`` at V.
+
+    At zero frequency the Wagner lags are settled (``Q_eff = Q``) and only the quasi-steady
+    lift of the strips' twist acts: the static equilibrium of eq. 6 with the linear operator
+    of :meth:`SeedWing.aero_matrices` (per unit modal mass).
+    """
+    am = wing.aero_matrices(V)
+    return np.linalg.det(np.diag(wing.modal_structure().omega ** 2) - am.W @ am.Gx)
+
+
+def test_no_static_divergence_below_the_controllers_range(wing):
+    """Static divergence of the truth lies above V = 2.6 (the paper's controller held V < 2.4).
+
+    The elastic axis at the quarter-chord aerodynamic centre removes the torsional
+    divergence; what is left is the lateral mode's own twist (store coupling) lifting its
+    plunge, far above the flutter speed.  Checked twice: the static stiffness stays
+    positive definite in determinant, and at its root the state matrix has a zero eigenvalue.
+    """
+    Vs = np.linspace(0.05, 2.6, 103)
+    dets = np.array([_static_stiffness_det(wing, V) for V in Vs])
+    assert np.all(dets > 0)
+    VD = brentq(lambda V: _static_stiffness_det(wing, V), 2.6, 4.0, xtol=1e-10)
+    assert_allclose(VD, REF["calibrated"]["truth_divergence_speed_index"], atol=5e-3)
+    lam = np.linalg.eigvals(wing.state_matrix(VD))
+    assert np.min(np.abs(lam)) < 1e-6 * np.max(np.abs(lam))
+    assert np.min(np.abs(lam[np.abs(lam.imag) < 1e-9].real)) < 1e-6 * np.max(np.abs(lam))
 
 
 def _frozen_flutter(wing):
@@ -291,15 +326,17 @@ def test_frozen_aerodynamics_flutter(wing):
 def test_lco_above_flutter(wing):
     """Nonlinear truth above its flutter speed: a stable LCO at 8.5 Hz (paper Fig. 9).
 
-    At V = 1.4 (11 % above the truth's flutter) the linearised truth is unstable; started
-    below and above the cycle, the response converges to the same bounded oscillation.
+    At V = 1.3 (20 % above the truth's flutter, 8 % above the ROM's) the linearised truth
+    is unstable; started below and above the cycle, the response converges to the same
+    bounded oscillation.
     """
-    V = 1.4
+    V = 1.3
+    assert V > REF["calibrated"]["truth_flutter_speed_index"]
     assert np.max(np.linalg.eigvals(wing.state_matrix(V)).real) > 0  # linearly unstable
     t = np.arange(0, 12.0, 0.002)
     late = t >= 10.0
     amps = []
-    for start in (0.05, 0.5):
+    for start in (0.05, 0.6):
         x0 = np.zeros(10)
         x0[1] = start
         sim = wing.simulate(t, x0, V, rtol=1e-7, atol=1e-10)
@@ -308,7 +345,7 @@ def test_lco_above_flutter(wing):
         acc = sim.uddot @ wing.modal_structure().sensor_rows.T  # accelerometers
         f_hz, _, _ = dominant_frequency(t[late], acc[late, 1])
         assert abs(f_hz - PAPER["lco_frequency_hz"]) < TOL["lco_frequency_hz"]
-    assert amps[0] > 0.05 and amps[1] < 0.5  # grew from below, decayed from above
+    assert amps[0] > 0.05 and amps[1] < 0.6  # grew from below, decayed from above
     assert_allclose(amps[0], amps[1], rtol=0.02)  # one attracting cycle
 
 
@@ -359,8 +396,12 @@ def test_paper_route_lands_on_the_papers_flutter_speed(wing):
     system = AeroelasticSystem.from_parts(sigma_f, pipeline.structure_of(wing))
     assert system.rom_stable
     assert system.n_states == PAPER["n_aeroelastic_states"]
-    res = find_flutter(system, (0.6, 1.6), n_grid=21, max_refine=3)
+    res = find_flutter(system, (0.6, 3.0), n_grid=49, max_refine=3)
     assert res.status == "flutter"
     assert res.flutter_mode + 1 == PAPER["flutter_mode"]
+    # no static divergence within the controller's range (the accelerometers cannot see
+    # omega = 0, so no controller could move it): the elastic axis at the quarter chord
+    assert not [c for c in res.crossings if c.kind == "divergence" and c.V < 2.6], \
+        res.crossings
     assert abs(res.Vf - PAPER["flutter_speed_index"]) < TOL["flutter_speed_index"]
     assert abs(res.frequency_hz - PAPER["lco_frequency_hz"]) < TOL["lco_frequency_hz"]
