@@ -50,25 +50,34 @@ The flap is massless and prescribed; the tip store is aerodynamically inert.
 
 Calibration (issue 5; measured numbers in ``problems/seed_wing/problem.toml``)
 --------------------------------------------------------------------------
+- ``ea_chord`` (static divergence): the elastic axis sits at the quarter-chord aerodynamic
+  centre (a quarter-chord spar), so the lift of a twisted strip has no moment arm and there
+  is no torsional divergence.  What is left is the lateral mode's store-induced twist lifting
+  its own plunge (``H_2 = -acc1_offset T_2`` up to the small Acc1 entry), a static
+  divergence at ``V = 2.95``, far above the controller's range (the paper held ``V < 2.4``).
+  Divergence sits at ``omega = 0``, where the tip accelerometers see nothing, so no
+  controller can move it; with the axis at 35 % chord the paper route diverged at 1.26.
 - ``modal_mass`` (hence ``alpha``): the aerodynamic-to-structural scale; set so that the
   paper's route -- HWL ROM (3,1,1,1,2,2) identified at ``V0 = 0.69`` from chirp records
   whose forces lag the motion by one step (dt = 2 ms, staggered CFD coupling, the reason
   for ``r = 1``), ERA to ``nf = 15``, Tustin, ΣAE with the ``V^2`` scaling, Hopf -- finds
-  ``Vf = 1.20`` on the mode-2 branch.  The ROM data do not depend on ``modal_mass``, so
-  the ROM's ``Vf`` scales exactly with ``sqrt(modal_mass)``.  The full-order truth flutters
-  at 1.263 (8.6 Hz); an exact linear ROM without the delay (the truth's aerodynamics frozen
-  at ``V0``, scaled by ``V^2``) at 1.167: the frozen time scale, the one-step delay
-  (about +0.07 per millisecond of ``dt``) and the truncation to ``nf = 15`` (-0.08) all
-  move the ROM's flutter by several per cent.
+  ``Vf = 1.20`` on the mode-2 branch (9.15 Hz) and no other crossing below 3.0.  The ROM
+  data do not depend on ``modal_mass``, so the ROM's ``Vf`` (and any static divergence)
+  scales exactly with ``sqrt(modal_mass)``.  The full-order truth flutters at 1.085
+  (9.4 Hz); an exact linear ROM without the delay (the truth's aerodynamics frozen at
+  ``V0``, scaled by ``V^2``) at 1.005: the frozen time scale, the one-step delay and the
+  truncation to ``nf = 15`` (+0.07 against the minimal ``nf = 25``) all move the ROM's
+  flutter by several per cent.
 - ``lateral_twist`` (store offset): the twist that the store puts into the lateral mode;
-  it sets the frequency of the mode-2 flutter branch (8.6 Hz truth, 9.05 Hz ROM) and, with
-  ``acc1_offset``, the mode's plunge ``H_2`` through the Acc1 row.
-- ``zeta`` 2 %, ``zeta_lateral`` 1 %: typical of a wind-tunnel model; the in-plane mode is
-  the lightly damped one.
+  it drives the mode-2 flutter branch and sets its frequency, and with ``acc1_offset`` the
+  mode's plunge ``H_2`` through the Acc1 row.  The static divergence speed goes as
+  ``1 / lateral_twist``: 0.6 rad keeps it at 2.95 (0.8 gave 2.42).
+- ``zeta`` 2 %, ``zeta_lateral`` 0.5 %: typical of a wind-tunnel model; the in-plane mode is
+  the lightly damped one (its damping lowers the flutter speed, not the divergence).
 - ``alpha_sat`` (nonlinearity): the lift curve saturates near 11 deg (c_l,max 1.26), which
-  bounds the LCO above flutter (8.4 Hz at ``V = 1.4``, paper 8.5 Hz) and keeps the chirp
+  bounds the LCO above flutter (9.3 Hz at ``V = 1.3``, paper 8.5 Hz) and keeps the chirp
   responses of modes 1, 3, 4, 5 within 1 % of linear; ``suction = 1`` (full leading-edge
-  suction) makes the lateral mode's force about 8 % nonlinear in the same chirps.
+  suction) makes the lateral mode's force about 13 % nonlinear in the same chirps.
 - ``chord`` 4 cm (beam-like): short Wagner lags (``b / U = 1 ms`` at ``V0``), so the paper's
   HWL orders (3,1,1,1,2,2) fit the chirp forces within 1 % on modes 1, 3, 4, 5.
 
