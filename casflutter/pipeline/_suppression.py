@@ -68,16 +68,19 @@ def gain_schedule(settle: float, ramp: float, hold: float):
 
 def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain, *,
                       actuator_omega: float = 2 * np.pi * 40.0, actuator_zeta: float = 0.7,
-                      substeps: int = 4) -> dict:
+                      substeps: int = 4, sensor: str = "acceleration") -> dict:
     """Sampled-data closed loop of the nonlinear truth with the controller ``K``.
 
-    At every sample ``t_k`` the accelerometers ``zm = Hs u''`` are read, the controller
+    At every sample ``t_k`` the sensors (``zm = Hs u''`` for ``sensor="acceleration"``, the
+    paper's accelerometers, or ``zm = Hs u`` for ``"displacement"``) are read, the controller
     (ZOH discretisation at the sample time) updates, and the flap command
     ``v_c = g(t_k) K zm`` is held until ``t_{k+1}``; the flap follows a second-order actuator
     (``actuator_omega``, ``actuator_zeta``: our choice, the paper gives none), which supplies
     the flap rate and acceleration the aerodynamics need.  The truth is integrated by
     classical Runge--Kutta with ``substeps`` steps per sample.
     """
+    if sensor not in ("acceleration", "displacement"):
+        raise ValueError(f"sensor={sensor!r}: use 'acceleration' or 'displacement'")
     t = np.asarray(timepts, dtype=float)
     dt = float(t[1] - t[0])
     f = truth.flap_dynamics(V)
@@ -107,7 +110,7 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     for k in range(n):
         vdd_now = wa2 * (vc - xa[0]) - ca * xa[1]
         _, acc = f(s, xa[0], xa[1], vdd_now)
-        zm = Hs @ acc
+        zm = Hs @ (acc if sensor == "acceleration" else s[:Hs.shape[1]])
         if not np.all(np.isfinite(zm)) or np.abs(s).max() > 1e6:
             break
         ZM[k], Vf[k], G[k] = zm, xa[0], gain(t[k])

@@ -426,6 +426,23 @@ class AeroelasticTruth(abc.ABC):
                           name=f"{type(self).__name__}_V{V:g}".replace(".", "p"))
 
     # ---- nonlinear simulation --------------------------------------------------------
+    def flap_dynamics(self, V: float, linear: bool = False):
+        """The truth as ``f(s, v, v', v'') -> (ds/dt, u'')`` for a flap driven from outside
+        (a controller and actuator); ``s = [u, u', z1, z2]`` as in :meth:`simulate`, with the
+        same (optional) nonlinear structural stiffness unless ``linear``."""
+        c = self._coupled(V)
+        A, Bf, Minv, N = c["A"], c["Bflap"], c["Minv"], c["N"]
+        Phi = self._Phi
+        has_nl = (not linear) and self._nonlinear_force(np.zeros(Phi.shape[0])) is not None
+
+        def f(s, vv, vdv, vddv):
+            ds = A @ s + Bf @ np.array([vv, vdv, vddv])
+            if has_nl:
+                ds[N:2 * N] -= Minv @ (Phi.T @ self._nonlinear_force(Phi @ s[:N]))
+            return ds, ds[N:2 * N]
+
+        return f
+
     def simulate(self, timepts: np.ndarray, x0: np.ndarray, V: float,
                  v: np.ndarray | None = None, *, rtol: float = 1e-9,
                  atol: float = 1e-12) -> SimulationResult:
