@@ -78,6 +78,9 @@ class ControllerSection:
 
     order: int = 3
     starts: int = 4
+    #: nominal speeds of the plant set, as multiples of Vf: the LFT (eq. 14) is built at each
+    #: and the worst-case norm is minimised (the multi-speed design); [1.0] is the paper's
+    speeds: list = field(default_factory=lambda: [1.0])
     #: minimax solves per start: the deterministic budget of the synthesis
     max_outer: int = 20
     #: frequency slots per plant in the minimax NLP
@@ -218,6 +221,11 @@ def _semantic_checks(cfg: RunConfig) -> None:
         raise ConfigError(f"flutter.vrange = {vr!r}: [low, high] with 0 <= low < high")
     if cfg.controller.order < 0:
         raise ConfigError(f"controller.order = {cfg.controller.order}: must be >= 0")
+    sp = cfg.controller.speeds
+    if not sp or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and x > 0
+                         for x in sp):
+        raise ConfigError(f"controller.speeds = {sp!r}: a non-empty list of positive multiples "
+                          "of Vf")
     if cfg.controller.time_limit < 0:
         raise ConfigError(f"controller.time_limit = {cfg.controller.time_limit}: >= 0 (0: none)")
     if cfg.controller.nslots < 2 or cfg.controller.max_stab_rounds < 1:

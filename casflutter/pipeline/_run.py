@@ -230,8 +230,12 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
                                 nslots=c.nslots, stability_margin=c.stability_margin,
                                 max_stab_rounds=c.max_stab_rounds,
                                 ipopt=dict(cfg.solver.ipopt))
-        syn = synthesize(lft.plant_without_d22(), lft.nmeas, lft.ncon, c.order,
-                         starts=c.starts, seed=cfg.seed, options=opts)
+        # D22 (accelerometers see the flap) depends on the nominal speed: the multi-speed
+        # design uses each plant's own loop shift and the nominal plant's for the result
+        plants = [lft.plant_without_d22() if f == 1.0 else
+                  build_lft(system, Vf * f).plant_without_d22() for f in c.speeds]
+        syn = synthesize(plants if len(plants) > 1 else plants[0], lft.nmeas, lft.ncon,
+                         c.order, starts=c.starts, seed=cfg.seed, options=opts)
         K = lft.physical_controller(syn.controller)
         objects["synthesis"], objects["controller"] = syn, K
     with prog.stage(9, "verify"):
