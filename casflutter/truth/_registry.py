@@ -20,7 +20,10 @@ PROBLEMS: dict[str, type[AeroelasticTruth]] = {
     "seed_wing": SeedWing,
 }
 
-_PROBLEMS_DIR = Path(__file__).resolve().parents[2] / "problems"
+def _problems_dir() -> Path:
+    from .._resources import problems_dir
+
+    return problems_dir()
 
 
 def problem_names() -> list[str]:
@@ -63,7 +66,7 @@ def problem_definition(name: str, problems_dir: str | Path | None = None) -> dic
         without the repository's ``problems/`` folder: pass ``problems_dir``).
     """
     _cls(name)
-    root = Path(problems_dir) if problems_dir is not None else _PROBLEMS_DIR
+    root = Path(problems_dir) if problems_dir is not None else _problems_dir()
     path = root / name / "problem.toml"
     if not path.is_file():
         raise ConfigError(f"problem definition {path} not found; pass problems_dir= pointing "
