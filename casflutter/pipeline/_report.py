@@ -41,9 +41,12 @@ def write_figures(out: Path, objects: dict, cfg) -> dict:
     files["vg_vf"] = _save(plot_vg_vf(fl), out / "vg_vf.png")
     vr = cfg.flutter.vrange
     Vg = np.linspace(max(vr[0], 1e-3), vr[1], 60)
-    files["fig10_pole_loci"] = _save(plot_pole_loci(objects["system"], Vg,
-                                                    controller=objects["controller"]),
-                                     out / "fig10_pole_loci.png")
+    fig10 = plot_pole_loci(objects["system"], Vg, controller=objects["controller"])
+    # the structural region (far aerodynamic and controller poles would set the scale)
+    w_max = 1.3 * float(np.max(objects["system"].structure.omega))
+    fig10.axes[0].set_xlim(-0.25 * w_max / 2, 0.1 * w_max / 2)
+    fig10.axes[0].set_ylim(0.0, w_max)
+    files["fig10_pole_loci"] = _save(fig10, out / "fig10_pole_loci.png")
     sup = objects["suppression"]
     files["fig11_gain_ramp"] = _save(plot_gain_ramp(sup["timepts"], sup["zm"], sup["gain"],
                                                     sup["v"]), out / "fig11_gain_ramp.png")
