@@ -257,6 +257,27 @@ class AeroelasticTruth(abc.ABC):
             raise ConfigError(f"speed index V must be positive and finite, got {V}")
         return V
 
+    def _prescribed_motion(self, timepts, u, v, udot, uddot, vdot, vddot):
+        """Checked samples of a prescribed modal motion and flap with their first two
+        derivatives (from a quintic spline of the samples where not given), shared by every
+        truth's :meth:`aero_forces`."""
+        dt = check_timepts(timepts)
+        t = np.asarray(timepts, float)
+        K, N = t.size, self.n_modes
+        u = _as_2d("u", u, K, N)
+        v = np.zeros(K) if v is None else _as_1d("v", v, K)
+        if udot is None or uddot is None:
+            d1, d2 = sample_derivatives(t, u, 2)
+            udot = d1 if udot is None else udot
+            uddot = d2 if uddot is None else uddot
+        udot, uddot = _as_2d("udot", udot, K, N), _as_2d("uddot", uddot, K, N)
+        if vdot is None or vddot is None:
+            d1, d2 = sample_derivatives(t, v, 2)
+            vdot = d1 if vdot is None else vdot
+            vddot = d2 if vddot is None else vddot
+        vdot, vddot = _as_1d("vdot", vdot, K), _as_1d("vddot", vddot, K)
+        return t, dt, u, v, udot, uddot, vdot, vddot
+
     def aero_forces(self, timepts: np.ndarray, u: np.ndarray, v: np.ndarray | None,
                     V: float, *, udot: np.ndarray | None = None,
                     uddot: np.ndarray | None = None, vdot: np.ndarray | None = None,
@@ -293,21 +314,8 @@ class AeroelasticTruth(abc.ABC):
             ``(K, N)`` generalised aerodynamic forces ``y``.
         """
         V = self._check_V(V)
-        dt = check_timepts(timepts)
-        t = np.asarray(timepts, float)
-        K, N = t.size, self.n_modes
-        u = _as_2d("u", u, K, N)
-        v = np.zeros(K) if v is None else _as_1d("v", v, K)
-        if udot is None or uddot is None:
-            d1, d2 = sample_derivatives(t, u, 2)
-            udot = d1 if udot is None else udot
-            uddot = d2 if uddot is None else uddot
-        udot, uddot = _as_2d("udot", udot, K, N), _as_2d("uddot", uddot, K, N)
-        if vdot is None or vddot is None:
-            d1, d2 = sample_derivatives(t, v, 2)
-            vdot = d1 if vdot is None else vdot
-            vddot = d2 if vddot is None else vddot
-        vdot, vddot = _as_1d("vdot", vdot, K), _as_1d("vddot", vddot, K)
+        t, dt, u, v, udot, uddot, vdot, vddot = self._prescribed_motion(
+            timepts, u, v, udot, uddot, vdot, vddot)
         Phi = self._Phi
         x, xd, xdd = u @ Phi.T, udot @ Phi.T, uddot @ Phi.T
         am = self.aero_matrices(V)

@@ -96,9 +96,8 @@ from scipy.integrate import solve_ivp
 from scipy.interpolate import make_interp_spline
 
 from ..errors import DataError, DimensionError
-from ._aero import JONES_A, JONES_B, check_timepts, integrate_lags, sample_derivatives, \
-    strip_coefficients
-from ._base import AeroelasticTruth, AeroMatrices, SimulationResult, _as_1d, _as_2d
+from ._aero import JONES_A, JONES_B, integrate_lags, strip_coefficients
+from ._base import AeroelasticTruth, AeroMatrices, SimulationResult, _as_1d
 from ._goland import _bending_shapes
 from ._params import ParamsMixin, require
 
@@ -352,21 +351,8 @@ class SeedWing(AeroelasticTruth):
             return super().aero_forces(timepts, u, v, V, udot=udot, uddot=uddot, vdot=vdot,
                                        vddot=vddot)
         V = self._check_V(V)
-        dt = check_timepts(timepts)
-        t = np.asarray(timepts, float)
-        K, N = t.size, self.n_modes
-        u = _as_2d("u", u, K, N)
-        v = np.zeros(K) if v is None else _as_1d("v", v, K)
-        if udot is None or uddot is None:
-            d1, d2 = sample_derivatives(t, u, 2)
-            udot = d1 if udot is None else udot
-            uddot = d2 if uddot is None else uddot
-        udot, uddot = _as_2d("udot", udot, K, N), _as_2d("uddot", uddot, K, N)
-        if vdot is None or vddot is None:
-            d1, d2 = sample_derivatives(t, v, 2)
-            vdot = d1 if vdot is None else vdot
-            vddot = d2 if vddot is None else vddot
-        vdot, vddot = _as_1d("vdot", vdot, K), _as_1d("vddot", vddot, K)
+        t, dt, u, v, udot, uddot, vdot, vddot = self._prescribed_motion(
+            timepts, u, v, udot, uddot, vdot, vddot)
         am = self.aero_matrices(V)
         g = u @ am.Gx.T + udot @ am.Gx1.T + np.outer(v, am.Gv) + np.outer(vdot, am.Gv1)
         gd = udot @ am.Gx.T + uddot @ am.Gx1.T + np.outer(vdot, am.Gv) + np.outer(vddot, am.Gv1)
@@ -411,7 +397,7 @@ class SeedWing(AeroelasticTruth):
             raise DataError("timepts must be a 1-D increasing array of at least 2 samples")
         V = self._check_V(V)
         c = self._coupled(V)
-        am, Minv, N, ng = c["am"], c["Minv"], c["N"], c["ng"]
+        N, ng = c["N"], c["ng"]
         nx = 2 * N + 2 * ng
         x0 = np.asarray(x0, float).reshape(-1)
         if x0.size == 2 * N:
@@ -434,12 +420,12 @@ class SeedWing(AeroelasticTruth):
                 return forces_at(s, 0.0, 0.0, 0.0)
             return forces_at(s, float(vfun(tt)), float(vd1(tt)), float(vd2(tt)))
 
-        lam1, lam2 = am.lams
+        dynamics = self.flap_dynamics(V, linear)
 
         def rhs(tt, s):
-            acc, g, _ = forces(tt, s)
-            return np.concatenate([s[N:2 * N], acc, -lam1 * s[2 * N:2 * N + ng] + g,
-                                   -lam2 * s[2 * N + ng:] + g])
+            if vfun is None:
+                return dynamics(s, 0.0, 0.0, 0.0)[0]
+            return dynamics(s, float(vfun(tt)), float(vd1(tt)), float(vd2(tt)))[0]
 
         sol = solve_ivp(rhs, (t[0], t[-1]), x0, method="DOP853", t_eval=t, rtol=rtol,
                         atol=atol)
