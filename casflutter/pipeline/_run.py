@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import CasflutterError, ConfigError
+from ..errors import CasflutterError
 from ._config import RunConfig, load_config
 
 __all__ = ["RunResult", "run_pipeline"]
@@ -156,9 +156,7 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
     truth = load_problem(cfg.problem.name, sets)
     objects["truth"] = truth
     ms = truth.modal_structure()
-    hz = 1.0  # the seed wing's time unit is the second
-    if getattr(ms, "time_unit", "s") not in ("s", "second", "seconds"):
-        hz = float(getattr(truth, "omega_ref", 1.0))
+    hz = 1.0  # frequencies are cycles per the problem's time unit (seconds for the seed wing)
 
     with prog.stage(1, "data"):
         d = cfg.data
@@ -323,8 +321,3 @@ def _write_outputs(out: Path, summary: dict, objects: dict, cfg: RunConfig, prog
     files.update(figs)
     files["report"] = write_html(out, summary, figs)
     return files
-
-
-def _check_out_dir(out_dir) -> None:  # pragma: no cover - trivial
-    if out_dir is not None and Path(out_dir).exists() and not Path(out_dir).is_dir():
-        raise ConfigError(f"--out {out_dir} exists and is not a folder")

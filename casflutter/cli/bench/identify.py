@@ -12,12 +12,20 @@ import numpy as np
 PAPER_ORDERS = (3, 1, 1, 1, 2, 2)
 
 
+def _timed_least_squares(residual, theta0, cost):
+    """``scipy.optimize.least_squares`` (trf, 2-point Jacobian): seconds, our cost at its
+    solution, residual evaluations, success."""
+    from scipy.optimize import least_squares
+
+    t0 = time.perf_counter()
+    sol = least_squares(residual, theta0, method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10)
+    return time.perf_counter() - t0, cost(sol.x), int(sol.nfev), bool(sol.success)
+
+
 def _scipy_reference(structure, data, theta0, cost):
     """The same stage-2 problem (prediction error over the whole record) with
     ``scipy.optimize.least_squares`` from the same start: numpy residuals of the full
     record, finite-difference Jacobian (scipy's default), trust-region reflective."""
-    from scipy.optimize import least_squares
-
     from ...ident import HWLModel
 
     L = structure.max_lag
@@ -29,17 +37,13 @@ def _scipy_reference(structure, data, theta0, cost):
         return np.concatenate([((m.predict(r.y, r.u, r.v) - r.y)[L:] * scale).ravel()
                                for r in data.records])
 
-    t0 = time.perf_counter()
-    sol = least_squares(residual, theta0, method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10)
-    return time.perf_counter() - t0, cost(sol.x), int(sol.nfev), bool(sol.success)
+    return _timed_least_squares(residual, theta0, cost)
 
 
 def _scipy_reduced(structure, data, theta0, cost):
     """The same problem in casflutter's QR-reduced form (``Q'Y - R w(theta)``), handed to
     ``least_squares`` with a finite-difference Jacobian: isolates the solver from the
     formulation."""
-    from scipy.optimize import least_squares
-
     from ...ident._regression import regressor_matrix, weights_matrix
 
     Phi, Y = regressor_matrix(structure, data)
@@ -52,9 +56,12 @@ def _scipy_reduced(structure, data, theta0, cost):
         Wm = np.vstack(weights_matrix(structure, structure.weights(theta)))
         return ((C - RD @ Wm) * scale).ravel()
 
-    t0 = time.perf_counter()
-    sol = least_squares(residual, theta0, method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10)
-    return time.perf_counter() - t0, cost(sol.x), int(sol.nfev), bool(sol.success)
+    return _timed_least_squares(residual, theta0, cost)
+
+
+def _record(runs, method: str) -> dict:
+    return {"t_s": statistics.median(r[0] for r in runs), "cost": float(runs[0][1]),
+            "nfev": runs[0][2], "success": runs[0][3], "method": method}
 
 
 def run(n_samples: int = 4000, noise: float = 0.05, seed: int = 1, repeat: int = 3,
@@ -91,20 +98,10 @@ def run(n_samples: int = 4000, noise: float = 0.05, seed: int = 1, repeat: int =
         "ipopt_status": res.return_status,
         "ipopt_iterations": res.iterations,
         "repeats": repeat,
-        "scipy_reference": {
-            "t_s": statistics.median(s[0] for s in sc),
-            "cost": float(sc[0][1]),
-            "nfev": sc[0][2],
-            "success": sc[0][3],
-            "method": "least_squares(trf), full-record numpy residuals, 2-point Jacobian",
-        },
-        "scipy_reduced_reference": {
-            "t_s": statistics.median(s[0] for s in sr),
-            "cost": float(sr[0][1]),
-            "nfev": sr[0][2],
-            "success": sr[0][3],
-            "method": "least_squares(trf) on casflutter's QR-reduced residual, 2-point Jacobian",
-        },
+        "scipy_reference": _record(
+            sc, "least_squares(trf), full-record numpy residuals, 2-point Jacobian"),
+        "scipy_reduced_reference": _record(
+            sr, "least_squares(trf) on casflutter's QR-reduced residual, 2-point Jacobian"),
         "speedup_stage2_vs_scipy": statistics.median(s[0] for s in sc) / t2,
     }
 
