@@ -239,10 +239,15 @@ def _semantic_checks(cfg: RunConfig) -> None:
         raise ConfigError(f"controller.starts = {cfg.controller.starts}: must be >= 1")
     if cfg.data.coupling_delay < 0:
         raise ConfigError(f"data.coupling_delay = {cfg.data.coupling_delay}: must be >= 0")
-    from ..truth import problem_names
+    from ..truth import PROBLEMS, problem_names
     if cfg.problem.name not in problem_names():
         raise ConfigError(f"problem.name = {cfg.problem.name!r}: allowed "
                           f"{', '.join(problem_names())}")
+    # the truth's own check of problem.set (names and physical values), as run_pipeline uses it
+    try:
+        PROBLEMS[cfg.problem.name].Params.from_sets(f"{k}={v}" for k, v in cfg.problem.set.items())
+    except ConfigError as exc:
+        raise ConfigError(f"problem.set: {exc}") from None
 
 
 def default_config_path() -> Path:
@@ -250,10 +255,53 @@ def default_config_path() -> Path:
     return problems_dir() / "seed_wing" / "run.toml"
 
 
-def load_config(path=None, **overrides) -> RunConfig:
+def _apply_update(table: dict, dotted: str, value) -> None:
+    """Set ``dotted`` (``"controller.order"``, ``"problem.set.zeta"``) in the raw TOML
+    ``table``.  The path follows the sections of :class:`RunConfig`; inside a table-valued
+    key (``problem.set``, ``solver.ipopt``) the rest of the path is one key, dots included
+    (``"solver.ipopt.ipopt.tol"``).  A table value is merged key by key.  Names are not
+    checked here: ``_build`` rejects unknown ones with the list of allowed keys."""
+    _set_path(table, RunConfig, str(dotted).split("."), value, str(dotted))
+
+
+def _set_path(node: dict, cls, parts: list, value, dotted: str) -> None:
+    name, rest = parts[0], parts[1:]
+    typ = get_type_hints(cls).get(name) if cls is not None else None
+    section = typ is not None and is_dataclass(typ)
+    mapping = typ is not None and not section and (get_origin(typ) or typ) is dict
+    if not rest:
+        if isinstance(value, dict) and (section or mapping):
+            for k, v in value.items():  # merge a table key by key
+                _set_path(node, cls, [name, str(k)], v, dotted)
+        else:
+            node[name] = value
+        return
+    if typ is not None and not (section or mapping):
+        raise ConfigError(f"{dotted!r}: {name!r} is a single value, not a table; drop the "
+                          "rest of the path")
+    sub = node.setdefault(name, {})
+    if not isinstance(sub, dict):
+        raise ConfigError(f"{dotted!r}: [{name}] must be a table, got {sub!r}")
+    if mapping:  # problem.set / solver.ipopt: the rest of the path is one key
+        sub[".".join(rest)] = value
+    else:
+        _set_path(sub, typ if section else None, rest, value, dotted)
+
+
+def load_config(path=None, *, updates=None, **overrides) -> RunConfig:
     """Read and validate a run configuration (default: the seed wing's).
 
-    ``overrides`` replace top-level fields (e.g. ``seed=3``).
+    Parameters
+    ----------
+    path : path, optional
+        The TOML file (default :func:`default_config_path`).
+    updates : mapping of str to value, optional
+        Changes by dotted path applied on top of the file before validation:
+        ``{"controller.order": 4, "rom.orders": [2, 1, 1, 1, 2, 2],
+        "problem.set.zeta": 0.03}`` (a table value, e.g. ``{"controller": {"starts": 1}}``,
+        is merged key by key).  Unknown names fail like unknown keys in the file.
+    **overrides
+        Replace top-level fields (e.g. ``seed=3``).
     """
     path = Path(path) if path is not None else default_config_path()
     if not path.exists():
@@ -264,6 +312,8 @@ def load_config(path=None, **overrides) -> RunConfig:
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: not valid TOML ({exc})") from None
     table.update({k: v for k, v in overrides.items() if v is not None})
+    for key, value in (updates or {}).items():
+        _apply_update(table, key, value)
     cfg = _build(RunConfig, table, "")
     _semantic_checks(cfg)
     return cfg
