@@ -35,7 +35,7 @@ class Crossing:
     eigenvalue : complex
         λ of the branch at ``V`` (Re λ ≈ 0).
     omega : float
-        Frequency |Im λ| [rad/s] at the crossing (0 for divergence).
+        Frequency ``|Im λ|`` [rad/s] at the crossing (0 for divergence).
     frequency_hz : float
         ``omega / 2π`` [Hz].
     branch : int
@@ -135,7 +135,7 @@ def origin_modes(tracking: EigenTracking, *, mode_states=None, omega=None) -> np
     by their squared magnitude) is attributed to it, exactly two branches per mode (the
     assignment maximising the total fraction, :func:`scipy.optimize.linear_sum_assignment`);
     the remaining branches (aerodynamic lags of Σf) get -1.  Otherwise, with ``omega`` (natural frequencies), the mode whose
-    ω_i is nearest to |λ| in relative terms is the origin.  Returns -1 for every branch
+    ω_i is nearest to ``|λ|`` in relative terms is the origin.  Returns -1 for every branch
     when neither is given.
     """
     lam0 = tracking.eigenvalues[0]

@@ -287,7 +287,7 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
     window, tol :
         Classification settings, see :func:`analyze_response`.
     blowup : float
-        |u| above which the run is stopped and classified as divergence.
+        ``|u|`` above which the run is stopped and classified as divergence.
 
     Returns
     -------

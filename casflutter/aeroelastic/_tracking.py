@@ -120,7 +120,7 @@ class EigenTracking:
 
     @property
     def damping_ratio(self) -> np.ndarray:
-        """ζ = −Re λ / |λ| per point and branch (V–g data; g = 2ζ in the classical sense)."""
+        """``ζ = −Re λ / |λ|`` per point and branch (V–g data; g = 2ζ in the classical sense)."""
         lam = self.eigenvalues
         return -lam.real / np.maximum(np.abs(lam), 1e-300)
 

@@ -16,7 +16,7 @@ def _tracking(obj):
 
 
 def plot_vg_vf(result, *, branches=None, hz: bool = True, ax=None) -> Figure:
-    """V–g and V–f plot: damping ratio ζ = −Re λ/|λ| and frequency of every branch against V.
+    """V–g and V–f plot: damping ratio ``ζ = −Re λ/|λ|`` and frequency of every branch against V.
 
     Parameters
     ----------
