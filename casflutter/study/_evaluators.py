@@ -17,6 +17,9 @@ failure (the runner records the error and carries on).  Built-in evaluators:
     per worker process and reused for every point (:func:`casflutter.study.truth_hopf`).
 ``rom_flutter``
     The ROM route of the pipeline, registered only when ``casflutter.pipeline`` provides it.
+``pipeline``
+    The whole seed-wing study (``casflutter run``) per point, parameters by dotted path into
+    the run configuration (:mod:`casflutter.study._pipeline_eval`).
 
 Further evaluators plug in with :func:`register_evaluator` or as ``"package.module:function"``
 in the study file (the form that also reaches spawned and Dask worker processes).
@@ -343,13 +346,21 @@ def rom_flutter_evaluator(params: Mapping[str, Any], settings: Mapping[str, Any]
 
 
 def _maybe_register_pipeline() -> None:
-    """Register ``rom_flutter`` when :mod:`casflutter.pipeline` provides the ROM route."""
-    if "rom_flutter" in _REGISTRY:
+    """Register ``rom_flutter`` and ``pipeline`` when :mod:`casflutter.pipeline` provides
+    the ROM route and ``run_pipeline``."""
+    if "rom_flutter" in _REGISTRY and "pipeline" in _REGISTRY:
         return
     try:
-        from ..pipeline import rom_flutter, rom_settings  # noqa: F401, PLC0415
+        from ..pipeline import rom_flutter, rom_settings, run_pipeline  # noqa: F401, PLC0415
     except ImportError:
         return
+    from ._pipeline_eval import PIPELINE_OUTPUTS, pipeline_evaluator  # noqa: PLC0415
+
+    register_evaluator("pipeline", pipeline_evaluator, outputs=PIPELINE_OUTPUTS,
+                       description="the whole seed-wing study (casflutter run) per point: "
+                                   "sweep run-config keys by dotted path (controller.order, "
+                                   "rom.orders, data.V0, problem.set.zeta ...)",
+                       modules=("casflutter.pipeline", "casflutter.study._pipeline_eval"))
     register_evaluator("rom_flutter", rom_flutter_evaluator,
                        outputs=("Vf_truth", "Vf_rom", "Vf_frozen", "Vf_parametric",
                                 "rom_error", "scaling_error", "identification_error",

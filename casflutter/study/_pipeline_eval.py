@@ -1,0 +1,184 @@
+"""The ``pipeline`` evaluator: the whole seed-wing study (``casflutter run``) at one point.
+
+Every swept parameter and every fixed setting that is not one of the evaluator's own
+settings is a change of the run configuration by dotted path (the TOML tables of
+``problems/seed_wing/run.toml``, see :mod:`casflutter.pipeline._config`):
+
+- a stage's key: ``data.V0`` (nominal speed of the records), ``rom.orders`` (HWL orders
+  ``[mu, na, nb, r, p, q]``), ``rom.nf`` (order of Σf, eq. 5), ``controller.order``,
+  ``controller.starts``, ``lco.speed_factor``, ``suppression.speed_factor``, ``seed`` ...;
+- a truth parameter: ``problem.set.NAME`` (seed wing: ``zeta`` structural damping,
+  ``zeta_lateral``, ``rho`` air density and ``U_ref`` the flow's speed scale, ``suction``,
+  ``acc1_offset`` (the Acc1 position) ... ``casflutter problems`` lists them).
+
+The changes go through :func:`casflutter.pipeline.load_config` (``updates=``), so a point
+with an unknown or invalid name fails before any work with the configuration's own message
+(the key and what is allowed).  The outputs are ``RunResult.summary`` (``summary.json``)
+flattened into columns (:func:`flatten_summary`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import re
+from pathlib import Path
+from typing import Any, Mapping
+
+from ..errors import ConfigError
+
+__all__ = ["PIPELINE_SETTINGS", "PIPELINE_OUTPUTS", "pipeline_config", "flatten_summary",
+           "pipeline_evaluator"]
+
+#: The evaluator's own settings (everything else is a configuration change).
+PIPELINE_SETTINGS = {
+    "config": "base run configuration (TOML, relative to the study file; default the seed "
+              "wing's problems/seed_wing/run.toml)",
+    "out_dir": "write each point's files (summary.json, figures, report) to "
+               "OUT_DIR/<point>; relative to the working directory (default: no files)",
+    "quiet": "no stage progress on stderr (default true)",
+}
+
+#: The columns :func:`pipeline_evaluator` returns (``time_<stage>`` for each of the ten
+#: stages of :func:`casflutter.pipeline.run_pipeline` besides ``time_total``).
+PIPELINE_OUTPUTS = (
+    "Vf_rom", "freq_hz_rom", "mode_rom", "Vf_truth", "freq_hz_truth", "mode_truth",
+    "lco_V", "lco_kind", "lco_freq_hz", "lco_amplitude", "lco_truth_kind",
+    "lco_truth_freq_hz", "lco_truth_amplitude", "controller_order", "gamma",
+    "small_gain_V_lo", "small_gain_V_hi", "stable_V_lo", "stable_V_hi", "closed_loop_stable",
+    "synthesis_success", "synthesis_status", "attenuation_percent", "lco_returns",
+    "suppression_V", "fit_error_max", "n_params", "nf", "nae", "time_data", "time_rom",
+    "time_realize", "time_structure", "time_flutter", "time_lco", "time_lft",
+    "time_controller", "time_verify", "time_suppression", "time_total",
+)
+
+
+def _split(params: Mapping[str, Any], settings: Mapping[str, Any]):
+    merged = {**settings, **params}
+    base = Path(str(merged.pop("_base_dir", ".")))
+    own = {k: merged.pop(k) for k in list(merged) if k in PIPELINE_SETTINGS}
+    return base, own, merged
+
+
+def pipeline_config(params: Mapping[str, Any], settings: Mapping[str, Any] | None = None):
+    """The validated run configuration of one point.
+
+    Parameters
+    ----------
+    params : mapping
+        Swept values by dotted path (module docstring).
+    settings : mapping, optional
+        ``config`` (base file), ``out_dir``, ``quiet`` and further fixed changes by dotted
+        path (a TOML table such as ``[settings.controller]`` is merged key by key).
+
+    Returns
+    -------
+    RunConfig
+
+    Raises
+    ------
+    ConfigError
+        An unknown or invalid name or value (from :func:`casflutter.pipeline.load_config`).
+    """
+    from ..pipeline import default_config_path, load_config  # noqa: PLC0415
+
+    base, own, updates = _split(params, settings or {})
+    path = own.get("config")
+    if path is None:
+        path = default_config_path()
+    else:
+        path = Path(str(path))
+        if not path.is_absolute():
+            path = base / path
+    try:
+        return load_config(path, updates=updates)
+    except ConfigError as exc:
+        raise ConfigError(f"pipeline evaluator: {exc} (swept names and [settings] are dotted "
+                          f"paths into the run configuration; the evaluator's own settings: "
+                          f"{', '.join(PIPELINE_SETTINGS)})") from None
+
+
+def _pair(value, i):
+    return None if value is None else value[i]
+
+
+def flatten_summary(summary: Mapping[str, Any]) -> dict[str, Any]:
+    """One row of columns from ``RunResult.summary`` (the content of ``summary.json``).
+
+    Returns
+    -------
+    dict
+        ROM and truth flutter (``Vf_*``, ``freq_hz_*`` [Hz], ``mode_*`` 1-based), LCO of the
+        nonlinear ROM and of the truth (``lco_*``; amplitude = largest sensor amplitude),
+        the controller (``controller_order``, verified ``gamma``, the small-gain and exact
+        stable speed intervals as ``*_lo``/``*_hi``), the suppression (``attenuation_percent``
+        ...), the ROM sizes and ``time_<stage>`` [s] for every stage and ``time_total``.
+    """
+    fl, ft, lco = summary["flutter"], summary["flutter_truth"], summary["lco"]
+    ctl, sup = summary["controller"], summary["suppression"]
+    amp, tamp = lco.get("amplitude"), lco.get("truth_amplitude")
+    out = {
+        "Vf_rom": fl["V"], "freq_hz_rom": fl["freq_hz"], "mode_rom": fl["mode"],
+        "Vf_truth": ft["V"], "freq_hz_truth": ft["freq_hz"], "mode_truth": ft["mode"],
+        "lco_V": lco["V"], "lco_kind": lco["kind"], "lco_freq_hz": lco["freq_hz"],
+        "lco_amplitude": max(amp) if amp else None, "lco_truth_kind": lco.get("truth_kind"),
+        "lco_truth_freq_hz": lco.get("truth_freq_hz"),
+        "lco_truth_amplitude": max(tamp) if tamp else None,
+        "controller_order": ctl["order"], "gamma": ctl["gamma"],
+        "small_gain_V_lo": _pair(ctl["small_gain_V"], 0),
+        "small_gain_V_hi": _pair(ctl["small_gain_V"], 1),
+        "stable_V_lo": _pair(ctl["stable_V"], 0), "stable_V_hi": _pair(ctl["stable_V"], 1),
+        "closed_loop_stable": ctl["stable"],
+        "attenuation_percent": sup["attenuation_percent"], "lco_returns": sup["lco_returns"],
+        "suppression_V": sup["V"],
+        "fit_error_max": max(summary["fit_error_percent"]), "n_params": summary["n_params"],
+        "nf": summary["nf"], "nae": summary["nae"],
+    }
+    out.update({f"time_{k}": v for k, v in summary["timings_s"].items()})
+    return out
+
+
+def _point_dir(params: Mapping[str, Any]) -> str:
+    """A readable, unique folder name of a point: ``controller.order=2,zeta=0.03-<hash>``."""
+    text = ",".join(f"{k.rsplit('.', 1)[-1]}={params[k]}" for k in sorted(params))
+    slug = re.sub(r"[^A-Za-z0-9_.=,+-]", "", text)[:80]
+    digest = hashlib.sha256(json.dumps({k: params[k] for k in sorted(params)},
+                                       default=str).encode()).hexdigest()[:8]
+    return f"{slug}-{digest}" if slug else digest
+
+
+def pipeline_evaluator(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dict[str, Any]:
+    """Run :func:`casflutter.pipeline.run_pipeline` at one point of a sweep.
+
+    Parameters
+    ----------
+    params : mapping
+        Swept configuration changes by dotted path (``controller.order``,
+        ``problem.set.zeta``, ``data.V0``, ``rom.orders`` ...; module docstring).
+    settings : mapping
+        :data:`PIPELINE_SETTINGS` (``config``, ``out_dir``, ``quiet``) and fixed changes.
+
+    Returns
+    -------
+    dict
+        :func:`flatten_summary` of the run, plus ``synthesis_success`` and
+        ``synthesis_status`` (the last Ipopt status of the best start, verbatim).
+
+    Raises
+    ------
+    ConfigError
+        Before any work, for an unknown or invalid name (:func:`pipeline_config`).
+    """
+    from ..pipeline import run_pipeline  # noqa: PLC0415
+
+    cfg = pipeline_config(params, settings)
+    _, own, _ = _split(params, settings)
+    out_dir = own.get("out_dir")
+    write = out_dir is not None
+    res = run_pipeline(cfg, out_dir=Path(str(out_dir)) / _point_dir(params) if write else None,
+                       quiet=bool(own.get("quiet", True)), write=write)
+    out = flatten_summary(res.summary)
+    syn = res.objects.get("synthesis")
+    out["synthesis_success"] = None if syn is None else bool(syn.success)
+    out["synthesis_status"] = syn.statuses[-1] if syn is not None and syn.statuses else None
+    return out

@@ -1,0 +1,201 @@
+"""The ``pipeline`` evaluator: ``casflutter run`` (the seed-wing study) swept over run-config
+keys and truth parameters by dotted path."""
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from casflutter.errors import ConfigError
+from casflutter.study import (Parameter, PointStore, Study, evaluator_names, load_study,
+                              run_sweep, sweep_table)
+
+# The reduced seed-wing run of tests/pipeline/test_run.py, cut further so that one point
+# takes ~10 s (one minimax solve; the controller is poor but the run is complete).
+# ipopt.max_wall_time: the synthesis' default per-solve wall-clock cap (3 s) makes its
+# result depend on the machine's load; without it the run is deterministic.
+REDUCED = """
+seed = 3
+[problem]
+name = "seed_wing"
+{problem_set}
+[data]
+duration = 4.0
+[rom]
+regularization = 1e-6
+[flutter]
+n_grid = 61
+[lco]
+duration = 2.0
+[controller]
+order = {order}
+starts = 1
+max_outer = 1
+nslots = 2
+max_stab_rounds = 2
+[suppression]
+settle = 2.0
+ramp = 1.0
+hold = 2.0
+release = 2.0
+[solver]
+ipopt = {{"ipopt.max_wall_time" = 1e4}}
+"""
+
+ORDERS = (1, 2)
+ZETAS = (0.005, 0.01)   # structural damping of the lateral mode, the flutter mode (mode 2)
+
+
+def _study(cfg_path: Path) -> Study:
+    # a 2-point Latin hypercube over explicit values: each order and each damping once
+    return Study(name="pipe", evaluator="pipeline", design="lhs", samples=2, seed=0,
+                 parameters=(Parameter("controller.order", values=ORDERS),
+                             Parameter("problem.set.zeta_lateral", values=ZETAS)),
+                 settings={"config": cfg_path.name}, base_dir=str(cfg_path.parent))
+
+
+@pytest.fixture(scope="module")
+def swept(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("pipe")
+    cfg = folder / "base.toml"
+    cfg.write_text(REDUCED.format(order=3, problem_set=""))
+    study = _study(cfg)
+    res = run_sweep(study, store=folder / "pipe.jsonl", workers=0, progress=False)
+    return folder, study, res, sweep_table(study, res.store)
+
+
+def test_pipeline_is_registered():
+    assert "pipeline" in evaluator_names()
+
+
+def test_swept_parameters_take_effect(swept):
+    from casflutter.aeroelastic import find_flutter
+    from casflutter.truth import load_problem
+
+    _, study, res, rows = swept
+    assert (res.n_points, res.n_computed, res.n_failed) == (2, 2, 0), [r["error"] for r in rows]
+    assert sorted(r["controller.order"] for r in rows) == list(ORDERS)
+    assert sorted(r["problem.set.zeta_lateral"] for r in rows) == list(ZETAS)
+    for r in rows:
+        # the requested order, not the base file's 3
+        assert r["controller_order"] == r["controller.order"]
+        # the damping reached the truth: its flutter speed is that of the truth built
+        # directly with the same damping (same search as run_pipeline)
+        truth = load_problem("seed_wing", [f"zeta_lateral={r['problem.set.zeta_lateral']}"])
+        N = truth.n_modes
+        direct = find_flutter(truth, (0.05, 2.5), n_grid=61, max_refine=3,
+                              mode_states=[np.array([i, N + i]) for i in range(N)],
+                              omega=truth.modal_structure().omega)
+        np.testing.assert_allclose(r["Vf_truth"], direct.Vf, rtol=1e-12)
+        assert r["stable_V_lo"] <= r["Vf_rom"] <= r["stable_V_hi"]
+        assert r["small_gain_V_lo"] < r["Vf_rom"] < r["small_gain_V_hi"]
+        assert r["time_total"] >= r["time_controller"] > 0
+    lo, hi = sorted(rows, key=lambda r: r["problem.set.zeta_lateral"])
+    # more structural damping of the flutter mode raises the flutter speed (ROM and truth)
+    assert hi["Vf_rom"] > lo["Vf_rom"] + 0.01
+    assert hi["Vf_truth"] > lo["Vf_truth"] + 0.01
+
+
+def test_swept_point_equals_a_direct_run(swept):
+    """The same point run directly from a config file that spells the values out."""
+    from casflutter.pipeline import load_config, run_pipeline
+
+    folder, _, _, rows = swept
+    r = rows[0]
+    path = folder / "direct.toml"
+    path.write_text(REDUCED.format(order=r["controller.order"],
+                                   problem_set=f"set = {{zeta_lateral = "
+                                               f"{r['problem.set.zeta_lateral']!r}}}"))
+    s = run_pipeline(load_config(path), write=False, quiet=True).summary
+    expected = {
+        "Vf_rom": s["flutter"]["V"], "freq_hz_rom": s["flutter"]["freq_hz"],
+        "mode_rom": s["flutter"]["mode"], "Vf_truth": s["flutter_truth"]["V"],
+        "freq_hz_truth": s["flutter_truth"]["freq_hz"], "lco_V": s["lco"]["V"],
+        "lco_freq_hz": s["lco"]["freq_hz"], "lco_kind": s["lco"]["kind"],
+        "lco_amplitude": max(s["lco"]["amplitude"]),
+        "lco_truth_amplitude": max(s["lco"]["truth_amplitude"]),
+        "controller_order": s["controller"]["order"], "gamma": s["controller"]["gamma"],
+        "small_gain_V_lo": s["controller"]["small_gain_V"][0],
+        "small_gain_V_hi": s["controller"]["small_gain_V"][1],
+        "stable_V_lo": s["controller"]["stable_V"][0],
+        "stable_V_hi": s["controller"]["stable_V"][1],
+        "attenuation_percent": s["suppression"]["attenuation_percent"],
+        "fit_error_max": max(s["fit_error_percent"]), "nf": s["nf"], "nae": s["nae"],
+    }
+    for name, value in expected.items():
+        if isinstance(value, float):
+            # deterministic in one process: equal up to floating-point reassociation
+            assert r[name] == pytest.approx(value, rel=1e-8, abs=1e-12), name
+        else:
+            assert r[name] == value, name
+    assert set(s["timings_s"]) == {k[len("time_"):] for k in r if k.startswith("time_")}
+
+
+@pytest.mark.parametrize("name, words", [
+    ("controller.ordr", ["'ordr'", "[controller]", "allowed", "max_outer"]),
+    ("contrlr.order", ["'contrlr'", "allowed", "controller", "suppression"]),
+    ("problem.set.zeta_lat", ["problem.set", "'zeta_lat'", "zeta_lateral"]),
+])
+def test_unknown_name_fails_before_any_work(tmp_path, name, words):
+    st = Study(name="bad", evaluator="pipeline", parameters=(Parameter(name, values=(1.0,)),),
+               settings={})
+    res = run_sweep(st, store=tmp_path / "bad.jsonl", workers=0, progress=False)
+    assert (res.n_computed, res.n_failed) == (1, 1)
+    (rec,) = list(PointStore(res.store))
+    assert rec["error"].startswith("ConfigError")
+    for w in words:
+        assert w in rec["error"]
+    assert rec["work_time"] < 2.0   # the config check only; a run takes ~10 s and more
+
+
+def test_pipeline_config_direct_errors():
+    from casflutter.study._pipeline_eval import pipeline_config
+
+    with pytest.raises(ConfigError, match="'seed.x'.*single value"):
+        pipeline_config({"seed.x": 1})
+    with pytest.raises(ConfigError, match="rom.orders"):
+        pipeline_config({"rom.orders": [3, 1, 1]})
+    # the evaluator's own settings are not config keys; fixed changes merge with swept ones
+    cfg = pipeline_config({"controller.order": 4},
+                          {"quiet": False, "out_dir": "x", "controller": {"starts": 1}})
+    assert (cfg.controller.order, cfg.controller.starts) == (4, 1)
+
+
+def test_example_study_file_is_valid():
+    """Every point of the example study gives a valid config carrying the swept values."""
+    from casflutter.study._pipeline_eval import pipeline_config
+
+    st = load_study(Path(__file__).parents[2] / "problems" / "studies" /
+                    "seed_wing_pipeline.toml")
+    assert st.evaluator == "pipeline" and len(st.points()) >= 4
+    for p in st.points():
+        cfg = pipeline_config(p, st.resolved_settings())
+        assert cfg.controller.order == p["controller.order"]
+        assert cfg.problem.set["zeta_lateral"] == p["problem.set.zeta_lateral"]
+
+
+@pytest.mark.slow
+def test_example_study_writes_point_folders(tmp_path):
+    """The example study on 2 local processes with per-point files (slow: full points)."""
+    st = load_study(Path(__file__).parents[2] / "problems" / "studies" /
+                    "seed_wing_pipeline.toml")
+    st = replace(st, settings={**st.settings, "out_dir": str(tmp_path / "points")})
+    res = run_sweep(st, store=tmp_path / "s.jsonl", workers=2, progress=False)
+    assert (res.n_failed, res.n_left) == (0, 0)
+    rows = sweep_table(st, res.store)
+    folders = sorted((tmp_path / "points").iterdir())
+    assert len(folders) == len(rows)
+    for f in folders:   # each point's own summary.json holds the numbers of its row
+        s = json.loads((f / "summary.json").read_text())
+        (r,) = [r for r in rows if r["Vf_rom"] == s["flutter"]["V"]
+                and r["controller.order"] == s["controller"]["order"]]
+        assert r["gamma"] == s["controller"]["gamma"]
+        assert (f / "report.html").is_file()
+    for order in {r["controller.order"] for r in rows}:
+        # more damping of the flutter mode, higher flutter speed (ROM and truth)
+        same = sorted((r for r in rows if r["controller.order"] == order),
+                      key=lambda r: r["problem.set.zeta_lateral"])
+        assert all(b["Vf_rom"] > a["Vf_rom"] and b["Vf_truth"] > a["Vf_truth"]
+                   for a, b in zip(same, same[1:]))
