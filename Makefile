@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test test-all bench clean
+.PHONY: demo test test-all bench clean docs
 
 # single-threaded BLAS: the same seed gives the same numbers (threaded reductions reorder
 # floating-point sums, and the nonconvex synthesis can end in another local optimum)
@@ -26,6 +26,17 @@ test: $(STAMP)
 
 test-all: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m pytest -n 2 tests
+
+# the documentation site (docs/_build/html): warnings are errors; the gallery examples run at
+# a small size (CASFLUTTER_DOCS_QUICK=1)
+DOCS_STAMP := $(VENV)/.docs-installed
+
+$(DOCS_STAMP): pyproject.toml $(STAMP)
+	$(PY) -m pip install --quiet -e '.[docs]'
+	touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP)
+	CASFLUTTER_DOCS_QUICK=1 MPLBACKEND=Agg $(VENV)/bin/sphinx-build -W --keep-going -b html docs docs/_build/html
 
 bench: $(STAMP)
 	$(VENV)/bin/casflutter bench identify --out bench-identify.json
