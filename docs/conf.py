@@ -8,6 +8,7 @@ stays within a few minutes on two cores); without it the examples run at full si
 from __future__ import annotations
 
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -39,6 +40,13 @@ default_role = "code"
 nitpicky = False
 
 # -- API reference ------------------------------------------------------------------------
+# autosummary's one-line summaries end at the first ". "; the docstrings cite "eq. 5",
+# "Sec. III", "Fig. 9", "et al.", "e.g.": do not end a summary there.
+import sphinx.ext.autosummary as _autosummary  # noqa: E402
+
+_autosummary.periods_re = re.compile(
+    r"(?<!\beq)(?<!\bEq)(?<!\bSec)(?<!\bFig)(?<!\bal)(?<!e\.g)(?<!i\.e)(?<!\bvs)\.(?:\s+)")
+
 autosummary_generate = True
 autosummary_imported_members = True
 autosummary_ignore_module_all = False

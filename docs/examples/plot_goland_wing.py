@@ -41,12 +41,12 @@ print(f"flutter: V_f = {result.Vf:.4f}, U_f = {U_f:.1f} m/s (reference {ref['air
       f"mode {structure.mode_names[result.flutter_mode]!r}")
 
 # %%
-# V–g and V–f diagrams of the four lowest modes (the branches of the aerodynamic lag
-# states and of the stiff higher modes are left out), against the airspeed.
+# V–g and V–f diagrams of the two lowest modes, first bending and first torsion, whose
+# frequencies approach each other until the torsion branch goes unstable (the branches of
+# the aerodynamic lag states and of the stiffer modes are left out).
 lam = result.tracking.eigenvalues
 low = [k for k in result.tracking.upper_branches()
-       if np.mean(abs(lam[:, k].imag)) < 1.3 * structure.omega[3]
-       and np.mean(lam[:, k].imag) > 0.1 * structure.omega[0]]
+       if 0.5 * structure.omega[0] < np.mean(lam[:, k].imag) < 1.3 * structure.omega[1]]
 fig = plot_vg_vf(result, branches=low)
 fig.axes[1].set_xlabel(r"speed index $V = U/(b\,\omega_{ref})$"
                        f"  ({b * omega_ref:.1f} m/s per unit)")

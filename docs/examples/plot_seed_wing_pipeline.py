@@ -16,9 +16,12 @@ on the seed wing (the paper's wind-tunnel wing with tip store: five modes at 2.1
    of closed-loop stability;
 7. the gain-ramp suppression of the truth's LCO (Fig. 11).
 
-Here it runs on a reduced configuration (shorter records and simulations, a smaller
-synthesis budget) so that it takes well under a minute; the full configuration is
-``problems/seed_wing/run.toml``.  The files are written to a temporary folder.
+The documentation build (``CASFLUTTER_DOCS_QUICK=1``) runs it on a reduced configuration
+(shorter records and simulations; an order-2 controller from one start and two minimax
+rounds) so that it takes under a minute; the numbers printed below are those of that run,
+not of the paper's.  Without the variable it runs the full configuration
+``problems/seed_wing/run.toml`` (a few minutes), as ``make demo`` does.  The files are written
+to a temporary folder.
 """
 
 import os
