@@ -1,0 +1,161 @@
+"""Issue 4, "A flutter check": an order-2 controller through the flap of the typical section,
+designed on the ROM's LFT at the ROM's flutter speed Vf.
+
+Targets (issue): the verified exact stable interval of V contains [0.5 Vf, 1.2 Vf]; above the
+open-loop flutter speed (1.1 Vf) the open loop grows and the closed loop decays, on the ROM
+loop and on the truth.  Every number is checked against an independent computation:
+
+- the truth's flutter speed against the published Hodges & Pierce value (Jones aero), the
+  ROM's against the truth's (at the fixed point V0 = Vf_ROM the ROM is the truth frozen at
+  its own flutter speed, so the two must agree to the identification error);
+- the exact interval (guardian-map pencil, casflutter.verify) against a dense eigenvalue
+  sweep of the same loop, and the verified γ against the synthesis's own γ for that plant;
+- simulated envelope growth rates against the spectral abscissae of the linear loops.
+  Open loop (one growing mode dominates): truth, same model in an RK4 sampled-data loop,
+  to 1e-3 (measured 1e-5); ROM, the discrete HWL model with ZOH force coupling at dt = 0.1
+  against the Tustin realisation, to 5e-3 (measured 3e-3, the half-sample delay of the
+  coupling).  Closed loop: to 30 % (several modes decay at comparable rates).
+"""
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from casflutter.errors import ConfigError
+from casflutter.pipeline._flutter_check import (FlutterCheckSettings, flutter_check,
+                                                flutter_check_settings, truth_loop_matrix)
+from casflutter.truth import TypicalSection, problem_definition
+
+#: the cheap (non-slow) variant: shorter chirp records and two design plants; it checks the
+#: machinery and the targets above Vf (the slow test checks the issue's full interval)
+CHEAP = dict(duration=150.0, speed_factors=(1.0, 1.2))
+
+
+def _check_rom_and_truth_flutter(res):
+    ref = problem_definition("typical_section")["reference"]["jones"]
+    assert_allclose(res.Vf_truth, ref["flutter_speed"], rtol=ref["rtol"])
+    V0, Vf = res.v0_history[-1]
+    assert abs(Vf - V0) <= res.settings.v0_rtol * Vf
+    # the first ROM (V0 = 1.8) is 4 % off; at the fixed point it is the truth at Vf
+    assert abs(res.v0_history[0][1] / res.Vf_truth - 1) > 0.03
+    assert_allclose(res.Vf, res.Vf_truth, rtol=2e-3)
+    assert res.identification.relative_residual < 1e-10
+
+
+def _check_verification(res):
+    ver, syn = res.verification, res.synthesis
+    assert res.controller.nstates == res.settings.order == 2
+    assert ver.stable and np.isfinite(ver.gamma)
+    # the verified γ of the nominal plant is the synthesis's own γ for that plant
+    i = list(res.settings.speed_factors).index(1.0)
+    assert_allclose(ver.gamma, syn.gammas[i], rtol=1e-6)
+    assert_allclose(ver.small_gain_dV[1], 1.0 / ver.gamma, rtol=1e-12)
+    # small gain is a certificate inside the exact interval
+    (a, b), (lo, hi) = ver.small_gain_V, ver.exact_V
+    assert lo <= a < res.Vf < b <= hi
+
+
+def _check_dense_sweep(res):
+    """The exact interval against the eigenvalues of the same loop on a dense V grid:
+    stable at every grid point inside, unstable at the grid points just beyond each finite
+    edge (further out the loop may be stable again: the interval is the component of the
+    stable set that contains Vf)."""
+    sw = res.rom_sweep
+    lo, hi = res.verification.exact_V
+    inside = (sw.V > lo * 1.001) & (sw.V < hi * 0.999)
+    assert inside.sum() > 100 and np.all(sw.spectral_abscissa[inside] < 0)
+    above = sw.V > hi * 1.001
+    assert np.all(sw.spectral_abscissa[above][:5] > 0)
+    below = (sw.V < lo * 0.999) & (sw.V > 0)
+    assert np.all(sw.spectral_abscissa[below][-5:] > 0)
+
+
+def _check_simulations(res):
+    rom, tru = res.rom_simulation, res.truth_simulation
+    assert_allclose(rom.V, res.settings.sim_factor * res.Vf)
+    assert_allclose(tru.V, res.settings.sim_factor * res.Vf_truth)
+    for sim, tol in ((rom, 5e-3), (tru, 1e-3)):
+        assert sim.open_eig_rate > 0 > sim.closed_eig_rate
+        assert sim.grows_open_decays_closed, sim.model
+        assert_allclose(sim.open_rate, sim.open_eig_rate, atol=tol)
+        # several closed-loop modes decay at comparable rates and the envelope fit mixes
+        # them: agreement to 30 % (measured: 7 % truth, 7-20 % ROM)
+        assert_allclose(sim.closed_rate, sim.closed_eig_rate, rtol=0.3)
+
+
+@pytest.fixture(scope="module")
+def cheap():
+    return flutter_check(TypicalSection(), flutter_check_settings(**CHEAP))
+
+
+def test_rom_identified_at_its_own_flutter_speed(cheap):
+    _check_rom_and_truth_flutter(cheap)
+
+
+def test_cheap_design_verified_above_flutter(cheap):
+    """Two design plants (Vf, 1.2 Vf): the exact interval covers [Vf, 1.2 Vf]."""
+    _check_verification(cheap)
+    lo, hi = cheap.verification.exact_V
+    assert lo < cheap.Vf and hi >= 1.2 * cheap.Vf
+    _check_dense_sweep(cheap)
+
+
+def test_cheap_design_simulations(cheap):
+    _check_simulations(cheap)
+
+
+def test_truth_loop_sweep(cheap):
+    """The truth's closed-loop stable interval contains its flutter speed and the
+    simulation speed; its edges are eigenvalue crossings."""
+    tsw = cheap.truth_sweep
+    a, b = tsw.stable_V
+    assert a < cheap.Vf_truth < cheap.truth_simulation.V < b
+    kw = dict(actuator_omega=cheap.settings.actuator_omega,
+              actuator_zeta=cheap.settings.actuator_zeta)
+    for edge in (a, b):
+        if tsw.V[0] < edge < tsw.V[-1]:
+            A = truth_loop_matrix(TypicalSection(), cheap.controller, edge, **kw)
+            assert abs(np.linalg.eigvals(A).real.max()) < 1e-7
+    # open loop: the truth's own flutter speed is the zero crossing of the sweep
+    crossing = tsw.V[np.argmax(tsw.open_abscissa > 1e-9)]
+    assert_allclose(crossing, cheap.Vf_truth, atol=2 * (tsw.V[1] - tsw.V[0]))
+
+
+def test_truth_loop_matrix_without_controller_is_the_truth():
+    """K = 0: the open truth plus the actuator's poles."""
+    import control
+    T = TypicalSection()
+    K = control.ss(np.diag([-1.0, -2.0]), np.zeros((2, 2)), np.zeros((1, 2)), np.zeros((1, 2)))
+    wa, za, V = 10.0, 0.7, 2.0
+    ev = np.sort_complex(np.linalg.eigvals(truth_loop_matrix(T, K, V, actuator_omega=wa,
+                                                              actuator_zeta=za)))
+    act = np.roots([1.0, 2 * za * wa, wa * wa])
+    ref = np.sort_complex(np.r_[np.linalg.eigvals(T.state_matrix(V)), act, -1.0, -2.0])
+    assert_allclose(ev, ref, rtol=1e-9, atol=1e-9)
+
+
+def test_settings_validation():
+    with pytest.raises(ConfigError, match="valid: V0, v0_iterations"):
+        flutter_check_settings(V00=2.0)
+    with pytest.raises(ConfigError, match="containing 1.0"):
+        FlutterCheckSettings(speed_factors=(0.5, 1.2))
+    with pytest.raises(ConfigError, match="sim_factor > 1"):
+        FlutterCheckSettings(sim_factor=0.9)
+    s = flutter_check_settings()
+    assert s.order == 2 and s.required == (0.5, 1.2)
+
+
+@pytest.mark.slow
+def test_flutter_check_full():
+    """The issue's targets with the problem's settings (five design plants)."""
+    res = flutter_check(TypicalSection())
+    _check_rom_and_truth_flutter(res)
+    _check_verification(res)
+    assert res.interval_ok, (res.verification.exact_V, res.required_V)
+    _check_dense_sweep(res)
+    _check_simulations(res)
+    assert res.success
+    # the honest check: the truth's closed loop is stable on the same speed range
+    a, b = res.truth_sweep.stable_V
+    lo, hi = res.settings.required
+    assert a <= lo * res.Vf_truth and b >= hi * res.Vf_truth
