@@ -9,7 +9,7 @@ the closed-loop frequency response, with an epigraph variable).  Here it runs on
 plant AC4 (Leibfritz 2004: 4 states, open-loop unstable, 2 measurements, 1 control) for
 controller orders 0, 1 and 2.  Every controller is re-checked by independent code
 (:func:`casflutter.verify.hinf_norm`, exact norm by the Hamiltonian/SLICOT algorithm) and
-compared with the full-order optimum: python-control's :func:`control.hinfsyn` (SLICOT
+compared with the full-order optimum: python-control's ``control.hinfsyn`` (SLICOT
 ``SB10AD``, γ-iteration to the optimum) gives 0.55729; the LMI value stored with the plant,
 0.55919, is a slightly inaccurate solve of the same bound.
 """
