@@ -72,19 +72,19 @@ class FlutterCheckSettings:
     """Chirp record length (``None``: the problem's ``[rom]`` setting)."""
     order: int = 2
     """Controller order."""
-    speed_factors: tuple = (0.5, 1.0, 1.25)
+    speed_factors: tuple = (0.5, 1.0, 1.2)
     """Nominal speeds of the design plants, as multiples of the ROM's Vf (1.0 must be one)."""
     starts: int = 1
     """Starts of the synthesis besides given controllers (the first is the zero controller)."""
     seed: int = 0
     """Seed of the random synthesis starts."""
-    max_outer: int = 20
+    max_outer: int = 6
     """Minimax solves per start."""
     polish_rank: int = 0
     """Polishing phase of the synthesis (0: off)."""
     stability_margin: float = 1e-4
     """Closed-loop decay required by the synthesis's stabilisation phase (relative)."""
-    max_stab_rounds: int = 8
+    max_stab_rounds: int = 20
     """Stabilisation solves per start."""
     ipopt: dict = field(default_factory=lambda: {"ipopt.max_wall_time": 1e4})
     """Extra Ipopt options of the synthesis.  The default lifts the synthesis's per-solve
