@@ -80,6 +80,8 @@ class FlutterCheckSettings:
     """Seed of the random synthesis starts."""
     max_outer: int = 6
     """Minimax solves per start."""
+    nslots: int = 16
+    """Frequency slots per plant in the minimax NLP."""
     polish_rank: int = 0
     """Polishing phase of the synthesis (0: off)."""
     stability_margin: float = 1e-4
@@ -112,8 +114,8 @@ class FlutterCheckSettings:
     def __post_init__(self):
         for name in ("speed_factors", "required", "sweep_range"):
             object.__setattr__(self, name, tuple(float(x) for x in getattr(self, name)))
-        for name in ("v0_iterations", "order", "starts", "seed", "max_outer", "polish_rank",
-                     "max_stab_rounds", "n_sweep"):
+        for name in ("v0_iterations", "order", "starts", "seed", "max_outer", "nslots",
+                     "polish_rank", "max_stab_rounds", "n_sweep"):
             v = getattr(self, name)
             if isinstance(v, bool) or int(v) != v:
                 raise ConfigError(f"{name}={v!r} must be an integer")
@@ -504,7 +506,7 @@ def flutter_check(truth, settings: FlutterCheckSettings | None = None, *,
     t0 = time.perf_counter()
     lft = build_lft(system, Vf)
     plants = [build_lft(system, f * Vf).plant_without_d22() for f in s.speed_factors]
-    opts = SynthesisOptions(max_outer=s.max_outer, polish_rank=s.polish_rank,
+    opts = SynthesisOptions(max_outer=s.max_outer, nslots=s.nslots, polish_rank=s.polish_rank,
                             stability_margin=s.stability_margin,
                             max_stab_rounds=s.max_stab_rounds, ipopt=dict(s.ipopt))
     syn = synthesize(plants if len(plants) > 1 else plants[0], lft.nmeas, lft.ncon, s.order,
