@@ -27,10 +27,9 @@ from casflutter.pipeline._flutter_check import (FlutterCheckSettings, flutter_ch
                                                 flutter_check_settings, truth_loop_matrix)
 from casflutter.truth import TypicalSection, problem_definition
 
-#: the non-slow check: the problem's settings (problems/typical_section/flutter_check.toml,
-#: design plants at 0.5, 1 and 1.2 Vf) with chirp records of half the length (the ROM fit is
-#: exact to rounding either way)
-CHEAP = dict(duration=150.0)
+#: the non-slow check: the problem's settings (problems/typical_section/flutter_check.toml:
+#: design plants at 0.5, 1 and 1.2 Vf, six minimax solves; about 15 s)
+CHEAP = dict()
 
 #: the slow check: five design plants and up to 20 minimax solves
 FULL = dict(speed_factors=(0.5, 1.0, 1.1, 1.2, 1.25), max_outer=20)
@@ -118,26 +117,15 @@ def _check_truth_interval(res):
     assert a <= lo * res.Vf_truth and b >= hi * res.Vf_truth, (a, b)
 
 
-@pytest.fixture(scope="module")
-def cheap():
-    return flutter_check(TypicalSection(), flutter_check_settings(**CHEAP))
-
-
-def test_rom_identified_at_its_own_flutter_speed(cheap):
-    _check_rom_and_truth_flutter(cheap)
-
-
-def test_verification(cheap):
-    _check_verification(cheap)
-
-
-def test_flutter_check_targets(cheap):
-    _check_targets(cheap)
-
-
-def test_truth_stable_on_the_required_range(cheap):
-    """Measured: truth closed loop stable on (0.02, 1.2416) x Vf_truth."""
-    _check_truth_interval(cheap)
+def test_flutter_check():
+    """The problem's settings.  One test function (not a module fixture shared by several):
+    under ``pytest -n 2`` a shared fixture would be computed once per worker.  Measured:
+    truth closed loop stable on (0.02, 1.2413) x Vf_truth."""
+    res = flutter_check(TypicalSection(), flutter_check_settings(**CHEAP))
+    _check_rom_and_truth_flutter(res)
+    _check_verification(res)
+    _check_targets(res)
+    _check_truth_interval(res)
 
 
 def test_truth_loop_matrix_without_controller_is_the_truth():
@@ -183,6 +171,6 @@ def test_flutter_check_full(full):
     "leaves the truth stable only on (0.02, 1.119) x Vf_truth (closed-loop eigenvalue "
     "crossing at V = 2.4279; at 1.1 Vf_truth it decays at only -0.0030): a smaller gamma on "
     "the ROM family (frozen aerodynamics) does not aim at the ROM-truth mismatch above Vf; "
-    "the three-plant default design reaches 1.242 x Vf_truth"))
+    "the three-plant default design reaches 1.241 x Vf_truth"))
 def test_full_truth_stable_on_the_required_range(full):
     _check_truth_interval(full)
