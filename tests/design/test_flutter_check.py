@@ -27,10 +27,6 @@ from casflutter.pipeline._flutter_check import (FlutterCheckSettings, flutter_ch
                                                 flutter_check_settings, truth_loop_matrix)
 from casflutter.truth import TypicalSection, problem_definition
 
-#: the non-slow check: the problem's settings (problems/typical_section/flutter_check.toml:
-#: design plants at 0.5, 1 and 1.2 Vf, six minimax solves; about 15 s)
-CHEAP = dict()
-
 #: the slow check: five design plants and up to 20 minimax solves
 FULL = dict(speed_factors=(0.5, 1.0, 1.1, 1.2, 1.25), max_outer=20)
 
@@ -118,10 +114,11 @@ def _check_truth_interval(res):
 
 
 def test_flutter_check():
-    """The problem's settings.  One test function (not a module fixture shared by several):
-    under ``pytest -n 2`` a shared fixture would be computed once per worker.  Measured:
-    truth closed loop stable on (0.02, 1.2413) x Vf_truth."""
-    res = flutter_check(TypicalSection(), flutter_check_settings(**CHEAP))
+    """The problem's settings (problems/typical_section/flutter_check.toml: design plants at
+    0.5, 1 and 1.2 Vf, six minimax solves; about 15 s).  One test function, not a module
+    fixture shared by several: under ``pytest -n 2`` a shared fixture would be computed once
+    per worker.  Measured: truth closed loop stable on (0.02, 1.2413) x Vf_truth."""
+    res = flutter_check(TypicalSection())
     _check_rom_and_truth_flutter(res)
     _check_verification(res)
     _check_targets(res)
@@ -167,10 +164,10 @@ def test_flutter_check_full(full):
 
 @pytest.mark.slow
 @pytest.mark.xfail(strict=True, reason=(
-    "the five-plant design (gamma 9.776 on the ROM, exact interval (0, 1.378) x Vf) "
-    "leaves the truth stable only on (0.02, 1.119) x Vf_truth (closed-loop eigenvalue "
-    "crossing at V = 2.4279; at 1.1 Vf_truth it decays at only -0.0030): a smaller gamma on "
-    "the ROM family (frozen aerodynamics) does not aim at the ROM-truth mismatch above Vf; "
+    "the five-plant design (gamma 9.776, exact interval (0, 1.378) x Vf on the ROM) leaves "
+    "the truth stable only on (0.02, 1.119) x Vf_truth (closed-loop eigenvalue crossing at "
+    "V = 2.4279; at 1.1 Vf_truth it decays at only -0.0030): robustness on the ROM family "
+    "(aerodynamics frozen at Vf, scaled by V^2) does not carry over to the truth above Vf; "
     "the three-plant default design reaches 1.241 x Vf_truth"))
 def test_full_truth_stable_on_the_required_range(full):
     _check_truth_interval(full)
