@@ -64,14 +64,24 @@ class SynthesisOptions:
     (coalescing singular values modelled exactly to first order); 0 or 1 disables it."""
     polish_tol: float = 1e-5
     """Stopping tolerance of the polishing phase."""
+    max_iter: int = 80
+    """Ipopt iterations per solve.  Together with ``max_outer`` and ``max_stab_rounds`` this
+    is the deterministic budget: without ``time_limit`` the same seed gives the same
+    controller on any machine and under any load."""
+    zero_start: bool = True
+    """Make the first of the ``starts`` the zero controller (the others are seeded random);
+    ``False``: all random."""
     time_limit: float | None = None
     """Wall-time budget in seconds for everything (``None``: unlimited); with polishing on,
-    the starts get 60 % of it and the polish the rest."""
+    the starts get 60 % of it and the polish the rest.  A budget also caps every Ipopt solve
+    at 3 s of wall time: the result then depends on the machine's speed and load (use it
+    for benchmarks, not where the same seed must give the same controller)."""
     ipopt: Mapping[str, Any] = field(default_factory=dict)
     """Extra flat Ipopt options, e.g. ``{"ipopt.max_iter": 300}``."""
 
     def __post_init__(self):
         checks = {"nslots": self.nslots >= 2, "max_outer": self.max_outer >= 1,
+                  "max_iter": self.max_iter >= 1,
                   "tol": 0 < self.tol < 1, "max_stab_rounds": self.max_stab_rounds >= 1,
                   "stability_margin": self.stability_margin > 0,
                   "trust_region": self.trust_region > 0, "rank": self.rank in (1, 2, 3),
@@ -81,7 +91,7 @@ class SynthesisOptions:
         bad = [k for k, ok in checks.items() if not ok]
         if bad:
             raise ConfigError(f"invalid SynthesisOptions field(s) {bad}: need nslots>=2, "
-                              "max_outer>=1, 0<tol<1, max_stab_rounds>=1, stability_margin>0, "
+                              "max_outer>=1, max_iter>=1, 0<tol<1, max_stab_rounds>=1, stability_margin>0, "
                               "trust_region>0, rank in 1..3, polish_rank in 0..3, 0<polish_tol<1, "
                               "time_limit None or >0")
 
@@ -336,7 +346,8 @@ def synthesize(plants, nmeas: int, ncon: int, order: int, *, starts: int = 3, se
         Controller order ``k >= 0`` (``0``: static output feedback).
     starts : int
         Number of starts besides the given ``initial`` controllers: the first is the zero
-        controller (with a stable ``Ak``), the others seeded random.
+        controller (with a stable ``Ak``) unless ``options.zero_start`` is false, the others
+        seeded random.
     seed : int
         Seed of the random starts (same seed, same result).
     initial : StateSpace or sequence, optional
@@ -380,9 +391,11 @@ def synthesize(plants, nmeas: int, ncon: int, order: int, *, starts: int = 3, se
         else list(initial))
     if not given and starts == 0:
         raise ConfigError("starts=0 needs at least one initial controller")
-    ipopt = {"ipopt.max_iter": 80, "ipopt.max_wall_time": 3.0,
+    ipopt = {"ipopt.max_iter": opts.max_iter,
              "ipopt.hessian_approximation": "limited-memory", "ipopt.tol": 1e-8,
              "ipopt.acceptable_tol": 1e-5, "ipopt.mu_strategy": "adaptive"}
+    if opts.time_limit:
+        ipopt["ipopt.max_wall_time"] = 3.0   # budget mode (not reproducible across machines)
     ipopt.update(opts.ipopt)
     stab = StabilizationNLP(prob.aug, ipopt)
     hinf = HinfNLP(prob.aug, opts.nslots, ipopt, rank=opts.rank)
@@ -399,7 +412,8 @@ def synthesize(plants, nmeas: int, ncon: int, order: int, *, starts: int = 3, se
     # a lower-order start padded with decoupled states sits on a saddle (zero Bk, Ck for the
     # new states): also start from a slightly perturbed copy
     plan += [("given-perturbed", g) for g in given if control.ss(g).nstates < order and starts]
-    plan += [("zero" if i == 0 else "random", None) for i in range(starts)]
+    plan += [("zero" if i == 0 and opts.zero_start else "random", None)
+             for i in range(starts)]
     records, gains = [], []
     best_alpha = np.inf
     for s, (kind, g) in enumerate(plan):

@@ -90,6 +90,11 @@ class ControllerSection:
     stability_margin: float = 1e-4
     #: short stabilisation solves per start
     max_stab_rounds: int = 8
+    #: Ipopt iterations per minimax/stabilisation solve (with ``max_outer`` and
+    #: ``max_stab_rounds`` the deterministic budget of the synthesis)
+    max_iter: int = 80
+    #: first start from the zero controller (``false``: every start seeded random)
+    zero_start: bool = True
     #: wall-clock budget [s] for all starts, 0 for none (a time budget makes the result
     #: depend on the machine's speed: the same seed then need not give the same controller)
     time_limit: float = 0.0
@@ -149,6 +154,11 @@ def _check_value(path: str, name: str, value, typ):
             raise ConfigError(f"{path} = {value}: must be > 0")
         if name == "regularization" and value < 0:
             raise ConfigError(f"{path} = {value}: must be >= 0")
+        return value
+    if origin is bool:
+        if not isinstance(value, bool):
+            raise ConfigError(f"{path}: expected true or false, got {type(value).__name__} "
+                              f"{value!r}")
         return value
     if origin is int:
         if isinstance(value, bool) or not isinstance(value, int):
@@ -233,6 +243,8 @@ def _semantic_checks(cfg: RunConfig) -> None:
     if not cfg.controller.stability_margin > 0:
         raise ConfigError(f"controller.stability_margin = {cfg.controller.stability_margin}: "
                           "must be > 0")
+    if cfg.controller.max_iter < 1:
+        raise ConfigError(f"controller.max_iter = {cfg.controller.max_iter}: must be >= 1")
     if cfg.controller.max_outer < 1:
         raise ConfigError(f"controller.max_outer = {cfg.controller.max_outer}: must be >= 1")
     if cfg.controller.starts < 1:

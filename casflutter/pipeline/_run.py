@@ -225,6 +225,7 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
     with prog.stage(8, "controller"):
         c = cfg.controller
         opts = SynthesisOptions(time_limit=c.time_limit or None, max_outer=c.max_outer,
+                                max_iter=c.max_iter, zero_start=c.zero_start,
                                 nslots=c.nslots, stability_margin=c.stability_margin,
                                 max_stab_rounds=c.max_stab_rounds,
                                 ipopt=dict(cfg.solver.ipopt))

@@ -13,6 +13,8 @@
   the Hopf-point NLP (:func:`hopf_point`, CasADi).
 - :func:`gamma_sensitivity`: dγ*/dp of fixed-order H∞ synthesis at its solution (envelope
   theorem of the minimax NLP, CasADi AD), checked against closed-form optima.
+- :func:`pipeline_evaluator`: the ``pipeline`` evaluator, one ``casflutter run`` per point,
+  parameters as dotted run-config paths (``controller.order``, ``problem.set.zeta_lateral``).
 - :func:`cached_solver`: one parametric CasADi solver per worker process and structure
   (the ``truth_hopf`` evaluator builds its NLP once per worker).
 """
@@ -20,6 +22,8 @@
 from ._evaluators import (Evaluator, evaluator_names, get_evaluator, register_evaluator,
                           synthesis_gamma, truth_flutter)
 from ._gamma import GammaSensitivity, gamma_sensitivity
+from ._pipeline_eval import (PIPELINE_OUTPUTS, PIPELINE_SETTINGS, flatten_summary,
+                             pipeline_config, pipeline_evaluator)
 from ._hopf import (HopfPoint, flutter_sensitivity_nlp, hopf_point, quadratic_coefficients,
                     truth_hopf)
 from ._runner import Progress, SweepResult, evaluate_point, run_sweep
@@ -35,6 +39,8 @@ __all__ = [
     "run_sweep", "SweepResult", "Progress", "evaluate_point",
     "Evaluator", "register_evaluator", "get_evaluator", "evaluator_names",
     "truth_flutter", "synthesis_gamma",
+    "pipeline_evaluator", "pipeline_config", "flatten_summary", "PIPELINE_OUTPUTS",
+    "PIPELINE_SETTINGS",
     "sweep_table", "write_table", "plot_sweep",
     "flutter_sensitivity", "flutter_speed_fd", "FlutterSensitivity", "ParameterSensitivity",
     "cached_solver", "solver_builds", "clear_solver_cache",

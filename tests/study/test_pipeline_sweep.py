@@ -14,8 +14,6 @@ from casflutter.study import (Parameter, PointStore, Study, evaluator_names, loa
 
 # The reduced seed-wing run of tests/pipeline/test_run.py, cut further so that one point
 # takes 10-20 s (one minimax solve; the controller is poor but the run is complete).
-# ipopt.max_wall_time: the synthesis' default per-solve wall-clock cap (3 s) makes its
-# result depend on the machine's load; without it the run is deterministic.
 REDUCED = """
 seed = 3
 [problem]
@@ -40,8 +38,6 @@ settle = 1.5
 ramp = 0.5
 hold = 1.5
 release = 1.0
-[solver]
-ipopt = {{"ipopt.max_wall_time" = 1e4}}
 """
 
 ORDERS = (1, 2)
