@@ -144,7 +144,8 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
     from ..truth import load_problem
     from ..verify import verify_controller
     from ._rom_data import truth_records
-    from ._suppression import accelerometer_structure, suppression_run, truth_lco
+    from ._suppression import (accelerometer_structure, sensor_rows_of, suppression_run,
+                               truth_lco)
 
     cfg = config if isinstance(config, RunConfig) else load_config(config)
     if seed is not None:
@@ -156,6 +157,9 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
     truth = load_problem(cfg.problem.name, sets)
     objects["truth"] = truth
     ms = truth.modal_structure()
+    # the accelerometers of every stage: Σs, the LFT, the truth's LCO and the suppression run
+    Hs = sensor_rows_of(truth, cfg.sensors.rows)
+    objects["sensor_rows"] = Hs
     hz = 1.0  # frequencies are cycles per the problem's time unit (seconds for the seed wing)
 
     with prog.stage(1, "data"):
@@ -176,7 +180,7 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
         real = realize(model, cfg.rom.nf)
         objects["realization"] = real
     with prog.stage(4, "structure"):
-        structure = accelerometer_structure(truth)
+        structure = accelerometer_structure(truth, Hs)
         system = AeroelasticSystem.from_parts(real.sigma_f, structure, warn_unstable=False)
         objects["system"] = system
         if not system.rom_stable:
@@ -214,8 +218,13 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
         lco = simulate_loop(model, structure, V_lco, n_steps, xs0=xs0)
         objects["lco"] = lco
         objects["lco_speeds"] = {"V_hopf_exact_order": V_hopf, "V": V_lco}
-        lco_truth = truth_lco(truth, V_lco, cfg.lco.duration, crit,
-                              cfg.lco.initial_deflection, dt=model.dt)
+        # the truth's own LCO: the same distance above its own Hopf point (the ROM's speed
+        # can be far above the truth's flutter speed, where the truth diverges)
+        V_lco_truth = (float(flutter_truth.Vf) * cfg.lco.speed_factor
+                       if flutter_truth.flutter is not None else V_lco)
+        lco_truth = truth_lco(truth, V_lco_truth, cfg.lco.duration, crit,
+                              cfg.lco.initial_deflection, dt=model.dt, sensor_rows=Hs)
+        lco_truth["V"] = V_lco_truth
         objects["lco_truth"] = lco_truth
         prog.note(f"ROM LCO at V = {V_lco:.4f} (exact-order Hopf {V_hopf:.4f}): "
                   f"{lco.sensors.kind}, {lco.sensors.frequency_hz:.3f} Hz")
@@ -278,6 +287,7 @@ def _summary(cfg, ident, real, system, flutter, flutter_truth, lco, lco_truth, s
                 "V_hopf_exact_order": objects_speeds.get("V_hopf_exact_order"),
                 "freq_hz": sens.frequency_hz * hz if sens.frequency_hz is not None else None,
                 "amplitude": list(sens.amplitude), "kind": sens.kind,
+                "truth_V": lco_truth.get("V"),
                 "truth_freq_hz": lco_truth.get("freq_hz"),
                 "truth_amplitude": lco_truth.get("amplitude"),
                 "truth_kind": lco_truth.get("kind")},

@@ -7,31 +7,80 @@ import numpy as np
 
 from ..aeroelastic import ModalStructure, analyze_response, simulate_loop
 from ..errors import CasflutterError
+from ._config import check_sensor_rows
 
-__all__ = ["accelerometer_structure", "truth_lco", "flap_pulse_comparison", "suppression_run",
-           "closed_loop_truth", "gain_schedule"]
+__all__ = ["sensor_rows_of", "accelerometer_structure", "truth_lco", "flap_pulse_comparison",
+           "suppression_run", "closed_loop_truth", "gain_schedule"]
 
 
-def accelerometer_structure(truth) -> ModalStructure:
-    """Σs (eq. 6-7) of a truth with its sensor rows read as accelerometers (the paper's
-    tip-store accelerometers): ``zm = Hs u''`` computed from the closed loop."""
+def sensor_rows_of(truth, rows=None) -> np.ndarray:
+    """The sensor rows ``Hs`` (eq. 7) of a run: ``rows`` if given, else the truth's own.
+
+    Parameters
+    ----------
+    truth : AeroelasticTruth
+        The problem (its ``modal_structure().sensor_rows`` are the default, for the seed
+        wing the paper's §IV rows of the two tip-store accelerometers).
+    rows : array_like, shape (n_sensors, N), optional
+        Sensor locations in modal coordinates (``[sensors] rows`` of the run
+        configuration); ``None`` or empty: the truth's rows.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(n_sensors, N)`` float array (a copy).
+
+    Raises
+    ------
+    ConfigError
+        Rows of the wrong length, non-finite entries or a row of zeros.
+    """
+    if rows is None or len(rows) == 0:
+        return np.array(truth.modal_structure().sensor_rows, dtype=float)
+    if isinstance(rows, np.ndarray):
+        rows = rows.tolist()
+    checked = check_sensor_rows(rows, truth.n_modes, key="sensor rows",
+                                problem=getattr(truth, "name", type(truth).__name__))
+    return np.array(checked, dtype=float)
+
+
+def accelerometer_structure(truth, rows=None) -> ModalStructure:
+    """Σs (eq. 6-7) of a truth read by accelerometers (the paper's tip-store
+    accelerometers): ``zm = Hs u''`` computed from the closed loop.
+
+    Parameters
+    ----------
+    truth : AeroelasticTruth
+        In-vacuo ω, ζ and the flow constant α.
+    rows : array_like, shape (n_sensors, N), optional
+        ``Hs`` (default: the truth's own sensor rows, :func:`sensor_rows_of`).
+
+    Returns
+    -------
+    ModalStructure
+    """
     ms = truth.modal_structure()
-    return ModalStructure(ms.omega, ms.zeta, ms.alpha, Hs=ms.sensor_rows, sensor="acceleration")
+    return ModalStructure(ms.omega, ms.zeta, ms.alpha, Hs=sensor_rows_of(truth, rows),
+                          sensor="acceleration")
 
 
-def _sensors(truth, sim) -> np.ndarray:
-    Hs = np.asarray(truth.modal_structure().sensor_rows, dtype=float)
-    return sim.uddot @ Hs.T
+def _sensors(sim, Hs: np.ndarray, kind: str = "acceleration") -> np.ndarray:
+    """``zm`` of a truth simulation: ``Hs u''`` (accelerometers), ``Hs u'`` or ``Hs u``."""
+    motion = {"acceleration": sim.uddot, "velocity": sim.udot, "displacement": sim.u}
+    if kind not in motion:
+        raise ValueError(f"sensor kind {kind!r}: use one of {', '.join(motion)}")
+    return motion[kind] @ np.asarray(Hs, dtype=float).T
 
 
 def truth_lco(truth, V: float, duration: float, mode: int, deflection: float, *,
-              dt: float) -> dict:
-    """The truth's own response at V from a deflected ``mode`` (its LCO, if any)."""
+              dt: float, sensor_rows=None) -> dict:
+    """The truth's own response at V from a deflected ``mode`` (its LCO, if any), read by
+    the accelerometers ``sensor_rows`` (default: the truth's own, :func:`sensor_rows_of`)."""
     t = np.arange(0.0, duration, dt)
     x0 = np.zeros(2 * truth.n_modes)
     x0[mode] = deflection
     sim = truth.simulate(t, x0, V)
-    zm = _sensors(truth, sim)
+    zm = _sensors(sim, sensor_rows_of(truth, sensor_rows))
     an = analyze_response(t, zm)
     return {"kind": an.kind, "freq_hz": float(an.frequency_hz),
             "amplitude": [float(a) for a in an.amplitude], "timepts": t, "zm": zm,
@@ -41,7 +90,8 @@ def truth_lco(truth, V: float, duration: float, mode: int, deflection: float, *,
 def flap_pulse_comparison(truth, model, structure, V: float, *, dt: float,
                           duration: float = 4.0, amplitude: float = np.radians(2.0)) -> dict:
     """Sensor response to a sequence of finite-width flap pulses at V (paper Fig. 8):
-    the nonlinear ROM in the loop with Σs against the truth."""
+    the nonlinear ROM in the loop with Σs against the truth, both read by the sensors of
+    ``structure`` (its ``Hs`` and ``sensor`` kind)."""
     t = np.arange(0.0, duration, dt)
     v = np.zeros_like(t)
     for k, t0 in enumerate((0.2, 0.9, 1.6, 2.3)):
@@ -49,7 +99,8 @@ def flap_pulse_comparison(truth, model, structure, V: float, *, dt: float,
         v += (-1) ** k * amplitude * np.exp(-0.5 * ((t - t0) / (0.35 * w)) ** 2)
     sim_t = truth.simulate(t, np.zeros(2 * truth.n_modes), V, v=v)
     sim_r = simulate_loop(model, structure, V, t.size, v=v)
-    return {"timepts": t, "v": v, "truth_zm": _sensors(truth, sim_t), "rom_zm": sim_r.zm}
+    return {"timepts": t, "v": v, "truth_zm": _sensors(sim_t, structure.Hs, structure.sensor),
+            "rom_zm": sim_r.zm}
 
 
 def gain_schedule(settle: float, ramp: float, hold: float):
@@ -69,7 +120,8 @@ def gain_schedule(settle: float, ramp: float, hold: float):
 def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain, *,
                       actuator_omega: float = 2 * np.pi * 40.0, actuator_zeta: float = 0.7,
                       substeps: int = 4, sensor: str = "acceleration",
-                      kick: tuple[float, int, float] | None = None) -> dict:
+                      kick: tuple[float, int, float] | None = None,
+                      sensor_rows=None) -> dict:
     """Sampled-data closed loop of the nonlinear truth with the controller ``K``.
 
     At every sample ``t_k`` the sensors (``zm = Hs u''`` for ``sensor="acceleration"``, the
@@ -81,13 +133,14 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     classical Runge--Kutta with ``substeps`` steps per sample.  ``kick = (time, mode,
     deflection)`` adds a modal deflection at that time (a tap on the wing, as the tunnel's
     turbulence would give), so that a released flutter can restart from a quiet wing.
+    ``sensor_rows`` are ``Hs`` (default: the truth's own, :func:`sensor_rows_of`).
     """
     if sensor not in ("acceleration", "displacement"):
         raise ValueError(f"sensor={sensor!r}: use 'acceleration' or 'displacement'")
     t = np.asarray(timepts, dtype=float)
     dt = float(t[1] - t[0])
     f = truth.flap_dynamics(V)
-    Hs = np.asarray(truth.modal_structure().sensor_rows, dtype=float)
+    Hs = sensor_rows_of(truth, sensor_rows)
     Kd = control.sample_system(K, dt, method="zoh") if K.nstates else K
     Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (Kd.A, Kd.B, Kd.C, Kd.D))
     nk = Ak.shape[0] if K.nstates else 0
@@ -139,6 +192,9 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
 def suppression_run(truth, K, cfg, Vf: float, *, dt: float, mode: int) -> dict:
     """Paper Fig. 11 on the truth: LCO develops, the gain ramps 0 -> 1, holds, is released.
 
+    The controller reads the accelerometers of the run configuration (``cfg.sensors.rows``,
+    default the truth's own rows).
+
     The attenuation compares the RMS of the dominant sensor over the last third of the
     hold with its RMS over the last third of the settling phase (open-loop LCO);
     ``lco_returns`` checks that after the release (the wing is tapped with the initial
@@ -153,7 +209,8 @@ def suppression_run(truth, K, cfg, Vf: float, *, dt: float, mode: int) -> dict:
     g = gain_schedule(sp.settle, sp.ramp, sp.hold)
     t_release = sp.settle + sp.ramp + sp.hold
     res = closed_loop_truth(truth, K, V, t, x0, g,
-                            kick=(t_release, mode, cfg.lco.initial_deflection))
+                            kick=(t_release, mode, cfg.lco.initial_deflection),
+                            sensor_rows=getattr(getattr(cfg, "sensors", None), "rows", None))
     zm = res["zm"]
     if not np.all(np.isfinite(zm)):
         raise CasflutterError(f"the closed-loop truth simulation at V = {V:.4f} blew up")

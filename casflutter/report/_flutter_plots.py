@@ -94,7 +94,8 @@ def plot_root_locus(result, *, branches=None, ax=None) -> Figure:
     return fig
 
 
-def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | None = None) -> Figure:
+def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | None = None,
+             truth=None) -> Figure:
     """LCO time history and spectrum (paper Fig. 9).
 
     Parameters
@@ -107,6 +108,11 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
         Channels to draw (default all).
     fmax_hz : float, optional
         Upper limit of the spectrum axis (default 4× the fundamental).
+    truth : dict, optional
+        The truth's own response beside the ROM's (sensor outputs only): keys ``timepts``,
+        ``zm``, ``analysis`` (a :class:`casflutter.aeroelastic.ResponseAnalysis`), ``V`` and
+        optionally ``t_start`` (where the history begins), as returned by the pipeline's
+        truth LCO stage; drawn dashed.
     """
     if which not in ("sensors", "modes"):
         raise ValueError(f"which={which!r}; choose 'sensors' or 'modes'")
@@ -124,10 +130,25 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
     title = f"V = {sim.V:g}: {an.kind}" if an is not None else f"V = {sim.V:g}"
     if an is not None and an.kind == "lco":
         title += f", fundamental {an.frequency_hz:.4g} Hz"
-    at.set_title(title)
+    if truth is not None and which == "sensors":
+        ta = truth.get("analysis")
+        for j in chans:
+            at.plot(truth["timepts"], truth["zm"][:, j], lw=0.8, ls="--",
+                    label=f"truth zm[{j}]")
+        title += f"; truth at V = {truth.get('V', float('nan')):.4g}: "
+        title += ta.kind if ta is not None else "?"
+        if ta is not None and ta.kind == "lco":
+            title += f", {ta.frequency_hz:.4g} Hz"
+        if truth.get("t_start", 0.0) > 0:
+            title += f" (its last {truth['timepts'][-1]:.3g} s after {truth['t_start']:.3g} s)"
+        if ta is not None and ta.spectrum.size:
+            afr.plot(ta.spectrum_freq_hz, ta.spectrum, lw=0.9, ls="--", label="truth")
+    at.set_title(title, fontsize="medium")
     at.legend(fontsize="small", ncol=3)
     if an is not None and an.spectrum.size:
-        afr.plot(an.spectrum_freq_hz, an.spectrum, lw=0.9)
+        afr.plot(an.spectrum_freq_hz, an.spectrum, lw=0.9, label="ROM")
+        if truth is not None:
+            afr.legend(fontsize="small")
         if np.isfinite(an.frequency_hz):
             afr.axvline(an.frequency_hz, color="r", ls="--", lw=0.8)
             afr.set_xlim(0, fmax_hz or 4 * an.frequency_hz)
