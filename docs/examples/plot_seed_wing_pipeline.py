@@ -20,7 +20,7 @@ The documentation build (``CASFLUTTER_DOCS_QUICK=1``) runs it on a reduced confi
 (shorter records and simulations; an order-2 controller from one start and two minimax
 rounds) so that it takes under a minute; the numbers printed below are those of that run,
 not of the paper's.  Without the variable it runs the full configuration
-``problems/seed_wing/run.toml`` (a few minutes), as ``make demo`` does.  The files are written
+``problems/seed_wing/run.toml`` (about 70 s), as ``make demo`` does.  The files are written
 to a temporary folder.
 """
 
