@@ -56,7 +56,15 @@ def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflu
         "LCO attenuation": (None if s.get("suppression", {}).get("attenuation_percent") is None
                             else f"{s['suppression']['attenuation_percent']:.1f} %"),
     }
+    ft, lco = s.get("flutter_truth", {}), s.get("lco", {})
+    truth = {   # the truth simulator's own values, where it has one
+        "flutter speed index Vf": ft.get("V"),
+        "flutter mode": ft.get("mode"),
+        "LCO fundamental frequency [Hz]": (lco.get("truth_freq_hz")
+                                           if lco.get("truth_kind") == "lco" else None),
+    }
     rows = "\n".join(f"<tr><td>{html.escape(k)}</td><td>{_fmt(ours.get(k))}</td>"
+                     f"<td>{_fmt(truth.get(k))}</td>"
                      f"<td>{html.escape(v)}</td></tr>" for k, v in PAPER_TABLE_I.items())
     fit = ", ".join(f"{e:.3f}" for e in s.get("fit_error_percent", []))
     imgs = []
@@ -77,7 +85,7 @@ figcaption{{font-size:90%;color:#555}}</style></head><body>
 <p>Reproduction of K.-Y. Lum et al., ACC 2016, on casflutter's truth simulator
 (the paper's CFD and wind tunnel are not available). Seed {_fmt(s.get('seed'))}.</p>
 <h2>Table I</h2>
-<table><tr><th>quantity</th><th>this run</th><th>paper</th></tr>
+<table><tr><th>quantity</th><th>this run (ROM)</th><th>truth simulator</th><th>paper</th></tr>
 {rows}</table>
 <p>ROM fit error per mode [%]: {fit}. Truth flutter: V = {_fmt(s.get('flutter_truth', {}).get('V'))},
 {_fmt(s.get('flutter_truth', {}).get('freq_hz'))} Hz. Controller: verified γ = {_fmt(ctrl.get('gamma'))},

@@ -1,0 +1,50 @@
+"""The self-contained HTML report: Table I beside the truth and the paper, figures embedded."""
+
+import base64
+import re
+
+import matplotlib.pyplot as plt
+
+from casflutter.report import html_report
+from casflutter.report._html import PAPER_TABLE_I
+
+SUMMARY = {
+    "problem": "seed_wing", "seed": 0, "V0": 0.69, "n_sensors": 2, "orders": [3, 1, 1, 1, 2, 2],
+    "fit_error_percent": [0.5, 2.8, 0.4, 0.2, 0.9], "nf": 15, "ns": 10, "nae": 25,
+    "flutter": {"V": 1.19999, "mode": 2}, "flutter_truth": {"V": 1.08499, "mode": 2},
+    "lco": {"freq_hz": 9.2855, "truth_freq_hz": 9.3758, "truth_kind": "lco"},
+    "controller": {"order": 3, "stable_V": [0.0, 1.76]},
+    "suppression": {"attenuation_percent": 99.99},
+    "timings_s": {"rom": 0.5, "total": 70.0},
+}
+
+
+def _row(text, name):
+    m = re.search(r"<tr><td>" + re.escape(name) + r"</td>(.*?)</tr>", text)
+    assert m, f"no Table I row {name!r}"
+    return re.findall(r"<td>(.*?)</td>", m.group(1))
+
+
+def test_table_i_has_run_truth_and_paper_columns():
+    text = html_report(SUMMARY, {})
+    for name in PAPER_TABLE_I:
+        assert len(_row(text, name)) == 3, name
+    assert _row(text, "flutter speed index Vf") == ["1.2", "1.085", "1.20"]
+    assert _row(text, "LCO fundamental frequency [Hz]") == ["9.286", "9.376", "8.5"]
+    assert _row(text, "stable speed range (controller)") == ["(0, 1.76)", "—", "(0, 2.4)"]
+    assert _row(text, "LCO attenuation") == ["100.0 %", "—", "&gt; 90 %"]
+
+
+def test_truth_lco_frequency_only_when_the_truth_has_an_lco():
+    s = dict(SUMMARY, lco=dict(SUMMARY["lco"], truth_kind="divergence"))
+    assert _row(html_report(s, {}), "LCO fundamental frequency [Hz]")[1] == "—"
+
+
+def test_figures_are_embedded(tmp_path):
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [0, 1])
+    path = tmp_path / "fig.png"
+    fig.savefig(path)
+    text = html_report(SUMMARY, {"fig7_rom_fit": path})
+    data = re.search(r'src="data:image/png;base64,([^"]+)"', text).group(1)
+    assert base64.b64decode(data) == path.read_bytes()
