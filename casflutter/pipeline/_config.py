@@ -7,6 +7,7 @@ that names the key and what is allowed.
 
 from __future__ import annotations
 
+import math
 import tomllib
 from dataclasses import asdict, dataclass, field, fields, is_dataclass
 from pathlib import Path
@@ -15,7 +16,7 @@ from typing import Any, get_origin, get_type_hints
 from .._resources import problems_dir
 from ..errors import ConfigError
 
-__all__ = ["RunConfig", "load_config", "default_config_path"]
+__all__ = ["RunConfig", "load_config", "default_config_path", "check_sensor_rows"]
 
 
 @dataclass(frozen=True)
@@ -114,6 +115,22 @@ class SuppressionSection:
 
 
 @dataclass(frozen=True)
+class SensorsSection:
+    """``[sensors]``: the measured outputs ``zm = Hs u''`` of the accelerometers (eq. 7).
+
+    The rows of ``Hs`` are the sensor locations in modal coordinates (paper §IV: the mode
+    shapes at each accelerometer in its measuring direction, from FEA); the seed wing's two
+    tip-store accelerometers are printed there.  One set of rows is used by every stage:
+    Σs in the ROM loop (eq. 6--9), the LFT's measured output (eq. 14), the truth's LCO and
+    the closed-loop suppression run.
+    """
+
+    #: one row of N numbers (one per mode of the problem) per accelerometer; empty (the
+    #: default): the problem's own rows (``truth.modal_structure().sensor_rows``)
+    rows: list = field(default_factory=list)
+
+
+@dataclass(frozen=True)
 class SolverSection:
     """``[solver]``: flat Ipopt options for every NLP (``"ipopt.tol" = 1e-8``)."""
 
@@ -131,6 +148,7 @@ class RunConfig:
     lco: LcoSection = field(default_factory=LcoSection)
     controller: ControllerSection = field(default_factory=ControllerSection)
     suppression: SuppressionSection = field(default_factory=SuppressionSection)
+    sensors: SensorsSection = field(default_factory=SensorsSection)
     solver: SolverSection = field(default_factory=SolverSection)
     seed: int = 0
 
@@ -260,6 +278,61 @@ def _semantic_checks(cfg: RunConfig) -> None:
         PROBLEMS[cfg.problem.name].Params.from_sets(f"{k}={v}" for k, v in cfg.problem.set.items())
     except ConfigError as exc:
         raise ConfigError(f"problem.set: {exc}") from None
+    if cfg.sensors.rows:
+        from ..truth import load_problem
+        n_modes = load_problem(cfg.problem.name,
+                               [f"{k}={v}" for k, v in cfg.problem.set.items()]).n_modes
+        check_sensor_rows(cfg.sensors.rows, n_modes, key="sensors.rows",
+                          problem=cfg.problem.name)
+
+
+def check_sensor_rows(rows, n_modes: int, *, key: str = "sensors.rows",
+                      problem: str = "the problem") -> list[list[float]]:
+    """Check sensor rows ``Hs`` (eq. 7) given as nested lists: ``(n_sensors, n_modes)``.
+
+    Parameters
+    ----------
+    rows : sequence of sequences of float
+        One row per sensor, one number per mode.
+    n_modes : int
+        Number of modes ``N`` of the problem.
+    key : str
+        Name of the setting, for the error message.
+    problem : str
+        Name of the problem, for the error message.
+
+    Returns
+    -------
+    list of list of float
+        The rows as floats.
+
+    Raises
+    ------
+    ConfigError
+        Not a non-empty list of lists, a row whose length is not ``n_modes``, an entry that
+        is not a finite number, or a row of zeros (a sensor that sees no mode).
+    """
+    want = (f"give a list of rows, one per sensor, each a list of {n_modes} numbers (one per "
+            f"mode of {problem}), e.g. {key} = [[{', '.join(['0.1'] * n_modes)}]]")
+    if isinstance(rows, (str, bytes)) or not hasattr(rows, "__len__") or len(rows) == 0:
+        raise ConfigError(f"{key} = {rows!r}: {want}")
+    out = []
+    for i, row in enumerate(rows):
+        if isinstance(row, (str, bytes)) or not hasattr(row, "__len__"):
+            raise ConfigError(f"{key}[{i}] = {row!r} is not a list: {want}")
+        if len(row) != n_modes:
+            raise ConfigError(f"{key}[{i}] has {len(row)} entries, {problem} has {n_modes} "
+                              f"modes: {want}")
+        vals = []
+        for j, x in enumerate(row):
+            if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+                raise ConfigError(f"{key}[{i}][{j}] = {x!r}: must be a finite number")
+            vals.append(float(x))
+        if not any(vals):
+            raise ConfigError(f"{key}[{i}] is all zeros: a sensor that sees no mode; drop the "
+                              "row")
+        out.append(vals)
+    return out
 
 
 def default_config_path() -> Path:

@@ -1,10 +1,11 @@
 """The ``pipeline`` evaluator: ``casflutter run`` (the seed-wing study) swept over run-config
-keys and truth parameters by dotted path."""
+keys (controller order, the accelerometer rows) and truth parameters by dotted path."""
 
 import json
 from dataclasses import replace
 from pathlib import Path
 
+import control
 import numpy as np
 import pytest
 
@@ -33,6 +34,7 @@ starts = 1
 max_outer = 1
 nslots = 2
 max_stab_rounds = 2
+{sensors}
 [suppression]
 settle = 1.5
 ramp = 0.5
@@ -42,13 +44,20 @@ release = 1.0
 
 ORDERS = (1, 2)
 ZETAS = (0.005, 0.01)   # structural damping of the lateral mode, the flutter mode (mode 2)
+#: paper §IV accelerometer rows (Acc1, Acc2) and two other readings of the same wing: the
+#: sensors mixed (S H0) and Acc2 alone
+H0 = np.array([[0.1299, -0.0006, -0.2866, -0.1130, 0.0766],
+               [-0.0021, 0.1364, 0.0141, 0.0021, -0.0020]])
+S = np.array([[2.0, 0.5], [-0.3, 1.5]])
+ROWS = ((S @ H0).tolist(), H0[1:].tolist())
 
 
 def _study(cfg_path: Path) -> Study:
-    # a 2-point Latin hypercube over explicit values: each order and each damping once
+    # a 2-point Latin hypercube over explicit values: each order, damping and row set once
     return Study(name="pipe", evaluator="pipeline", design="lhs", samples=2, seed=0,
                  parameters=(Parameter("controller.order", values=ORDERS),
-                             Parameter("problem.set.zeta_lateral", values=ZETAS)),
+                             Parameter("problem.set.zeta_lateral", values=ZETAS),
+                             Parameter("sensors.rows", values=ROWS)),
                  settings={"config": cfg_path.name}, base_dir=str(cfg_path.parent))
 
 
@@ -56,7 +65,7 @@ def _study(cfg_path: Path) -> Study:
 def swept(tmp_path_factory):
     folder = tmp_path_factory.mktemp("pipe")
     cfg = folder / "base.toml"
-    cfg.write_text(REDUCED.format(order=3, problem_set=""))
+    cfg.write_text(REDUCED.format(order=3, problem_set="", sensors=""))
     study = _study(cfg)
     res = run_sweep(study, store=folder / "pipe.jsonl", workers=0, progress=False)
     return folder, study, res, sweep_table(study, res.store)
@@ -105,8 +114,12 @@ def test_swept_point_equals_a_direct_run(swept):
     path = folder / "direct.toml"
     path.write_text(REDUCED.format(order=r["controller.order"],
                                    problem_set=f"set = {{zeta_lateral = "
-                                               f"{r['problem.set.zeta_lateral']!r}}}"))
-    s = run_pipeline(load_config(path), write=False, quiet=True).summary
+                                               f"{r['problem.set.zeta_lateral']!r}}}",
+                                   sensors=f"[sensors]\nrows = {r['sensors.rows']!r}"))
+    cfg = load_config(path)
+    run = run_pipeline(cfg, write=False, quiet=True)
+    s = run.summary
+    _check_sensor_rows_reach_every_stage(run, cfg, np.asarray(r["sensors.rows"]))
     expected = {
         "Vf_rom": s["flutter"]["V"], "freq_hz_rom": s["flutter"]["freq_hz"],
         "mode_rom": s["flutter"]["mode"], "Vf_truth": s["flutter_truth"]["V"],
@@ -129,6 +142,43 @@ def test_swept_point_equals_a_direct_run(swept):
         else:
             assert r[name] == value, name
     assert set(s["timings_s"]) == {k[len("time_"):] for k in r if k.startswith("time_")}
+
+
+def _check_sensor_rows_reach_every_stage(run, cfg, R):
+    """The configured rows R read every stage: Σs, the LFT (eq. 14) and the truth's LCO and
+    suppression records equal R times the same quantities computed independently with one
+    accelerometer per mode (identity rows)."""
+    from casflutter.aeroelastic import AeroelasticSystem, build_lft
+    from casflutter.pipeline._suppression import (accelerometer_structure, closed_loop_truth,
+                                                  truth_lco)
+
+    ob = run.objects
+    truth, system, lft = ob["truth"], ob["system"], ob["lft"]
+    np.testing.assert_array_equal(system.structure.Hs, R)
+    assert run.summary["n_sensors"] == lft.nmeas == R.shape[0]
+    eye = build_lft(AeroelasticSystem.from_parts(ob["realization"].sigma_f,
+                                                 accelerometer_structure(truth, np.eye(5)),
+                                                 warn_unstable=False), lft.Vf)
+    for name in ("C2", "D21", "D22"):
+        np.testing.assert_allclose(getattr(lft, name), R @ getattr(eye, name), rtol=1e-12,
+                                   atol=1e-12, err_msg=name)
+    crit = run.summary["flutter"]["mode"] - 1
+    dt = ob["identification"].model.dt
+    lt = ob["lco_truth"]
+    # the truth's LCO speed (recorded with the record when the run stores it)
+    V_lt = lt.get("V", ob["lco_speeds"]["V"])
+    acc = truth_lco(truth, V_lt, cfg.lco.duration, crit, cfg.lco.initial_deflection, dt=dt,
+                    sensor_rows=np.eye(5))["zm"]
+    np.testing.assert_allclose(lt["zm"], acc @ R.T, rtol=1e-10, atol=1e-12)
+    # suppression: open loop (gain 0) during the settling phase
+    sup = ob["suppression"]
+    n = int(np.sum(sup["timepts"] < cfg.suppression.settle)) - 1
+    x0 = np.zeros(10)
+    x0[crit] = cfg.lco.initial_deflection
+    no_control = control.ss([], [], [], np.zeros((1, 5)))
+    open_acc = closed_loop_truth(truth, no_control, sup["V"], sup["timepts"][:n], x0,
+                                 lambda t: 0.0, sensor_rows=np.eye(5))["zm"]
+    np.testing.assert_allclose(sup["zm"][:n], open_acc @ R.T, rtol=1e-9, atol=1e-10)
 
 
 @pytest.mark.parametrize("name, words", [
