@@ -23,6 +23,13 @@ failure (the runner records the error and carries on).  Built-in evaluators:
 
 Further evaluators plug in with :func:`register_evaluator` or as ``"package.module:function"``
 in the study file (the form that also reaches spawned and Dask worker processes).
+
+An evaluator may carry a ``check(params, settings)``: the pre-flight check that
+:func:`~casflutter.study.run_sweep` calls on every point before any point runs, so that a
+misspelt parameter or setting stops the study at once instead of failing point by point
+(``pipeline``: the run configuration's validation; ``truth_flutter``: the problem's
+parameter names; ``synthesis``: the plant file and the order).  A ``"module:function"``
+evaluator gets one from an attribute ``function.check``.
 """
 
 from __future__ import annotations
@@ -58,6 +65,10 @@ class Evaluator:
     modules : tuple of str
         Modules a worker imports before its first point (so that start-up is not counted
         as the first point's work).
+    check : callable or None
+        ``check(params, settings) -> None``: a cheap validation of one point's names and
+        values (no work), raising :class:`~casflutter.errors.ConfigError`; the runner
+        calls it on every point before submitting any (:meth:`check_point`).
     """
 
     name: str
@@ -65,6 +76,25 @@ class Evaluator:
     outputs: tuple = ()
     description: str = ""
     modules: tuple = ()
+    check: Callable[[Mapping[str, Any], Mapping[str, Any]], Any] | None = None
+
+    def check_point(self, params: Mapping[str, Any], settings: Mapping[str, Any]) -> None:
+        """Run :attr:`check` on one point (nothing when the evaluator has none).
+
+        Parameters
+        ----------
+        params : mapping
+            The swept values of the point.
+        settings : mapping
+            The study's fixed settings (with ``_base_dir``).
+
+        Raises
+        ------
+        ConfigError
+            The point's names or values are invalid for this evaluator.
+        """
+        if self.check is not None:
+            self.check(dict(params), dict(settings))
 
     def warm_up(self) -> None:
         """Import :attr:`modules` (run once per worker process)."""
@@ -76,11 +106,11 @@ _REGISTRY: dict[str, Evaluator] = {}
 
 
 def register_evaluator(name: str, function: Callable, outputs=(), description: str = "",
-                       modules=()) -> Evaluator:
+                       modules=(), check: Callable | None = None) -> Evaluator:
     """Add (or replace) an evaluator under ``name`` and return it (fields of
-    :class:`Evaluator`)."""
+    :class:`Evaluator`, ``check`` the optional pre-flight check)."""
     ev = Evaluator(name=name, function=function, outputs=tuple(outputs),
-                   description=description, modules=tuple(modules))
+                   description=description, modules=tuple(modules), check=check)
     _REGISTRY[name] = ev
     return ev
 
@@ -110,7 +140,7 @@ def get_evaluator(ref: str) -> Evaluator:
         except (ImportError, AttributeError) as exc:
             raise ConfigError(f"evaluator {ref!r} cannot be imported ({exc}); give "
                               "'package.module:function' importable on every worker") from None
-        return Evaluator(name=ref, function=fn)
+        return Evaluator(name=ref, function=fn, check=getattr(fn, "check", None))
     raise ConfigError(f"unknown evaluator {ref!r}; registered: {', '.join(sorted(_REGISTRY))} "
                       "(or give 'package.module:function')")
 
@@ -225,6 +255,12 @@ def truth_flutter(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dic
     return out
 
 
+def _truth_flutter_check(params: Mapping[str, Any], settings: Mapping[str, Any]) -> None:
+    """Pre-flight check of :func:`truth_flutter`: the problem, its parameter names and
+    values, the option names (builds the truth, no flutter search)."""
+    load_truth(params, settings)
+
+
 # --------------------------------------------------------------------------- synthesis
 
 def synthesis_gamma(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dict[str, Any]:
@@ -273,17 +309,37 @@ def synthesis_gamma(params: Mapping[str, Any], settings: Mapping[str, Any]) -> d
             "synthesis_time": time.perf_counter() - t0}
 
 
+def _synthesis_check(params: Mapping[str, Any], settings: Mapping[str, Any]) -> None:
+    """Pre-flight check of :func:`synthesis_gamma`: ``plant`` names an existing file and
+    ``order`` is a non-negative integer."""
+    merged = {**settings, **params}
+    base = Path(str(merged.pop("_base_dir", ".")))
+    if "plant" not in merged or "order" not in merged:
+        raise ConfigError("synthesis needs 'plant' (COMPleib JSON path) and 'order'")
+    plant = Path(str(merged["plant"]))
+    if not plant.is_absolute():
+        plant = base / plant
+    if not plant.is_file():
+        raise ConfigError(f"plant = {merged['plant']!r}: no file {plant} (paths are relative "
+                          "to the study file)")
+    order = merged["order"]
+    if isinstance(order, bool) or not isinstance(order, (int, float)) or order < 0 \
+            or int(order) != order:
+        raise ConfigError(f"order = {order!r}: a non-negative integer")
+
+
 register_evaluator("truth_flutter", truth_flutter,
                    outputs=("flutter_status", "Vf", "omega_f", "frequency_hz", "flutter_mode",
                             "divergence_V", "n_crossings", "flutter_time", "lco_amplitude"),
                    description="truth flutter speed/frequency/divergence (and LCO amplitude)",
-                   modules=("casflutter.truth", "casflutter.aeroelastic"))
+                   modules=("casflutter.truth", "casflutter.aeroelastic"),
+                   check=_truth_flutter_check)
 register_evaluator("synthesis", synthesis_gamma,
                    outputs=("gamma", "delta_bound", "spectral_abscissa", "success",
                             "converged", "n_solves", "n_solve_succeeded", "last_status",
                             "synthesis_time"),
                    description="fixed-order H-infinity synthesis on a COMPleib plant (gamma vs order)",
-                   modules=("casflutter.design",))
+                   modules=("casflutter.design",), check=_synthesis_check)
 
 
 
@@ -354,13 +410,15 @@ def _maybe_register_pipeline() -> None:
         from ..pipeline import rom_flutter, rom_settings, run_pipeline  # noqa: F401, PLC0415
     except ImportError:
         return
-    from ._pipeline_eval import PIPELINE_OUTPUTS, pipeline_evaluator  # noqa: PLC0415
+    from ._pipeline_eval import (PIPELINE_OUTPUTS, pipeline_check,  # noqa: PLC0415
+                                 pipeline_evaluator)
 
     register_evaluator("pipeline", pipeline_evaluator, outputs=PIPELINE_OUTPUTS,
                        description="the whole seed-wing study (casflutter run) per point: "
                                    "sweep run-config keys by dotted path (controller.order, "
                                    "rom.orders, data.V0, problem.set.zeta ...)",
-                       modules=("casflutter.pipeline", "casflutter.study._pipeline_eval"))
+                       modules=("casflutter.pipeline", "casflutter.study._pipeline_eval"),
+                       check=pipeline_check)
     register_evaluator("rom_flutter", rom_flutter_evaluator,
                        outputs=("Vf_truth", "Vf_rom", "Vf_frozen", "Vf_parametric",
                                 "rom_error", "scaling_error", "identification_error",

@@ -7,13 +7,16 @@ settings is a change of the run configuration by dotted path (the TOML tables of
 - a stage's key: ``data.V0`` (nominal speed of the records), ``rom.orders`` (HWL orders
   ``[mu, na, nb, r, p, q]``), ``rom.nf`` (order of Σf, eq. 5), ``controller.order``,
   ``controller.starts``, ``lco.speed_factor``, ``suppression.speed_factor``, ``seed`` ...;
+- the accelerometers: ``sensors.rows`` (``Hs`` of eq. 7, a list of rows per value, one
+  number per mode; default the problem's own rows, the paper's §IV);
 - a truth parameter: ``problem.set.NAME`` (seed wing: ``zeta`` structural damping,
   ``zeta_lateral``, ``rho`` air density and ``U_ref`` the flow's speed scale, ``suction``,
   ``acc1_offset`` (the Acc1 position) ... ``casflutter problems`` lists them).
 
 The changes go through :func:`casflutter.pipeline.load_config` (``updates=``), so a point
 with an unknown or invalid name fails before any work with the configuration's own message
-(the key and what is allowed).  The outputs are ``RunResult.summary`` (``summary.json``)
+(the key and what is allowed); :func:`pipeline_check`, the evaluator's pre-flight check,
+does so for every point of a study before the first one runs.  The outputs are ``RunResult.summary`` (``summary.json``)
 flattened into columns (:func:`flatten_summary`).
 """
 
@@ -27,8 +30,8 @@ from typing import Any, Mapping
 
 from ..errors import ConfigError
 
-__all__ = ["PIPELINE_SETTINGS", "PIPELINE_OUTPUTS", "pipeline_config", "flatten_summary",
-           "pipeline_evaluator"]
+__all__ = ["PIPELINE_SETTINGS", "PIPELINE_OUTPUTS", "pipeline_config", "pipeline_check",
+           "flatten_summary", "pipeline_evaluator"]
 
 #: The evaluator's own settings (everything else is a configuration change).
 PIPELINE_SETTINGS = {
@@ -96,6 +99,23 @@ def pipeline_config(params: Mapping[str, Any], settings: Mapping[str, Any] | Non
         raise ConfigError(f"pipeline evaluator: {exc} (swept names and [settings] are dotted "
                           f"paths into the run configuration; the evaluator's own settings: "
                           f"{', '.join(PIPELINE_SETTINGS)})") from None
+
+
+def pipeline_check(params: Mapping[str, Any], settings: Mapping[str, Any]) -> None:
+    """The pre-flight check of the ``pipeline`` evaluator: :func:`pipeline_config` (the
+    configuration's validation, no work).
+
+    Parameters
+    ----------
+    params, settings : mapping
+        As for :func:`pipeline_evaluator`.
+
+    Raises
+    ------
+    ConfigError
+        An unknown or invalid name or value (the message names the key).
+    """
+    pipeline_config(params, settings)
 
 
 def _pair(value, i):

@@ -58,6 +58,35 @@ def evaluate_point(evaluator: str, params: Mapping[str, Any], settings: Mapping[
     return rec
 
 
+def _preflight(study: Study, todo: Mapping[str, Mapping[str, Any]]) -> None:
+    """Run the evaluator's pre-flight check (:attr:`Evaluator.check`) on every point about
+    to be submitted; the first invalid one stops the study before anything runs.
+
+    Raises
+    ------
+    ConfigError
+        Names the point (its number in the design and its values) and the evaluator's
+        message (the key and what is allowed).
+    """
+    from ._evaluators import get_evaluator  # noqa: PLC0415
+
+    ev = get_evaluator(study.evaluator)
+    if ev.check is None or not todo:
+        return
+    settings = study.resolved_settings()
+    points = study.points()
+    for i, p in enumerate(points):
+        if study.key(p) not in todo:
+            continue
+        try:
+            ev.check_point(p, settings)
+        except Exception as exc:  # noqa: BLE001 - any failure of the check is a bad point
+            values = ", ".join(f"{k} = {v!r}" for k, v in p.items())
+            raise ConfigError(f"study {study.name!r}, point {i + 1} of {len(points)} "
+                              f"({values}): {type(exc).__name__}: {exc}; no point was run, fix "
+                              "the study file ([parameters] / [settings])") from None
+
+
 def _warm(evaluator: str) -> None:
     """Worker initializer: import the evaluator's modules before the first point."""
     from ._evaluators import get_evaluator  # noqa: PLC0415
@@ -375,8 +404,19 @@ def run_sweep(study: Study, *, store: str | Path | None = None, workers: int | N
 
     Raises
     ------
+    ConfigError
+        A point that the evaluator's pre-flight check (:attr:`Evaluator.check`, e.g. the
+        ``pipeline`` evaluator's configuration validation) rejects: every point is checked
+        before any is submitted, and nothing runs.
     KeyboardInterrupt
         Re-raised after Ctrl-C; every point finished before it is stored.
+
+    Notes
+    -----
+    Local workers are *spawned* processes that import the calling script: a script that
+    calls :func:`run_sweep` with ``workers >= 1`` must guard its top level with
+    ``if __name__ == "__main__":`` (otherwise every worker runs the sweep again and
+    Python stops it with a ``RuntimeError`` about bootstrapping).
     """
     store_path = Path(store) if store is not None else default_store_path(study)
     pstore = PointStore(store_path)
@@ -385,6 +425,7 @@ def run_sweep(study: Study, *, store: str | Path | None = None, workers: int | N
     finished = pstore.finished_keys(include_failed=not retry_failed)
     todo = {k: p for k, p in keyed.items() if k not in finished}
     n_resumed = len(keyed) - len(todo)
+    _preflight(study, todo)
     prog = Progress(len(keyed), skipped=n_resumed, enabled=progress)
     state = {"startup": 0.0, "wall": 0.0, "work": 0.0, "computed": 0, "restarts": 0,
              "interrupted": False}

@@ -187,15 +187,31 @@ def _check_sensor_rows_reach_every_stage(run, cfg, R):
     ("problem.set.zeta_lat", ["problem.set", "'zeta_lat'", "zeta_lateral"]),
 ])
 def test_unknown_name_fails_before_any_work(tmp_path, name, words):
+    """The pre-flight check stops the study before any point is submitted."""
     st = Study(name="bad", evaluator="pipeline", parameters=(Parameter(name, values=(1.0,)),),
                settings={})
-    res = run_sweep(st, store=tmp_path / "bad.jsonl", workers=0, progress=False)
-    assert (res.n_computed, res.n_failed) == (1, 1)
-    (rec,) = list(PointStore(res.store))
-    assert rec["error"].startswith("ConfigError")
-    for w in words:
-        assert w in rec["error"]
-    assert rec["work_time"] < 2.0   # the config check only; a run takes ~10 s and more
+    with pytest.raises(ConfigError) as exc:
+        run_sweep(st, store=tmp_path / "bad.jsonl", workers=0, progress=False)
+    msg = str(exc.value)
+    for w in [*words, "point 1 of 1", f"{name} = 1.0", "no point was run"]:
+        assert w in msg
+    assert list(PointStore(tmp_path / "bad.jsonl")) == []
+
+
+def test_one_bad_point_stops_the_whole_study(tmp_path):
+    """The first point is valid, the second is not: neither runs, the message names the
+    second point and its key (local processes: nothing is submitted, no worker starts)."""
+    st = Study(name="bad2", evaluator="pipeline",
+               parameters=(Parameter("rom.orders", values=([3, 1, 1, 1, 2, 2], [3, 1, 1])),),
+               settings={"controller.order": 1})
+    with pytest.raises(ConfigError, match=r"point 2 of 2 \(rom\.orders = \[3, 1, 1\]\).*"
+                                          r"rom\.orders = \[3, 1, 1\]: give six integers"):
+        run_sweep(st, store=tmp_path / "bad2.jsonl", workers=2, progress=False)
+    assert list(PointStore(tmp_path / "bad2.jsonl")) == []
+    bad_rows = Study(name="bad3", evaluator="pipeline",
+                     parameters=(Parameter("sensors.rows", values=([[1.0, 0, 0, 0]],)),))
+    with pytest.raises(ConfigError, match=r"point 1 of 1.*sensors\.rows\[0\] has 4 entries"):
+        run_sweep(bad_rows, store=tmp_path / "bad3.jsonl", workers=0, progress=False)
 
 
 def test_pipeline_config_direct_errors():
