@@ -42,4 +42,4 @@ bench: $(STAMP)
 	$(VENV)/bin/casflutter bench identify --out bench-identify.json
 
 clean:
-	rm -rf build *.egg-info .pytest_cache casflutter-run
+	rm -rf build *.egg-info .pytest_cache casflutter-run docs/_build docs/auto_examples docs/generated docs/sg_execution_times.rst

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import json
 import math
 from pathlib import Path
 from typing import Any, Mapping, Sequence
@@ -92,12 +93,63 @@ def _numeric(values) -> np.ndarray:
     return out
 
 
+def _categories(values) -> list[str] | None:
+    """Labels of a parameter's values when any is not a number (lists such as
+    ``rom.orders``, strings such as ``"auto"``), in order of first appearance; ``None``
+    when every value is a number (plotted on a numeric axis)."""
+    def is_number(v):
+        return v is None or (isinstance(v, (bool, int, float, np.number)))
+
+    if all(is_number(v) for v in values):
+        return None
+    labels: list[str] = []
+    for v in values:
+        if v is not None and _label(v) not in labels:
+            labels.append(_label(v))
+    return labels
+
+
+def _label(value) -> str:
+    """Tick label of a categorical value (JSON for lists and tables)."""
+    if isinstance(value, str):
+        return value
+    try:
+        return json.dumps(value)
+    except TypeError:
+        return str(value)
+
+
+def _tick_labels(labels: list[str], width: int = 22) -> list[str]:
+    """Labels cut to ``width`` characters; a cut one is numbered (``"2: [[0.1, ...…"``)
+    so that the ticks stay distinct."""
+    return [lab if len(lab) <= width else f"{k + 1}: {lab[:width - 4]}…"
+            for k, lab in enumerate(labels)]
+
+
+def _positions(values, labels: list[str] | None) -> np.ndarray:
+    if labels is None:
+        return _numeric(values)
+    index = {lab: k for k, lab in enumerate(labels)}
+    return np.array([np.nan if v is None else float(index[_label(v)]) for v in values])
+
+
 def plot_sweep(rows: Sequence[Mapping[str, Any]], parameters: Sequence[str],
                outputs: Sequence[str]):
     """Summary figure: every numeric output against every swept parameter.
 
     Successful points are dots; failed points are red crosses on the lower edge of each
-    panel (their outputs are missing).
+    panel (their outputs are missing).  A parameter with values that are not numbers
+    (list-valued such as ``rom.orders`` or ``sensors.rows``, strings such as ``rom.nf =
+    "auto"``) gets a categorical axis: one tick per distinct value, labelled with it.
+
+    Parameters
+    ----------
+    rows : sequence of mapping
+        The table of :func:`sweep_table`.
+    parameters : sequence of str
+        The swept parameters (columns of the panels).
+    outputs : sequence of str
+        The outputs (rows of the panels); those with no finite number are left out.
 
     Returns
     -------
@@ -113,19 +165,27 @@ def plot_sweep(rows: Sequence[Mapping[str, Any]], parameters: Sequence[str],
                              figsize=(3.2 * len(params) + 0.6, 2.4 * len(outs) + 0.6))
     failed = [r for r in rows if r.get("status") != "ok"]
     ok = [r for r in rows if r.get("status") == "ok"]
+    cats = {p: _categories([r.get(p) for r in rows]) for p in params}
     for i, o in enumerate(outs):
         y = _numeric([r.get(o) for r in ok])
         for j, p in enumerate(params):
             ax = axes[i, j]
-            x = _numeric([r.get(p) for r in ok])
+            x = _positions([r.get(p) for r in ok], cats[p])
             ax.plot(x, y, "o", ms=3.5, alpha=0.8)
             if failed:
-                xf = _numeric([r.get(p) for r in failed])
+                xf = _positions([r.get(p) for r in failed], cats[p])
                 ylo = np.nanmin(y) if np.isfinite(y).any() else 0.0
                 ax.plot(xf, np.full(xf.size, ylo), "x", color="tab:red", ms=6,
                         label=f"failed ({len(failed)})")
                 if i == 0 and j == 0:
                     ax.legend(fontsize="small")
+            if cats[p] is not None:
+                labels = _tick_labels(cats[p])
+                ax.set_xticks(np.arange(len(labels)))
+                long = max(len(lab) for lab in labels) > 8
+                ax.set_xticklabels(labels, rotation=30 if long else 0,
+                                   ha="right" if long else "center", fontsize="small")
+                ax.set_xlim(-0.5, len(labels) - 0.5)
             if i == len(outs) - 1:
                 ax.set_xlabel(p)
             if j == 0:
