@@ -19,12 +19,14 @@ from ._rom_flutter import (ParametricROM, RomFlutterResult, RomSettings,  # noqa
                            structure_of, truth_flutter)
 
 from ._run import RunResult, run_pipeline  # noqa: F401
+from ._suppression import sensor_rows_of  # noqa: F401
 from ._flutter_check import (FlutterCheckResult, FlutterCheckSettings,  # noqa: F401
                              SimulationCheck, TruthLoopSweep, flutter_check,
                              flutter_check_settings, truth_loop_matrix)
 
 __all__ = [
     "RunConfig", "load_config", "default_config_path", "RunResult", "run_pipeline",
+    "sensor_rows_of",
     "chirp_motion", "backward_derivatives", "truth_records", "RomIdentification",
     "identify_common_denominator",
     "RomSettings", "rom_settings", "structure_of", "truth_flutter", "frozen_aero_truth",

@@ -46,7 +46,7 @@ PIPELINE_SETTINGS = {
 #: stages of :func:`casflutter.pipeline.run_pipeline` besides ``time_total``).
 PIPELINE_OUTPUTS = (
     "Vf_rom", "freq_hz_rom", "mode_rom", "Vf_truth", "freq_hz_truth", "mode_truth",
-    "lco_V", "lco_kind", "lco_freq_hz", "lco_amplitude", "lco_truth_kind",
+    "lco_V", "lco_kind", "lco_freq_hz", "lco_amplitude", "lco_truth_V", "lco_truth_kind",
     "lco_truth_freq_hz", "lco_truth_amplitude", "controller_order", "gamma",
     "small_gain_V_lo", "small_gain_V_hi", "stable_V_lo", "stable_V_hi", "closed_loop_stable",
     "synthesis_success", "synthesis_status", "attenuation_percent", "lco_returns",
@@ -141,7 +141,8 @@ def flatten_summary(summary: Mapping[str, Any]) -> dict[str, Any]:
         "Vf_rom": fl["V"], "freq_hz_rom": fl["freq_hz"], "mode_rom": fl["mode"],
         "Vf_truth": ft["V"], "freq_hz_truth": ft["freq_hz"], "mode_truth": ft["mode"],
         "lco_V": lco["V"], "lco_kind": lco["kind"], "lco_freq_hz": lco["freq_hz"],
-        "lco_amplitude": max(amp) if amp else None, "lco_truth_kind": lco.get("truth_kind"),
+        "lco_amplitude": max(amp) if amp else None, "lco_truth_V": lco.get("truth_V"),
+        "lco_truth_kind": lco.get("truth_kind"),
         "lco_truth_freq_hz": lco.get("truth_freq_hz"),
         "lco_truth_amplitude": max(tamp) if tamp else None,
         "controller_order": ctl["order"], "gamma": ctl["gamma"],
