@@ -94,6 +94,21 @@ def test_seed_determinism():
         np.testing.assert_array_equal(M1, M2)
 
 
+def test_zero_start_option_and_iteration_budget():
+    # without a time limit the budget is counted in iterations: a tighter cap is visible
+    # in the Ipopt statuses, and zero_start=False makes every start a seeded random one
+    P, nmeas, ncon, _ = load_compleib(COMPLEIB / "AC4.json")
+    opts = SynthesisOptions(max_outer=3, max_iter=2, zero_start=False, polish_rank=0)
+    r = synthesize(P, nmeas, ncon, 1, starts=2, seed=7, options=opts)
+    assert [s.kind for s in r.starts] == ["random", "random"]
+    statuses = [st for s in r.starts for st in s.statuses]
+    assert "Maximum_Iterations_Exceeded" in statuses
+    assert "Maximum_WallTime_Exceeded" not in statuses
+    r0 = synthesize(P, nmeas, ncon, 1, starts=2, seed=7,
+                    options=SynthesisOptions(max_outer=3, max_iter=2, polish_rank=0))
+    assert [s.kind for s in r0.starts] == ["zero", "random"]
+
+
 # --------------------------------------------------------------------------- COMPleib
 
 
@@ -160,6 +175,8 @@ def test_invalid_inputs_are_named():
         synthesize(P, 1, 1, -1)
     with pytest.raises(ConfigError, match="tol"):
         SynthesisOptions(tol=2.0)
+    with pytest.raises(ConfigError, match="max_iter"):
+        SynthesisOptions(max_iter=0)
     with pytest.raises(DimensionError, match="nmeas"):
         synthesize(P, 3, 1, 0)
     Pd = control.ss(P.A, P.B, P.C, [[0.0, 0.0], [0.0, 1.0], [0.0, 0.5]])   # D22 != 0
