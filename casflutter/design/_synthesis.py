@@ -91,8 +91,8 @@ class SynthesisOptions:
         bad = [k for k, ok in checks.items() if not ok]
         if bad:
             raise ConfigError(f"invalid SynthesisOptions field(s) {bad}: need nslots>=2, "
-                              "max_outer>=1, max_iter>=1, 0<tol<1, max_stab_rounds>=1, stability_margin>0, "
-                              "trust_region>0, rank in 1..3, polish_rank in 0..3, 0<polish_tol<1, "
+                              "max_outer>=1, max_iter>=1, 0<tol<1, max_stab_rounds>=1, "
+                              "stability_margin>0, trust_region>0, rank in 1..3, polish_rank in 0..3, 0<polish_tol<1, "
                               "time_limit None or >0")
 
 
