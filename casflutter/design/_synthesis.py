@@ -92,8 +92,8 @@ class SynthesisOptions:
         if bad:
             raise ConfigError(f"invalid SynthesisOptions field(s) {bad}: need nslots>=2, "
                               "max_outer>=1, max_iter>=1, 0<tol<1, max_stab_rounds>=1, "
-                              "stability_margin>0, trust_region>0, rank in 1..3, polish_rank in 0..3, 0<polish_tol<1, "
-                              "time_limit None or >0")
+                              "stability_margin>0, trust_region>0, rank in 1..3, "
+                              "polish_rank in 0..3, 0<polish_tol<1, time_limit None or >0")
 
 
 @dataclass(frozen=True)
