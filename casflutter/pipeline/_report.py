@@ -36,7 +36,8 @@ def write_figures(out: Path, objects: dict, cfg) -> dict:
     files["fig8_flap_pulses"] = _save(plot_flap_pulses(fp["timepts"], fp["truth_zm"],
                                                        fp["rom_zm"], fp["v"]),
                                       out / "fig8_flap_pulses.png")
-    files["fig9_lco"] = _save(plot_lco(objects["lco"], truth=objects.get("lco_truth")), out / "fig9_lco.png")
+    files["fig9_lco"] = _save(plot_lco(objects["lco"], truth=objects.get("lco_truth")),
+                              out / "fig9_lco.png")
     fl = objects["flutter"]
     files["vg_vf"] = _save(plot_vg_vf(fl), out / "vg_vf.png")
     vr = cfg.flutter.vrange
