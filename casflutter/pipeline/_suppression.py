@@ -77,8 +77,9 @@ def truth_lco(truth, V: float, duration: float, mode: int, deflection: float, *,
     """The truth's own response at V from a deflected ``mode`` (its LCO, if any), read by
     the accelerometers ``sensor_rows`` (default: the truth's own, :func:`sensor_rows_of`).
 
-    Just above the Hopf point an LCO grows slowly: while the last ``duration`` seconds are
-    still classified as growing, the simulation is continued from its final state (at most
+    Just above the Hopf point an LCO grows slowly: while the modal displacements of the last
+    ``duration`` seconds are still classified as growing (a test that does not depend on
+    the sensors), the simulation is continued from its final state (at most
     ``max_extensions`` times); the returned history is the last ``duration`` seconds and
     ``t_start`` says where it begins."""
     t = np.arange(0.0, duration, dt)
@@ -88,12 +89,12 @@ def truth_lco(truth, V: float, duration: float, mode: int, deflection: float, *,
     t_start = 0.0
     for k in range(max_extensions + 1):
         sim = truth.simulate(t, x0, V)
-        zm = _sensors(sim, rows)
-        an = analyze_response(t, zm)
-        if an.kind != "divergence" or not np.all(np.isfinite(sim.states[-1])) \
-                or k == max_extensions:
+        growing = analyze_response(t, sim.u).kind == "divergence"
+        if not growing or not np.all(np.isfinite(sim.states[-1])) or k == max_extensions:
             break
         x0, t_start = sim.states[-1], t_start + t[-1]
+    zm = _sensors(sim, rows)
+    an = analyze_response(t, zm)
     return {"kind": an.kind, "freq_hz": float(an.frequency_hz),
             "amplitude": [float(a) for a in an.amplitude], "timepts": t, "zm": zm,
             "analysis": an, "t_start": t_start}
