@@ -319,15 +319,24 @@ class AeroelasticTruth(abc.ABC):
         Phi = self._Phi
         x, xd, xdd = u @ Phi.T, udot @ Phi.T, uddot @ Phi.T
         am = self.aero_matrices(V)
+        geff = self._lagged_circulation(am, dt, x, xd, xdd, v, vdot, vddot)
+        f = (x @ am.Kx.T + xd @ am.Cx.T + xdd @ am.Mx.T + np.outer(v, am.Fv)
+             + np.outer(vdot, am.Fv1) + np.outer(vddot, am.Fv2) + geff @ am.W.T)
+        return (f @ Phi) / (self.alpha * V * V)
+
+    @staticmethod
+    def _lagged_circulation(am: AeroMatrices, dt: float, x, xd, xdd, v, vdot,
+                            vddot) -> np.ndarray:
+        """Effective circulatory downwash per strip with Jones's two-lag Wagner function:
+        the quasi-steady ``g`` (from the strip motion ``x, x', x''`` and the flap) filtered
+        by the lag states ``z`` integrated exactly along the prescribed motion."""
         g = x @ am.Gx.T + xd @ am.Gx1.T + np.outer(v, am.Gv) + np.outer(vdot, am.Gv1)
         gd = xd @ am.Gx.T + xdd @ am.Gx1.T + np.outer(vdot, am.Gv) + np.outer(vddot, am.Gv1)
         zs = integrate_lags(g, gd, dt, am.lams)
         geff = (1.0 - sum(JONES_A)) * g
         for A, lam, z in zip(JONES_A, am.lams, zs):
             geff = geff + A * lam * z
-        f = (x @ am.Kx.T + xd @ am.Cx.T + xdd @ am.Mx.T + np.outer(v, am.Fv)
-             + np.outer(vdot, am.Fv1) + np.outer(vddot, am.Fv2) + geff @ am.W.T)
-        return (f @ Phi) / (self.alpha * V * V)
+        return geff
 
     # ---- coupled linear system -------------------------------------------------------
     def _coupled(self, V: float) -> dict:

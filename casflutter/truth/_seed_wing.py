@@ -96,7 +96,7 @@ from scipy.integrate import solve_ivp
 from scipy.interpolate import make_interp_spline
 
 from ..errors import DataError, DimensionError
-from ._aero import JONES_A, JONES_B, integrate_lags, strip_coefficients
+from ._aero import JONES_A, JONES_B, strip_coefficients
 from ._base import AeroelasticTruth, AeroMatrices, SimulationResult, _as_1d
 from ._goland import _bending_shapes
 from ._params import ParamsMixin, require
@@ -354,12 +354,7 @@ class SeedWing(AeroelasticTruth):
         t, dt, u, v, udot, uddot, vdot, vddot = self._prescribed_motion(
             timepts, u, v, udot, uddot, vdot, vddot)
         am = self.aero_matrices(V)
-        g = u @ am.Gx.T + udot @ am.Gx1.T + np.outer(v, am.Gv) + np.outer(vdot, am.Gv1)
-        gd = udot @ am.Gx.T + uddot @ am.Gx1.T + np.outer(vdot, am.Gv) + np.outer(vddot, am.Gv1)
-        zs = integrate_lags(g, gd, dt, am.lams)
-        geff = (1.0 - sum(JONES_A)) * g
-        for A, lam, z in zip(JONES_A, am.lams, zs):
-            geff = geff + A * lam * z
+        geff = self._lagged_circulation(am, dt, u, udot, uddot, v, vdot, vddot)
         gsat, qx = self._nonlinear_circulation(geff, self.airspeed(V))
         f = (udot @ am.Cx.T + uddot @ am.Mx.T + np.outer(v, am.Fv) + np.outer(vdot, am.Fv1)
              + np.outer(vddot, am.Fv2) + gsat @ am.W.T + qx)
