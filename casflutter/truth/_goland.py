@@ -36,7 +36,7 @@ from scipy.optimize import brentq
 
 from ._aero import JONES_B, strip_coefficients
 from ._base import AeroelasticTruth, AeroMatrices
-from ._params import ParamsMixin, require
+from ._params import ChordGeometryMixin, ParamsMixin, require
 
 __all__ = ["GolandParams", "GolandWing", "clamped_free_roots"]
 
@@ -48,7 +48,7 @@ def _p(default, unit, doc):
 
 
 @dataclass(frozen=True)
-class GolandParams(ParamsMixin):
+class GolandParams(ChordGeometryMixin, ParamsMixin):
     """Goland-wing parameters; defaults are the published wing at sea-level density."""
 
     semispan: float = _p(6.096, "m", "semispan L (20 ft)")
@@ -82,16 +82,6 @@ class GolandParams(ParamsMixin):
         require(0 < self.flap_chord < 1, f"flap_chord = {self.flap_chord} must lie in (0, 1)")
         require(0 <= self.flap_span_start < 1,
                 f"flap_span_start = {self.flap_span_start} must lie in [0, 1)")
-
-    @property
-    def b(self) -> float:
-        """Semichord [m]."""
-        return 0.5 * self.chord
-
-    @property
-    def a(self) -> float:
-        """Elastic axis in semichords aft of mid-chord."""
-        return 2.0 * self.ea_chord - 1.0
 
     @property
     def x_cg(self) -> float:

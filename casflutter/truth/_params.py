@@ -7,7 +7,7 @@ from typing import Any, Iterable
 
 from ..errors import ConfigError
 
-__all__ = ["ParamsMixin"]
+__all__ = ["ParamsMixin", "ChordGeometryMixin"]
 
 
 class ParamsMixin:
@@ -102,3 +102,18 @@ def require(cond: bool, message: str) -> None:
     """Raise :class:`ConfigError` with ``message`` unless ``cond``."""
     if not cond:
         raise ConfigError(message)
+
+
+class ChordGeometryMixin:
+    """Section geometry of wing parameter sets with fields ``chord`` [m] and ``ea_chord``
+    (elastic axis as a fraction of the chord from the leading edge)."""
+
+    @property
+    def b(self) -> float:
+        """Semichord [m]."""
+        return 0.5 * self.chord
+
+    @property
+    def a(self) -> float:
+        """Elastic axis in semichords aft of mid-chord."""
+        return 2.0 * self.ea_chord - 1.0

@@ -99,7 +99,7 @@ from ..errors import DataError, DimensionError
 from ._aero import JONES_A, JONES_B, strip_coefficients
 from ._base import AeroelasticTruth, AeroMatrices, SimulationResult, _as_1d
 from ._goland import _bending_shapes
-from ._params import ParamsMixin, require
+from ._params import ChordGeometryMixin, ParamsMixin, require
 
 __all__ = ["SeedWingParams", "SeedWing", "SEED_FREQUENCIES_HZ", "SEED_SENSOR_ROWS",
            "SEED_MODE_NAMES", "SEED_U_REF"]
@@ -122,7 +122,7 @@ def _p(default, unit, doc):
 
 
 @dataclass(frozen=True)
-class SeedWingParams(ParamsMixin):
+class SeedWingParams(ChordGeometryMixin, ParamsMixin):
     """Seed-wing parameters.
 
     Geometry and air are plausible values for a low-speed wind-tunnel wing (the paper does
@@ -174,16 +174,6 @@ class SeedWingParams(ParamsMixin):
                 f"need 0 <= flap_span_start ({self.flap_span_start}) < flap_span_end "
                 f"({self.flap_span_end}) <= 1")
         require(2 <= self.n_strips <= 100, f"n_strips = {self.n_strips} must be in 2..100")
-
-    @property
-    def b(self) -> float:
-        """Semichord [m]."""
-        return 0.5 * self.chord
-
-    @property
-    def a(self) -> float:
-        """Elastic axis in semichords aft of mid-chord."""
-        return 2.0 * self.ea_chord - 1.0
 
 
 class SeedWing(AeroelasticTruth):
