@@ -1,4 +1,5 @@
-"""Where the package finds its problem definitions (``problems/``).
+"""Where the package finds its problem definitions (``problems/``), and how it reads the
+TOML files of problems, run configurations and studies.
 
 In a source checkout and in an installed wheel alike, the problem definitions are reached
 through ``casflutter/_problems`` (a link to the repository's ``problems/`` folder, copied into
@@ -7,9 +8,12 @@ the wheel as package data), so an installed package runs its default problems.
 
 from __future__ import annotations
 
+import tomllib
 from pathlib import Path
 
-__all__ = ["problems_dir"]
+from .errors import ConfigError
+
+__all__ = ["problems_dir", "read_toml"]
 
 
 def problems_dir() -> Path:
@@ -22,3 +26,22 @@ def problems_dir() -> Path:
     if source.is_dir():
         return source
     raise FileNotFoundError("casflutter's problem definitions are missing: reinstall the package")
+
+
+def read_toml(path, what: str = "file") -> dict:
+    """The tables of the TOML file ``path``.
+
+    Raises
+    ------
+    ConfigError
+        If the file does not exist or is not valid TOML; ``what`` names it in the message
+        (``"study file"``, ``"configuration file"`` ...).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"{what} {path} not found: the file does not exist")
+    try:
+        with open(path, "rb") as fh:
+            return tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{what} {path} is not valid TOML ({exc})") from None

@@ -8,12 +8,11 @@ that names the key and what is allowed.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import asdict, dataclass, field, fields, is_dataclass
 from pathlib import Path
 from typing import Any, get_origin, get_type_hints
 
-from .._resources import problems_dir
+from .._resources import problems_dir, read_toml
 from ..errors import ConfigError
 
 __all__ = ["RunConfig", "load_config", "default_config_path", "check_sensor_rows"]
@@ -389,13 +388,7 @@ def load_config(path=None, *, updates=None, **overrides) -> RunConfig:
         Replace top-level fields (e.g. ``seed=3``).
     """
     path = Path(path) if path is not None else default_config_path()
-    if not path.exists():
-        raise ConfigError(f"configuration file {path} does not exist")
-    try:
-        with open(path, "rb") as fh:
-            table = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML ({exc})") from None
+    table = read_toml(path, "configuration file")
     table.update({k: v for k, v in overrides.items() if v is not None})
     for key, value in (updates or {}).items():
         _apply_update(table, key, value)

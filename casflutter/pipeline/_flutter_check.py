@@ -50,7 +50,6 @@ larger γ (25.5 against 8.56 on a two-plant set).
 from __future__ import annotations
 
 import time
-import tomllib
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
@@ -60,6 +59,7 @@ from scipy.optimize import brentq
 
 from ..aeroelastic import (AeroelasticLFT, AeroelasticSystem, FlutterResult, build_lft,
                            envelope_growth_rate, find_flutter, simulate_loop)
+from .._resources import read_toml
 from ..errors import CasflutterError, ConfigError
 from ._rom_data import RomIdentification, identify_common_denominator, truth_records
 from ._rom_flutter import RomSettings, rom_settings, rom_system, structure_of, truth_flutter
@@ -174,8 +174,7 @@ def flutter_check_settings(problem: str = "typical_section", path=None,
         except FileNotFoundError:
             path = None
     if path is not None and Path(path).is_file():
-        with open(path, "rb") as fh:
-            values.update(tomllib.load(fh).get("flutter_check", {}))
+        values.update(read_toml(path, "flutter-check settings").get("flutter_check", {}))
     values.update(overrides)
     valid = [f.name for f in fields(FlutterCheckSettings)]
     unknown = [k for k in values if k not in valid]

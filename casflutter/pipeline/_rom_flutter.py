@@ -36,7 +36,6 @@ transform; ΣAE(V) then has continuous eigenvalues and eigenvectors and
 from __future__ import annotations
 
 import time
-import tomllib
 import warnings
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
@@ -45,6 +44,7 @@ import numpy as np
 from scipy.interpolate import BarycentricInterpolator
 
 from ..aeroelastic import AeroelasticSystem, FlutterResult, ModalStructure, find_flutter
+from .._resources import read_toml
 from ..errors import ConfigError, DimensionError
 from ..ident import HWLModel
 from ..realize import canonical_realization, lag_coefficients, realize, tustin_to_continuous
@@ -162,8 +162,7 @@ def rom_settings(problem: str, problems_dir=None, **overrides) -> RomSettings:
             problems_dir = Path(".")
     path = Path(problems_dir) / problem / "problem.toml"
     if path.is_file():
-        with open(path, "rb") as fh:
-            values.update(tomllib.load(fh).get("rom", {}))
+        values.update(read_toml(path, "problem definition").get("rom", {}))
     values.update(overrides)
     unknown = [k for k in values if k not in valid]
     if unknown:

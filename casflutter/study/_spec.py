@@ -28,13 +28,13 @@ import hashlib
 import itertools
 import json
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 
+from .._resources import read_toml
 from ..errors import ConfigError
 
 __all__ = ["Parameter", "Study", "load_study", "point_key"]
@@ -291,12 +291,6 @@ def load_study(path: str | Path) -> Study:
         Missing file, malformed TOML or an invalid entry (the message names it).
     """
     path = Path(path)
-    if not path.is_file():
-        raise ConfigError(f"study file {path} not found")
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"study file {path} is not valid TOML: {exc}") from None
+    data = read_toml(path, "study file")
     return Study.from_dict(data, name=path.stem, base_dir=path.resolve().parent)
 

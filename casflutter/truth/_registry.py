@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 
+from .._resources import read_toml
 from ..errors import ConfigError
 from ._base import AeroelasticTruth
 from ._goland import GolandWing
@@ -71,5 +71,4 @@ def problem_definition(name: str, problems_dir: str | Path | None = None) -> dic
     if not path.is_file():
         raise ConfigError(f"problem definition {path} not found; pass problems_dir= pointing "
                           "at the repository's problems/ folder")
-    with open(path, "rb") as fh:
-        return tomllib.load(fh)
+    return read_toml(path, "problem definition")

@@ -33,7 +33,6 @@ synthesis is differentiated (:func:`casflutter.study.gamma_sensitivity`)::
 from __future__ import annotations
 
 import json
-import tomllib
 from pathlib import Path
 
 __all__ = ["register", "run"]
@@ -63,15 +62,12 @@ def register(subparsers) -> None:
 
 
 def _config(args) -> tuple[dict, dict]:
+    from ..._resources import read_toml
     from ...errors import ConfigError
 
     cfg: dict = {}
     if args.config:
-        path = Path(args.config)
-        if not path.is_file():
-            raise ConfigError(f"config file {path} not found")
-        with open(path, "rb") as fh:
-            cfg = tomllib.load(fh)
+        cfg = read_toml(args.config, "config file")
         bad = set(cfg) - {"sensitivity", "params", "gamma"}
         if bad:
             raise ConfigError(f"unknown table(s) {sorted(bad)}; allowed: [sensitivity] or "
@@ -150,11 +146,11 @@ def _gamma(cfg: dict, args) -> int:
 
 def run(args) -> int:
     """Handler: print the ranked table (and the finite-difference check)."""
+    from ..._resources import read_toml
     from ...study import flutter_sensitivity, flutter_sensitivity_nlp, flutter_speed_fd
 
     if args.config:
-        with open(args.config, "rb") as fh:
-            raw = tomllib.load(fh)
+        raw = read_toml(args.config, "config file")
         if "gamma" in raw:
             _config(args)  # validates the tables
             return _gamma(raw, args)
