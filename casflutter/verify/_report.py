@@ -128,7 +128,7 @@ class VerificationReport:
                  f"  nominal closed loop: {'STABLE' if self.stable else 'UNSTABLE'}, "
                  f"spectral abscissa {f(self.spectral_abscissa)}"]
         shown = self.poles[:max_poles]
-        lines.append(f"  rightmost poles: " + ", ".join(
+        lines.append("  rightmost poles: " + ", ".join(
             f"{p.real:.4g}{p.imag:+.4g}j" for p in shown)
             + (" ..." if len(self.poles) > max_poles else ""))
         h = self.hinf
