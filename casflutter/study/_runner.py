@@ -237,11 +237,30 @@ def default_store_path(study: Study, out_dir: str | Path | None = None) -> Path:
     return Path(out_dir if out_dir is not None else "sweeps") / f"{study.name}.jsonl"
 
 
-def _dead_worker_record(key: str, params: Mapping[str, Any], err: BaseException) -> dict:
+def _failed_record(key: str, params: Mapping[str, Any], error: str) -> dict:
+    """The record of a point whose evaluation never returned (the worker was lost)."""
     return {"key": key, "params": dict(params), "status": "failed", "outputs": {},
-            "error": f"worker process died while computing this point ({type(err).__name__}: "
-                     f"{err}); it died again when retried alone",
-            "work_time": None, "worker": None, "started": None, "finished": time.time()}
+            "error": error, "work_time": None, "worker": None, "started": None,
+            "finished": time.time()}
+
+
+def _dead_worker_record(key: str, params: Mapping[str, Any], err: BaseException) -> dict:
+    return _failed_record(key, params,
+                          f"worker process died while computing this point "
+                          f"({type(err).__name__}: {err}); it died again when retried alone")
+
+
+def _finish(rec: dict, store, progress, state: dict, max_points: int | None) -> bool:
+    """Store a finished point, show it, count its work; True when ``max_points`` points
+    have been computed in this call (the sweep then stops as if interrupted)."""
+    store.append(rec)
+    progress.update(rec)
+    state["work"] += rec.get("work_time") or 0.0
+    state["computed"] += 1
+    if max_points is not None and state["computed"] >= max_points:
+        state["interrupted"] = True
+        return True
+    return False
 
 
 def _run_local(study, todo, store, progress, workers, max_points, state) -> None:
@@ -268,13 +287,8 @@ def _run_local(study, todo, store, progress, workers, max_points, state) -> None
                 except BrokenProcessPool:
                     broken = True
                     continue
-                store.append(rec)
                 remaining.pop(k)
-                progress.update(rec)
-                state["work"] += rec["work_time"] or 0.0
-                state["computed"] += 1
-                if max_points is not None and state["computed"] >= max_points:
-                    state["interrupted"] = True
+                if _finish(rec, store, progress, state, max_points):
                     for f in futs:
                         f.cancel()
                     break
@@ -315,13 +329,8 @@ def _run_one_by_one(study, remaining, store, progress, settings, ctx, max_points
                 rec = _dead_worker_record(k, p, exc)
                 ex.shutdown(wait=True)
                 ex = None
-            store.append(rec)
             remaining.pop(k)
-            progress.update(rec)
-            state["work"] += rec.get("work_time") or 0.0
-            state["computed"] += 1
-            if max_points is not None and state["computed"] >= max_points:
-                state["interrupted"] = True
+            if _finish(rec, store, progress, state, max_points):
                 return
     finally:
         if ex is not None:
@@ -354,15 +363,8 @@ def _run_dask(study, todo, store, progress, scheduler, max_points, state) -> Non
                 try:
                     rec = fut.result()
                 except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker after retries
-                    rec = {"key": k, "params": dict(p), "status": "failed", "outputs": {},
-                           "error": f"{type(exc).__name__}: {exc}", "work_time": None,
-                           "worker": None, "started": None, "finished": time.time()}
-                store.append(rec)
-                progress.update(rec)
-                state["work"] += rec.get("work_time") or 0.0
-                state["computed"] += 1
-                if max_points is not None and state["computed"] >= max_points:
-                    state["interrupted"] = True
+                    rec = _failed_record(k, p, f"{type(exc).__name__}: {exc}")
+                if _finish(rec, store, progress, state, max_points):
                     client.cancel(list(futs))
                     break
         except KeyboardInterrupt:
@@ -453,12 +455,7 @@ def run_sweep(study: Study, *, store: str | Path | None = None, workers: int | N
             t0 = time.perf_counter()
             for k, p in todo.items():
                 rec = evaluate_point(study.evaluator, p, settings, k)
-                pstore.append(rec)
-                prog.update(rec)
-                state["work"] += rec["work_time"]
-                state["computed"] += 1
-                if max_points is not None and state["computed"] >= max_points:
-                    state["interrupted"] = True
+                if _finish(rec, pstore, prog, state, max_points):
                     break
             state["wall"] = time.perf_counter() - t0
         else:
