@@ -152,6 +152,9 @@ def page_problems(page: Path, root: Path) -> list[str]:
 def check_site(root: Path | str) -> list[str]:
     """The problems of every HTML page under ``root`` (see the module docstring).
 
+    A file loaded from another host by many pages (a theme or extension setting) is reported
+    once, with the number of pages.
+
     Parameters
     ----------
     root : Path or str
@@ -163,10 +166,22 @@ def check_site(root: Path | str) -> list[str]:
         One message per problem, page by page; empty when the site is fine.
     """
     root = Path(root)
-    problems = []
+    problems: list[str] = []
+    external: dict[str, list[str]] = {}       # message without the page name -> pages
     for page in sorted(root.rglob("*.html")):
         if any(part.startswith(".") or part in _NOT_PAGES for part in
                page.relative_to(root).parts[:-1]):
             continue
-        problems.extend(page_problems(page, root))
+        for problem in page_problems(page, root):
+            name, _, what = problem.partition(": ")
+            if what.startswith("loads ") and "from another host" in what:
+                if what not in external:
+                    problems.append(problem)
+                external.setdefault(what, []).append(name)
+            else:
+                problems.append(problem)
+    for what, pages in external.items():
+        if len(pages) > 1:
+            i = problems.index(f"{pages[0]}: {what}")
+            problems[i] = f"{pages[0]} and {len(pages) - 1} more pages: {what}"
     return problems

@@ -19,10 +19,10 @@ on the seed wing (the paper's wind-tunnel wing with tip store: five modes at 2.1
 The example runs the default configuration ``problems/seed_wing/run.toml`` exactly as
 ``make demo`` does (about 70 s, most of it the synthesis), also in the documentation build:
 a shorter run changes the identified ROM slightly, and the nonconvex synthesis can then end
-in another local optimum (with 4-s instead of 8-s chirp records it ends at γ ≈ 81, and that
-controller does not suppress the truth's LCO), so a reduced run would not show what the
-study does.  The numbers printed below are those of this run; the files are written to a
-temporary folder.
+in another local optimum with another controller, so a reduced run would not show what the
+study does.  The numbers printed below are those of this run, of the version of casflutter
+this page was built with (other pages point here rather than repeat them); the files are
+written to a temporary folder.
 """
 
 import tempfile
