@@ -33,6 +33,36 @@ def _tf(A, B, C, D, omega: np.ndarray) -> np.ndarray:
     return C[None] @ X + D[None]
 
 
+class _Evaluator:
+    """σ_max(T(jω)) of one system at many frequencies.
+
+    With a well-conditioned eigenvector matrix ``A = V Λ V⁻¹`` each frequency costs
+    ``O(n (m + p))`` (``T = (CV) diag(1/(jω − λ)) (V⁻¹B) + D``); otherwise one LU solve per
+    frequency.  The modal form is used only to *locate* peaks; values that decide anything
+    are recomputed by :func:`sigma_max` (solves)."""
+
+    def __init__(self, A, B, C, D):
+        self.sys = (A, B, C, D)
+        self.modal = None
+        n = A.shape[0]
+        if n:
+            try:
+                lam, V = np.linalg.eig(A)
+                if np.linalg.cond(V) < 1e6:
+                    self.modal = (lam, C @ V, np.linalg.solve(V, B))
+            except np.linalg.LinAlgError:
+                self.modal = None
+
+    def __call__(self, omega) -> np.ndarray:
+        omega = np.atleast_1d(np.asarray(omega, dtype=float))
+        if self.modal is None:
+            return sigma_max(*self.sys, omega)
+        lam, CV, VB = self.modal
+        D = self.sys[3]
+        T = np.einsum("ik,wk,kj->wij", CV, 1.0 / (1j * omega[:, None] - lam[None, :]), VB) + D
+        return np.linalg.svd(T, compute_uv=False)[:, 0]
+
+
 def sigma_max(A, B, C, D, omega) -> np.ndarray:
     """Largest singular value of ``T(jω)`` at each ω (``inf`` where ``jωI − A`` is singular)."""
     omega = np.atleast_1d(np.asarray(omega, dtype=float))
@@ -46,6 +76,18 @@ def sigma_max(A, B, C, D, omega) -> np.ndarray:
             except np.linalg.LinAlgError:
                 out[i] = np.inf
         return out
+
+
+def _hamiltonian(A, B, C, D, g: float) -> np.ndarray:
+    """Hamiltonian ``H(g)`` (Bruinsma & Steinbuch) for ``g > σ_max(D)``."""
+    m, p = B.shape[1], C.shape[0]
+    R = D.T @ D - g * g * np.eye(m)
+    S = D @ D.T - g * g * np.eye(p)
+    RiDt = np.linalg.solve(R, D.T)
+    RiBt = np.linalg.solve(R, B.T)
+    H11 = A - B @ RiDt @ C
+    return np.block([[H11, -g * B @ RiBt], [g * C.T @ np.linalg.solve(S, C),
+                                             -A.T + C.T @ D @ RiBt]])
 
 
 def _level_pencil(A, B, C, D, g: float) -> tuple[np.ndarray, np.ndarray]:
@@ -72,11 +114,15 @@ def level_crossings(A, B, C, D, level: float, im_tol: float = 1e-2) -> np.ndarra
     The test for "imaginary" is loose on purpose (``|Re λ| <= im_tol |λ|``): a spurious
     frequency only costs one more evaluation of σ_max in the callers, whereas a crossing
     missed through rounding would end the level iteration below the norm."""
-    M, N = _level_pencil(A, B, C, D, level)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ev = sla.eigvals(M, N)
-    big = 1e8 * max(1.0, float(np.max(np.abs(M))))
-    ev = ev[np.isfinite(ev) & (np.abs(ev) < big)]
+    sD = float(np.linalg.norm(D, 2)) if D.size else 0.0
+    if level > 1.05 * sD:
+        ev = np.linalg.eigvals(_hamiltonian(A, B, C, D, level))
+    else:   # close to σ_max(D) the Hamiltonian is ill-conditioned: use the pencil
+        M, N = _level_pencil(A, B, C, D, level)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ev = sla.eigvals(M, N)
+        big = 1e8 * max(1.0, float(np.max(np.abs(M))))
+        ev = ev[np.isfinite(ev) & (np.abs(ev) < big)]
     scale = max(1.0, float(np.max(np.abs(ev), initial=0.0)))
     imag = ev[np.abs(ev.real) <= im_tol * np.maximum(np.abs(ev), 1e-6 * scale)]
     w = np.abs(imag.imag)
@@ -116,9 +162,10 @@ def hinf_norm(A, B, C, D, *, tol: float = 1e-9, max_iter: int = 60) -> tuple[flo
     grid = np.geomspace(max(0.1 * lo, 1e-9 * hi, 1e-300), 10.0 * hi, 40) if hi > 0 else []
     cand = np.concatenate([[0.0], np.abs(poles.imag), mags, grid])
     cand = np.unique(cand[np.isfinite(cand)])
-    sv = sigma_max(A, B, C, D, cand)
+    ev_ = _Evaluator(A, B, C, D)
+    sv = ev_(cand)
     i = int(np.argmax(sv))
-    lb, wpk = float(sv[i]), float(cand[i])
+    lb, wpk = float(sigma_max(A, B, C, D, [cand[i]])[0]), float(cand[i])
     if sD >= lb:
         lb, wpk = sD, np.inf
     if lb == 0.0:
@@ -132,8 +179,9 @@ def hinf_norm(A, B, C, D, *, tol: float = 1e-9, max_iter: int = 60) -> tuple[flo
         mids = 0.5 * (edges[:-1] + edges[1:])
         mids = np.concatenate([mids, np.sqrt(edges[:-1] * edges[1:]), w])
         mids = mids[np.isfinite(mids)]
-        sv = sigma_max(A, B, C, D, mids)
+        sv = ev_(mids)
         j = int(np.argmax(sv))
+        sv[j] = sigma_max(A, B, C, D, [mids[j]])[0]
         if not sv[j] > lb * (1.0 + tol):
             break          # crossings found but no higher value between them: converged
         lb, wpk = float(sv[j]), float(mids[j])

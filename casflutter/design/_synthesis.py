@@ -86,6 +86,11 @@ class SynthesisOptions:
     """Optional wall-time budget in seconds for all starts (``None``: none).  With a budget
     the result depends on the machine's speed and load; without one the budget is the
     iteration counts above and the same seed gives the same controller."""
+    abandon_after: int = 40
+    """A start whose γ is still above ``abandon_ratio`` times the best start's after this many
+    H∞ iterations is stopped (deterministic: counted in iterations)."""
+    abandon_ratio: float = 1.5
+    """See ``abandon_after``."""
     ipopt: Mapping[str, Any] = field(default_factory=dict)
     """Extra flat Ipopt options of the QP subproblems."""
 
@@ -96,13 +101,15 @@ class SynthesisOptions:
                   "min_det": 0 < self.min_det < 1, "trust_region": self.trust_region > 0,
                   "max_trust_region": self.max_trust_region >= self.trust_region,
                   "active_ratio": 0 < self.active_ratio < 1,
+                  "abandon_after": self.abandon_after >= 1, "abandon_ratio": self.abandon_ratio > 1,
                   "time_limit": self.time_limit is None or self.time_limit > 0}
         bad = [k for k, ok in checks.items() if not ok]
         if bad:
             raise ConfigError(f"invalid SynthesisOptions field(s) {bad}: need max_outer>=1, "
                               "max_stab_rounds>=1, max_iter>=1, 0<tol<1, stability_margin>0, "
                               "decay>=0, 0<min_det<1, trust_region>0, max_trust_region>="
-                              "trust_region, 0<active_ratio<1, time_limit None or >0")
+                              "trust_region, 0<active_ratio<1, abandon_after>=1, abandon_ratio>1, "
+                              "time_limit None or >0")
 
 
 @dataclass(frozen=True)
@@ -268,6 +275,7 @@ class _Phase:
     margin: float               # decay margin of the H∞ plants in the stabilisation phase
     deadline: float
     statuses: list
+    abandon_above: float = np.inf   # γ of the best start so far times ``abandon_ratio``
 
     def value(self, K: np.ndarray) -> tuple[float, Any]:
         if self.kind == "stab":
@@ -317,6 +325,9 @@ class _Phase:
         cuts_cache = None
         for it in range(1, max_iter + 1):
             if self.done(f) or time.perf_counter() > self.deadline:
+                break
+            if it > opts.abandon_after and f > self.abandon_above:
+                log.info("%s: abandoned at gamma %.6g (another start is far better)", label, f)
                 break
             if cuts_cache is None:
                 cuts_cache = self.cuts(K, f, info, delta, memory)
@@ -390,7 +401,7 @@ class _Phase:
                     cuts_cache = None
                 else:
                     cuts_cache = None
-                log.debug("%s %s it %d: rejected (ratio %.3g), radius %.3g", label, self.kind,
+                log.info("%s %s it %d: rejected (ratio %.3g), radius %.3g", label, self.kind,
                           it, ratio, delta)
                 if delta < 1e-10 * max(1.0, float(np.max(np.abs(K)))):
                     break
@@ -512,7 +523,9 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
         log.info("%s: stabilisation %s after %d iterations (abscissa %.4g rad/s)", label,
                  "reached the decay rates" if ok else "failed", r1["iterations"], a_h)
         if ok:
-            hinf = _Phase(prob, qp, opts, "hinf", margin, deadline, statuses)
+            best_g = min((r.gamma for r in records if r.stabilized), default=np.inf)
+            hinf = _Phase(prob, qp, opts, "hinf", margin, deadline, statuses,
+                          abandon_above=opts.abandon_ratio * best_g)
             r2 = hinf.run(K, label, opts.max_outer)
             K, gam = r2["K"], r2["f"]
             hist, conv, outer, pred = tuple(r2["history"]), r2["converged"], r2["iterations"], \

@@ -81,10 +81,18 @@ class ControllerSection:
     #: nominal speeds of the plant set, as multiples of Vf: the LFT (eq. 14) is built at each
     #: and the worst-case norm is minimised (the multi-speed design); [1.0] is the paper's
     speeds: list = field(default_factory=lambda: [1.0])
-    #: minimax solves per start: the deterministic budget of the synthesis
+    #: speed-index interval [lo, hi] over which the ROM loop ΣAE(V) must stay stable (the
+    #: interval design of casflutter.design.design_flutter_controller); [] for the paper's
+    #: design on the LFT alone
+    interval: list = field(default_factory=list)
+    #: stability constraints spread over the interval
+    n_speeds: int = 40
+    #: decay rate [rad/s] required of ΣAE(V) at those speeds
+    decay: float = 0.05
+    #: continuation steps of the interval's upper end
+    steps: int = 4
+    #: H∞ iterations per start: the deterministic budget of the synthesis
     max_outer: int = 20
-    #: frequency slots per plant in the minimax NLP
-    nslots: int = 8
     #: required closed-loop decay after the stabilisation phase, relative to the plant's
     #: largest eigenvalue modulus (the Tustin realisation has poles near 2/dt: keep it small)
     stability_margin: float = 1e-4
@@ -255,8 +263,16 @@ def _semantic_checks(cfg: RunConfig) -> None:
                           "of Vf")
     if cfg.controller.time_limit < 0:
         raise ConfigError(f"controller.time_limit = {cfg.controller.time_limit}: >= 0 (0: none)")
-    if cfg.controller.nslots < 2 or cfg.controller.max_stab_rounds < 1:
-        raise ConfigError("controller.nslots must be >= 2 and controller.max_stab_rounds >= 1")
+    if cfg.controller.max_stab_rounds < 1:
+        raise ConfigError("controller.max_stab_rounds must be >= 1")
+    iv = cfg.controller.interval
+    if iv and (len(iv) != 2 or not all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                      for x in iv) or not 0 <= iv[0] < iv[1]):
+        raise ConfigError(f"controller.interval = {iv!r}: [] or [lo, hi] speed indices with "
+                          "0 <= lo < hi")
+    if cfg.controller.n_speeds < 2 or cfg.controller.steps < 1 or not cfg.controller.decay >= 0:
+        raise ConfigError("controller.n_speeds must be >= 2, controller.steps >= 1 and "
+                          "controller.decay >= 0")
     if not cfg.controller.stability_margin > 0:
         raise ConfigError(f"controller.stability_margin = {cfg.controller.stability_margin}: "
                           "must be > 0")

@@ -518,7 +518,7 @@ def flutter_check(truth, settings: FlutterCheckSettings | None = None, *,
     t0 = time.perf_counter()
     lft = build_lft(system, Vf)
     plants = [build_lft(system, f * Vf).plant_without_d22() for f in s.speed_factors]
-    opts = SynthesisOptions(max_outer=s.max_outer, nslots=s.nslots, polish_rank=s.polish_rank,
+    opts = SynthesisOptions(max_outer=s.max_outer,
                             stability_margin=s.stability_margin,
                             max_stab_rounds=s.max_stab_rounds, ipopt=dict(s.ipopt))
     syn = synthesize(plants if len(plants) > 1 else plants[0], lft.nmeas, lft.ncon, s.order,

@@ -138,7 +138,7 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
         Write files (summary, figures, report, ROM, controller).
     """
     from ..aeroelastic import AeroelasticSystem, build_lft, find_flutter, simulate_loop
-    from ..design import SynthesisOptions, synthesize
+    from ..design import SynthesisOptions, design_flutter_controller
     from ..ident import identify
     from ..realize import realize
     from ..truth import load_problem
@@ -235,16 +235,17 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
         c = cfg.controller
         opts = SynthesisOptions(time_limit=c.time_limit or None, max_outer=c.max_outer,
                                 max_iter=c.max_iter, zero_start=c.zero_start,
-                                nslots=c.nslots, stability_margin=c.stability_margin,
+                                stability_margin=c.stability_margin,
                                 max_stab_rounds=c.max_stab_rounds,
                                 ipopt=dict(cfg.solver.ipopt))
-        # D22 (accelerometers see the flap) depends on the nominal speed: the multi-speed
-        # design uses each plant's own loop shift and the nominal plant's for the result
-        plants = [lft.plant_without_d22() if f == 1.0 else
-                  build_lft(system, Vf * f).plant_without_d22() for f in c.speeds]
-        syn = synthesize(plants if len(plants) > 1 else plants[0], lft.nmeas, lft.ncon,
-                         c.order, starts=c.starts, seed=cfg.seed, options=opts)
-        K = lft.physical_controller(syn.controller)
+        # γ of the LFT at Vf (eq. 14-16) with ΣAE(V) kept stable over controller.interval;
+        # the controller acts on the physical accelerometers (feed-through closed exactly)
+        design = design_flutter_controller(system, Vf, c.order, speeds=tuple(c.speeds),
+                                           interval=tuple(c.interval), n_speeds=c.n_speeds,
+                                           decay=c.decay, steps=c.steps, starts=c.starts,
+                                           seed=cfg.seed, options=opts)
+        syn, K = design.synthesis, design.controller
+        objects["design"] = design
         objects["synthesis"], objects["controller"] = syn, K
     with prog.stage(9, "verify"):
         ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
