@@ -14,6 +14,7 @@ import importlib
 import pkgutil
 import sys
 
+from .._threads import single_threaded
 from ..errors import CasflutterError
 
 __all__ = ["main", "build_parser"]
@@ -51,7 +52,10 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return 2
     try:
-        return int(args.func(args) or 0)
+        # one BLAS thread: the same seed gives bit-identical numbers however the process was
+        # launched (make demo pins the pools through the environment, a bare shell does not)
+        with single_threaded():
+            return int(args.func(args) or 0)
     except CasflutterError as exc:
         print(f"casflutter: error: {exc}", file=sys.stderr)
         return 1

@@ -21,6 +21,7 @@ state dimension; the optimisation itself only sees values and gradients.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -28,7 +29,7 @@ import control
 import numpy as np
 import scipy.linalg as sla
 
-from ._norm import active_frequencies, hinf_norm
+from ._norm import _refine_peak, active_frequencies, hinf_norm
 from ._plant import Partition, partition, spectral_abscissa
 
 __all__ = ["verify_closed_loop"]
@@ -73,7 +74,8 @@ def _io_scales(parts: Sequence[Partition]) -> tuple[np.ndarray, np.ndarray]:
         return np.ones(nu), np.ones(ny)
     S = np.concatenate(samples, axis=0)
     S = np.where(np.isfinite(S) & (S > 0), S, np.nan)
-    with np.errstate(all="ignore"):
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)      # entries never reached by u
         Mlog = np.log(np.nanmedian(S, axis=0))
     ok = np.isfinite(Mlog)
     if not np.any(ok):
@@ -81,7 +83,8 @@ def _io_scales(parts: Sequence[Partition]) -> tuple[np.ndarray, np.ndarray]:
     Mlog = np.where(ok, Mlog, np.nan)
     lr, lc = np.zeros(ny), np.zeros(nu)
     for _ in range(50):
-        with np.errstate(all="ignore"):
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
             lr = -np.nan_to_num(np.nanmean(Mlog + lc[None, :], axis=1))
             lc = -np.nan_to_num(np.nanmean(Mlog + lr[:, None], axis=0))
     su = np.exp(np.clip(lc, -200, 200))
@@ -107,6 +110,18 @@ class Cut:
     value: float
     grad: np.ndarray
     key: tuple
+
+
+def _cluster_samples(r: int) -> list[np.ndarray]:
+    """Unit vectors of C^r: the axes, then every pair of axes with the phases 1, j, −1, −j."""
+    out = [np.eye(r, dtype=complex)[i] for i in range(r)]
+    for i in range(r):
+        for k in range(i + 1, r):
+            for ph in (1, 1j, -1, -1j):
+                a = np.zeros(r, complex)
+                a[i], a[k] = 1 / np.sqrt(2), ph / np.sqrt(2)
+                out.append(a)
+    return out
 
 
 def _eig_lr(A: np.ndarray):
@@ -213,13 +228,20 @@ class Problem:
             F = P.D12 + Cc @ X[:, nw:]
             G = P.C2 @ X[:, :nw] + P.D21
             U, s, Vh = np.linalg.svd(T)
-            for i in range(min(3, s.size)):
-                if i and s[i] < max(floor, rel * s[0]):
-                    break
-                a = U[:, i].conj() @ F
-                b = G @ Vh[i].conj()
-                g = L.T @ np.real(np.outer(a, b)) @ R.T
-                out.append(Cut(float(s[i]), g.ravel(order="F"), ("sigma", j, float(w), i)))
+            r = 1
+            while r < min(3, s.size) and s[r] >= max(floor, rel * s[0]):
+                r += 1
+            # near-coalescing singular values: σ_max(T + dT) >= Re(uᴴ(T + dT)v) for every unit
+            # pair u = U_r a, v = V_r a, exact to first order for the best a; a polyhedral
+            # inner model of λ_max over the cluster from the axes and their phased pairs
+            for a in _cluster_samples(r):
+                u = U[:, :r] @ a
+                v = Vh[:r].conj().T @ a
+                val = float(np.real(u.conj() @ T @ v))
+                ga = u.conj() @ F
+                gb = G @ v
+                g = L.T @ np.real(np.outer(ga, gb)) @ R.T
+                out.append(Cut(val, g.ravel(order="F"), ("sigma", j, float(w), a.tobytes())))
         return out
 
     def _eig_cuts_of(self, P: Partition, K: np.ndarray, tag: tuple, offset: float,
@@ -271,9 +293,15 @@ class Problem:
         """The same piece at another gain (for the quasi-Newton update)."""
         kind = cut.key[0]
         if kind == "sigma":
-            _, j, w, i = cut.key
+            _, j, w, a = cut.key
+            if np.isfinite(w) and w > 0:
+                # follow the local peak: the gradient of the peak function max_ω σ (envelope)
+                # carries the curvature that the peak's motion adds
+                A, B, C, D = self.aug[j].closed_loop(K)
+                w = _refine_peak(A, B, C, D, w / 1.2, w * 1.2, w)[0]
             cs = self.sigma_cuts(K, j, [w], floor=0.0, rel=0.0)
-            return cs[i] if i < len(cs) else None
+            same = [c for c in cs if c.key[3] == a]
+            return same[0] if same else cs[0]
         if kind == "det":
             return self.det_cuts(K)[cut.key[1]]
         if kind == "eig":
