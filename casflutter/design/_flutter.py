@@ -9,10 +9,11 @@ interval is made a design requirement:
 * constraints: the ROM loop ΣAE(V) (eq. 8-9) closed by ``K`` decays at a rate ``decay`` at
   ``n_speeds`` speeds spread over the interval, and the algebraic loop through the
   accelerometers' flap feed-through stays well posed (``1 − Dk D22(V) >= min_det``);
-* continuation in speed: the upper end is raised in steps from just above Vf to the target,
-  each design starting from the previous controller (a loop that is stable up to ``V`` is
-  a good start for ``V + ΔV``); a dense eigenvalue scan after each design adds any speed
-  where the loop misbehaves between the grid points and designs again.
+* continuation in speed: starting from the paper's design at Vf, the upper end of the
+  constrained interval is pushed a step ``ΔV`` beyond the edge where the current loop still
+  decays (found by a dense eigenvalue scan), each design starting from the previous
+  controller, so that every start is nearly feasible; the step grows after a success and
+  halves after a failure.  A last design spends the full H∞ budget on the interval reached.
 
 The controller acts on the physical sensors (``v = K zm``, the feed-through closed exactly),
 so no loop shifting is needed.  The result states the interval actually reached; the exact
@@ -119,7 +120,7 @@ def design_flutter_controller(system: AeroelasticSystem, Vf: float, order: int =
     decay : float
         Decay rate (rad/s) required of ΣAE(V) at those speeds.
     steps : int
-        Continuation steps of the upper end from ``1.1 Vf`` to ``hi``.
+        The first continuation step is ``(hi − Vf) / steps``; at most ``6 steps`` designs.
     starts, seed : int
         Random starts of the first design and their seed (same seed, same controller).
     options : SynthesisOptions or dict, optional
@@ -153,40 +154,54 @@ def design_flutter_controller(system: AeroelasticSystem, Vf: float, order: int =
         raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < Vf = {Vf:.4g} < hi")
     if n_speeds < 2 or steps < 1:
         raise ConfigError(f"n_speeds = {n_speeds} (>= 2) and steps = {steps} (>= 1) required")
-    ends = np.linspace(min(1.1 * Vf, hi), hi, steps) if steps > 1 else np.array([hi])
-    best: tuple | None = None
-    initial = None
-    for k, top in enumerate(ends):
-        speeds = _speeds(lo, float(top), n_speeds, Vf)
-        dense = np.linspace(lo, float(top), 8 * n_speeds)
-        ok = False
-        for refine in range(3):
-            stab = [build_lft(system, float(V)).P for V in speeds]
-            try:
-                syn = synthesize(hinf, lft.nmeas, lft.ncon, order,
-                                 starts=starts if initial is None else 1, seed=seed,
-                                 initial=initial, stability_plants=stab, options=opts)
-            except SynthesisError as exc:
-                log.info("interval design up to V = %.4g: %s", top, exc)
-                break
-            a = loop_abscissa(system, syn.controller, dense)
-            worst = float(np.max(a))
-            log.info("interval design up to V = %.4g: gamma %.5g, worst abscissa %.4g rad/s "
-                     "on the dense scan", top, syn.gamma, worst)
-            initial = syn.controller
-            if worst < 0:
-                ok = True
-                best = (syn, (lo, float(top)), tuple(speeds), worst)
-                break
-            speeds = np.unique(np.concatenate([speeds, dense[a >= -decay]]))
-        if not ok:
-            break
-    if best is None:
-        log.info("no interval design succeeded; the design on the LFT alone is returned")
-        syn = synthesize(hinf, lft.nmeas, lft.ncon, order, starts=starts, seed=seed,
-                         options=opts)
-        return FlutterDesign(syn.controller, syn, lft, syn.gamma, (lo, hi), (), (Vf,),
-                             float(syn.spectral_abscissa), False)
+    # the paper's design at Vf starts the continuation
+    syn = synthesize(hinf, lft.nmeas, lft.ncon, order, starts=starts, seed=seed, options=opts)
+    K = syn.controller
+    dense_n = 8 * n_speeds
+
+    def edge(Kc) -> float:
+        """Largest V <= hi such that ΣAE decays at the rate ``decay`` on [lo, V]."""
+        grid = np.linspace(lo, hi, dense_n)
+        bad = np.flatnonzero(loop_abscissa(system, Kc, grid) > -decay)
+        return float(hi if bad.size == 0 else grid[max(bad[0] - 1, 0)])
+
+    e = edge(K)
+    best = (syn, e)
+    dV = (hi - Vf) / steps
+    log.info("interval design: the design at Vf decays on [%.4g, %.4g] (gamma %.5g)", lo, e,
+             syn.gamma)
+    rounds = 0
+    while e < hi and dV > 1e-3 * hi and rounds < 6 * steps:
+        rounds += 1
+        top = min(hi, e + dV)
+        speeds = _speeds(lo, top, n_speeds, Vf)
+        stab = [build_lft(system, float(V)).P for V in speeds]
+        try:
+            trial = synthesize(hinf, lft.nmeas, lft.ncon, order, starts=0, seed=seed,
+                               initial=K, stability_plants=stab,
+                               options=replace(opts, max_outer=max(1, opts.max_outer // 4)))
+            e_new = edge(trial.controller)
+        except SynthesisError:
+            trial, e_new = None, e
+        log.info("interval design: target V = %.4g -> decays up to %.4g", top, e_new)
+        if trial is not None and e_new > e:
+            K, e, dV = trial.controller, e_new, 1.5 * dV
+            best = (trial, e)
+        else:
+            dV *= 0.5
+    # the last interval reached, then the full H∞ budget on it
+    syn, e = best
+    speeds = _speeds(lo, e, n_speeds, Vf)
+    stab = [build_lft(system, float(V)).P for V in speeds]
+    try:
+        final = synthesize(hinf, lft.nmeas, lft.ncon, order, starts=0, seed=seed,
+                           initial=syn.controller, stability_plants=stab, options=opts)
+        if edge(final.controller) >= e:
+            syn = final
+    except SynthesisError:
+        pass
+    worst = float(np.max(loop_abscissa(system, syn.controller, np.linspace(lo, e, dense_n))))
+    best = (syn, (lo, e), tuple(speeds), worst)
     syn, reached, speeds, worst = best
     return FlutterDesign(syn.controller, syn, lft, syn.gamma, (lo, hi), reached, speeds,
                          worst, bool(reached[1] >= hi))

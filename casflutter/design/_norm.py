@@ -188,16 +188,19 @@ def hinf_norm(A, B, C, D, *, tol: float = 1e-9, max_iter: int = 60) -> tuple[flo
     return lb, wpk
 
 
-def _refine_peak(A, B, C, D, a: float, b: float, w0: float) -> tuple[float, float]:
+def _refine_peak(A, B, C, D, a: float, b: float, w0: float, xatol: float = 1e-6
+                 ) -> tuple[float, float]:
     """Local maximum of σ_max on ``[a, b]`` (bounded scalar search on log ω)."""
     lo, hi = max(a, 1e-12 * max(b, 1.0)), max(b, a * (1 + 1e-12))
     if hi <= lo * (1 + 1e-10):
         s = float(sigma_max(A, B, C, D, [w0])[0])
         return w0, s
-    f = lambda x: -float(sigma_max(A, B, C, D, [np.exp(x)])[0])  # noqa: E731
+    ev = _Evaluator(A, B, C, D)
+    f = lambda x: -float(ev([np.exp(x)])[0])  # noqa: E731
     r = minimize_scalar(f, bounds=(np.log(lo), np.log(hi)), method="bounded",
-                        options={"xatol": 1e-7})
-    w, s = float(np.exp(r.x)), -float(r.fun)
+                        options={"xatol": xatol})
+    w = float(np.exp(r.x))
+    s = float(sigma_max(A, B, C, D, [w])[0])
     s0 = float(sigma_max(A, B, C, D, [w0])[0])
     return (w, s) if s >= s0 else (w0, s0)
 

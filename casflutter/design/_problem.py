@@ -182,12 +182,18 @@ class Problem:
         return a, b
 
     def stab_objective(self, K: np.ndarray, margin: float) -> float:
-        """``max(α_j + margin, α_l + decay)``: negative once every requirement holds."""
-        if not self.well_posed(K):
+        """``max(α_j + margin, α_l + decay, min_det − det_i)``: negative once every
+        requirement holds (decay rates and well-posedness with margin)."""
+        dets = self.dets(K)
+        if np.any(np.abs(dets) < 1e-12):
             return np.inf
-        a, b = self.alphas(K)
+        try:
+            a, b = self.alphas(K)
+        except np.linalg.LinAlgError:
+            return np.inf
         return float(max(np.max(a + margin, initial=-np.inf),
-                         np.max(b + self.decay, initial=-np.inf)))
+                         np.max(b + self.decay, initial=-np.inf),
+                         np.max(self.min_det * (1.0 - 1e-6) - dets, initial=-np.inf)))
 
     def feasible(self, K: np.ndarray) -> bool:
         """Well posed, and the stability plants decay at the required rate."""
@@ -298,7 +304,7 @@ class Problem:
                 # follow the local peak: the gradient of the peak function max_ω σ (envelope)
                 # carries the curvature that the peak's motion adds
                 A, B, C, D = self.aug[j].closed_loop(K)
-                w = _refine_peak(A, B, C, D, w / 1.2, w * 1.2, w)[0]
+                w = _refine_peak(A, B, C, D, w / 1.2, w * 1.2, w, xatol=1e-4)[0]
             cs = self.sigma_cuts(K, j, [w], floor=0.0, rel=0.0)
             same = [c for c in cs if c.key[3] == a]
             return same[0] if same else cs[0]

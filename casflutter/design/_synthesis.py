@@ -79,6 +79,9 @@ class SynthesisOptions:
     """Local maxima of σ_max above this fraction of γ enter the local model."""
     max_iter: int = 300
     """Ipopt iterations per QP subproblem."""
+    strictly_proper: bool = False
+    """Keep ``Dk = 0`` (a strictly proper controller): no algebraic loop through a
+    control-to-measurement feed-through at any operating point."""
     zero_start: bool = True
     """Make the first of the ``starts`` the zero controller (the others are seeded random);
     ``False``: all random."""
@@ -86,6 +89,11 @@ class SynthesisOptions:
     """Optional wall-time budget in seconds for all starts (``None``: none).  With a budget
     the result depends on the machine's speed and load; without one the budget is the
     iteration counts above and the same seed gives the same controller."""
+    stall_window: int = 30
+    """Stop a start's H∞ phase when γ fell by less than ``stall_tol`` (relative) over this
+    many iterations (counted in iterations: deterministic)."""
+    stall_tol: float = 1e-4
+    """See ``stall_window``."""
     abandon_after: int = 40
     """A start whose γ is still above ``abandon_ratio`` times the best start's after this many
     H∞ iterations is stopped (deterministic: counted in iterations)."""
@@ -101,7 +109,8 @@ class SynthesisOptions:
                   "min_det": 0 < self.min_det < 1, "trust_region": self.trust_region > 0,
                   "max_trust_region": self.max_trust_region >= self.trust_region,
                   "active_ratio": 0 < self.active_ratio < 1,
-                  "abandon_after": self.abandon_after >= 1, "abandon_ratio": self.abandon_ratio > 1,
+                  "abandon_after": self.abandon_after >= 1,
+                  "stall_window": self.stall_window >= 2, "stall_tol": 0 <= self.stall_tol < 1, "abandon_ratio": self.abandon_ratio > 1,
                   "time_limit": self.time_limit is None or self.time_limit > 0}
         bad = [k for k, ok in checks.items() if not ok]
         if bad:
@@ -109,6 +118,7 @@ class SynthesisOptions:
                               "max_stab_rounds>=1, max_iter>=1, 0<tol<1, stability_margin>0, "
                               "decay>=0, 0<min_det<1, trust_region>0, max_trust_region>="
                               "trust_region, 0<active_ratio<1, abandon_after>=1, abandon_ratio>1, "
+                              "stall_window>=2, 0<=stall_tol<1, "
                               "time_limit None or >0")
 
 
@@ -290,13 +300,13 @@ class _Phase:
         prob = self.prob
         if self.kind == "stab":
             allc = prob.eig_cuts(K, self.margin, -np.inf, 0.0, which="all")
+            allc += [Cut(c.value - self.opts.min_det * 1e-6, c.grad, c.key)
+                     for c in prob.det_cuts(K)]
             top = max(allc, key=lambda c: c.value)
             reach = top.value - delta * np.sum(np.abs(top.grad))
             obj = [c for c in allc if c.value + delta * np.sum(np.abs(c.grad)) >= reach]
             obj.sort(key=lambda c: -(c.value + delta * np.sum(np.abs(c.grad))))
-            obj = obj[:48]
-            con = [c for c in prob.det_cuts(K) if c.value + delta * np.sum(np.abs(c.grad)) >= 0]
-            return obj, con
+            return obj[:48], []
         gams, peaks = info
         obj: list[Cut] = []
         for j, (gj, wj) in enumerate(zip(gams, peaks)):
@@ -315,8 +325,15 @@ class _Phase:
 
     def run(self, K: np.ndarray, label: str, max_iter: int) -> dict:
         prob, opts = self.prob, self.opts
+        free = np.ones(prob.shape)
+        if opts.strictly_proper:
+            free[:prob.nu, :prob.ny] = 0.0
+            K = K.copy()
+            K[:prob.nu, :prob.ny] = 0.0
+        free = prob.vec(free)
         f, info = self.value(K)
         history = [f]
+        history_at = [0]
         memory: list[list[float]] = [[] for _ in prob.aug]
         delta0 = delta = opts.trust_region * max(1.0, float(np.max(np.abs(K))))
         H = None
@@ -325,6 +342,12 @@ class _Phase:
         cuts_cache = None
         for it in range(1, max_iter + 1):
             if self.done(f) or time.perf_counter() > self.deadline:
+                break
+            if self.kind == "hinf" and len(history) > 1 and it > opts.stall_window and \
+                    history_at[-1] >= it - 1 and _stalled(history, history_at, it,
+                                                          opts.stall_window, opts.stall_tol):
+                log.info("%s: stalled at gamma %.6g (less than %.1e relative decrease in %d "
+                         "iterations)", label, f, opts.stall_tol, opts.stall_window)
                 break
             if it > opts.abandon_after and f > self.abandon_above:
                 log.info("%s: abandoned at gamma %.6g (another start is far better)", label, f)
@@ -342,7 +365,7 @@ class _Phase:
                 gscale = float(np.max(np.linalg.norm(G, axis=1)))
                 H = max(1e-8, 0.1 * gscale / delta0) * np.eye(prob.n)
                 fresh = True
-            step = self.qp.solve(H, fv, G, cv, Hc, delta)
+            step = self.qp.solve(H, fv, G, cv, Hc, delta * free)
             self.statuses.append(step.status)
             pred = -step.model
             scale = max(abs(f), 1e-12) if self.kind == "hinf" else max(abs(f), self.margin)
@@ -381,6 +404,7 @@ class _Phase:
                     fresh = False
                 K, f, info = Kn, fn, info_n
                 history.append(f)
+                history_at.append(it)
                 cuts_cache = None
                 if ratio > 0.75 and dmax > 0.9 * delta:
                     delta = min(2.0 * delta, opts.max_trust_region * max(1.0, np.max(np.abs(K))))
@@ -407,6 +431,15 @@ class _Phase:
                     break
         return dict(K=K, f=f, history=history, converged=converged, iterations=it,
                     pred=pred_rel)
+
+
+def _stalled(history: list, at: list, it: int, window: int, tol: float) -> bool:
+    """Less than ``tol`` relative decrease of the accepted values over the last ``window``
+    iterations."""
+    old = [h for h, a in zip(history, at) if a <= it - window]
+    if not old:
+        return False
+    return (old[-1] - history[-1]) < tol * abs(old[-1])
 
 
 def _merge(new: Sequence[float], old: Sequence[float], keep: int = 12) -> list[float]:
@@ -514,7 +547,13 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
         K0 = _initial_gain(prob, kind, rng, g)
         statuses: list[str] = []
         label = f"start {s} ({kind})"
-        stab = _Phase(prob, qp, opts, "stab", margin, deadline, statuses)
+        m_start = margin
+        if kind.startswith("given"):
+            # a stable given controller is kept as it is (its γ bounds this order's from above)
+            a0 = float(np.max(prob.alphas(K0)[0]))
+            if a0 < 0:
+                m_start = min(margin, 0.5 * -a0)
+        stab = _Phase(prob, qp, opts, "stab", m_start, deadline, statuses)
         r1 = stab.run(K0, label, opts.max_stab_rounds)
         K, phi = r1["K"], r1["f"]
         a_h = float(np.max(prob.alphas(K)[0])) * prob.w0
@@ -524,7 +563,7 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
                  "reached the decay rates" if ok else "failed", r1["iterations"], a_h)
         if ok:
             best_g = min((r.gamma for r in records if r.stabilized), default=np.inf)
-            hinf = _Phase(prob, qp, opts, "hinf", margin, deadline, statuses,
+            hinf = _Phase(prob, qp, opts, "hinf", m_start, deadline, statuses,
                           abandon_above=opts.abandon_ratio * best_g)
             r2 = hinf.run(K, label, opts.max_outer)
             K, gam = r2["K"], r2["f"]
