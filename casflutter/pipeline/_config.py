@@ -91,6 +91,8 @@ class ControllerSection:
     decay: float = 0.05
     #: continuation steps of the interval's upper end
     steps: int = 4
+    #: Dk = 0: no algebraic loop through the accelerometers' flap feed-through at any speed
+    strictly_proper: bool = False
     #: H∞ iterations per start: the deterministic budget of the synthesis
     max_outer: int = 20
     #: required closed-loop decay after the stabilisation phase, relative to the plant's

@@ -237,6 +237,7 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
                                 max_iter=c.max_iter, zero_start=c.zero_start,
                                 stability_margin=c.stability_margin,
                                 max_stab_rounds=c.max_stab_rounds,
+                                strictly_proper=c.strictly_proper,
                                 ipopt=dict(cfg.solver.ipopt))
         # γ of the LFT at Vf (eq. 14-16) with ΣAE(V) kept stable over controller.interval;
         # the controller acts on the physical accelerometers (feed-through closed exactly)
