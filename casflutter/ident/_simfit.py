@@ -238,20 +238,27 @@ class FreeRunProblem:
         """Jacobian of the weighted residual with respect to ``x`` (dense)."""
         co, caches = cache
         w = np.sqrt(2 * self.scale)
-        J = np.zeros((self.n_rows * self.N, self.n_x))
+        single = len(self.records) == 1
+        J = None if single else np.zeros((self.n_rows * self.N, self.n_x))
         row = 0
         for r, (rec, yused) in enumerate(zip(self.records, caches)):
             D = self._direct(co, rec, yused)
+            D *= w   # the sensitivity recursion is linear: scale its forcing once
             n = rec["M"] * self.N
             if self.H:
                 S = sensitivities(D, co["W"], self.lags, yused, int(seg), self.H)
+                if single:
+                    # columns [theta, initial outputs] are already the layout of x
+                    S[:, :, self.P:] *= w
+                    return S.reshape(n, self.n_x)
                 J[row:row + n, :self.P] = S[:, :, :self.P].reshape(n, self.P)
                 c0 = self.P + r * self.n_ic
-                J[row:row + n, c0:c0 + self.n_ic] = S[:, :, self.P:].reshape(n, self.n_ic)
+                J[row:row + n, c0:c0 + self.n_ic] = w * S[:, :, self.P:].reshape(n, self.n_ic)
             else:
+                if single:
+                    return D.reshape(n, self.P)
                 J[row:row + n, :self.P] = D.reshape(n, self.P)
             row += n
-        J *= w
         return J
 
     def cost(self, x, seg: int = 0) -> float:
