@@ -13,4 +13,6 @@ from ._model import (HWLModel, HWLStructure, UnstableModelWarning,  # noqa: F401
                      hwl_predict_function, hwl_simulate_function, paper_parameter_count)
 from ._orders import HWLOrders  # noqa: F401
 from ._regression import Stage1Result, stage1  # noqa: F401
-from ._synthetic import random_hwl_model, synthetic_data  # noqa: F401
+from ._select import (OrderCandidate, OrderSelection, order_grid, parse_grid,  # noqa: F401
+                      select_orders)
+from ._synthetic import duffing_data, random_hwl_model, synthetic_data  # noqa: F401

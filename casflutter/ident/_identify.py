@@ -329,7 +329,8 @@ def _shifted_data(data: IOData, my, mu, mv) -> IOData:
 
 
 def _warn_offsets(data: IOData) -> None:
-    """Warn when a channel's mean is large against its variation and no offset is fitted."""
+    """Warn when a channel's mean exceeds its standard deviation and no offset is fitted
+    (a nonlinear response has a mean of its own: only a dominant one is flagged)."""
     for name, arrs in (("y", [r.y for r in data.records]),
                        ("u", [r.u for r in data.records] if data.has_u else []),
                        ("v", [r.v[:, None] for r in data.records] if data.has_v else [])):
@@ -337,7 +338,7 @@ def _warn_offsets(data: IOData) -> None:
             continue
         a = np.concatenate(arrs, axis=0)
         mean, std = np.abs(a.mean(axis=0)), a.std(axis=0)
-        if np.any(mean > 0.2 * np.maximum(std, 1e-300)):
+        if np.any(mean > np.maximum(std, 1e-300)):
             warnings.warn(f"signal {name} has a mean of {float(mean.max()):.3g} against a "
                           f"standard deviation of {float(std[np.argmax(mean)]):.3g}; the HWL "
                           "model has no constant term: pass offset=True to identify it with one",
