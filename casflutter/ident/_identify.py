@@ -535,8 +535,9 @@ def identify(data: IOData, orders=(3, 1, 1, 1, 2, 2), *,
         raise ConvergenceError(
             f"the identified model is unstable in free run on the estimation data: its "
             f"simulation diverges at {where} (stage 2: {settings.criterion} criterion, "
-            f"{iters} iterations); use criterion='simulation', lower orders or add "
-            "regularization", result)
+            f"{iters} iterations); "
+            + ("use criterion='simulation', " if settings.criterion == "prediction" else "")
+            + "lower the orders or add regularization", result)
     if status in _ACCEPTABLE and settings.accept_acceptable:
         warnings.warn(f"stage 2 stopped at the acceptable level ({status}, {iters} iterations, "
                       f"cost {cost0:.3e} -> {cost:.3e}); the result is returned",

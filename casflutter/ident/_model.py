@@ -50,6 +50,10 @@ __all__ = ["HWLStructure", "HWLModel", "hwl_predict_function", "hwl_simulate_fun
            "paper_parameter_count", "UnstableModelWarning"]
 
 
+#: |y| above which a free run counts as diverged (its square still fits in a double)
+_DIVERGED = 1e100
+
+
 class UnstableModelWarning(UserWarning):
     """A free-run simulation of an HWL model diverged (the model is unstable for that input)."""
 
@@ -489,8 +493,9 @@ class HWLModel:
         Returns
         -------
         ndarray, shape (K, N)
-            When the model diverges (unstable free run) the samples from the divergence on are
-            NaN and one :class:`UnstableModelWarning` names the sample.
+            When the model diverges (unstable free run: an output above ``1e100`` in magnitude
+            or not finite) the samples from the divergence on are NaN and one
+            :class:`UnstableModelWarning` names the sample.
         """
         u, v, _, K = self._arrays(u, v, None, n_samples)
         N, L = self.n_modes, self.max_lag
@@ -510,7 +515,7 @@ class HWLModel:
         ybuf, _, diverged = free_run(xin, ar_weight_array(self.structure, self._weights),
                                      np.asarray(lags, dtype=np.int64),
                                      np.ascontiguousarray(y[L - H:L]), np.zeros((1, N)), 0,
-                                     np.inf)
+                                     _DIVERGED)
         y[L:] = ybuf[H:]
         if diverged >= 0:
             warnings.warn(f"the HWL model is unstable in free run: its output diverges at sample "

@@ -65,9 +65,8 @@ def simulation_problem(structure: HWLStructure, data: IOData, shooting_interval:
 
     Returns ``(nlp, residual, x0_nodes, unpack)``: the NLP dict, the residual vector (for a
     Gauss--Newton Hessian), the initial values of the shooting nodes (measured output
-    histories; the first node of each record is its initial output history, free) and a
-    function splitting the solution vector into ``(theta, [initial outputs (H, N) per
-    record])``.
+    histories) and a function splitting the solution vector into ``(theta, nodes)``.  Each
+    record starts from its measured outputs.
     """
     N, L = structure.n_modes, structure.max_lag
     lags = structure.orders.ar_lags()
@@ -79,7 +78,7 @@ def simulation_problem(structure: HWLStructure, data: IOData, shooting_interval:
     step = recursion_step(structure) if lags else None
     w_ar = ar_weights(structure, W) if lags else None
     accs: dict[int, ca.Function] = {}
-    nodes, node_init, g, residuals, ic_pos = [], [], [], [], []
+    nodes, node_init, g, residuals = [], [], [], []
     for rec in data.records:
         K = rec.n_samples
         u = None if rec.u is None else ca.DM(rec.u)
@@ -89,11 +88,8 @@ def simulation_problem(structure: HWLStructure, data: IOData, shooting_interval:
         if not lags:
             residuals.append(ca.vec(xin - ca.DM(target)))
             continue
-        # the initial output history of the record is a decision variable too
-        hist = ca.MX.sym(f"y0_{len(nodes)}", H * N)
-        node_init.append(np.concatenate([rec.y[L - 1 - d] for d in range(H)]))
-        nodes.append(hist)
-        ic_pos.append(len(nodes) - 1)
+        # the measured initial output history (the Gauss--Newton solver estimates it)
+        hist = ca.DM(np.concatenate([rec.y[L - 1 - d] for d in range(H)]))
         for start in range(0, K - L, shooting_interval):
             stop = min(start + shooting_interval, K - L)
             n = stop - start
@@ -118,15 +114,7 @@ def simulation_problem(structure: HWLStructure, data: IOData, shooting_interval:
     nlp = {"x": x, "f": f, "g": ca.vertcat(*g) if g else ca.MX(0, 1)}
     x_nodes = np.concatenate(node_init) if node_init else np.zeros(0)
     n_par = structure.n_params
-    size = H * N
-
-    def split(xx):
-        xx = np.asarray(xx).ravel()
-        ics = [xx[n_par + k * size:n_par + (k + 1) * size].reshape(H, N)[::-1].copy()
-               for k in ic_pos]
-        return xx[:n_par], ics
-
-    return nlp, residual, x_nodes, split
+    return nlp, residual, x_nodes, lambda xx: (np.asarray(xx)[:n_par], np.asarray(xx)[n_par:])
 
 
 def _gauss_newton_hessian(nlp, residual, structure, data, regularization) -> ca.Function:
@@ -166,9 +154,8 @@ def refine(structure: HWLStructure, data: IOData, theta0, *, criterion: str = "p
         Criterion at ``theta0`` and at ``theta``.  For the simulation criterion both are free
         runs evaluated outside the NLP (``cost0`` from the measured initial outputs), so they
         compare like with like.
-    initial_outputs : list of ndarray
-        Estimated initial outputs ``(H, N)`` of each record (simulation criterion; empty
-        otherwise).
+    initial_outputs : list
+        Empty: the Ipopt NLP starts every record from its measured outputs.
     """
     theta0 = np.asarray(theta0, dtype=float)
     opts = dict(options or {})
@@ -190,12 +177,7 @@ def refine(structure: HWLStructure, data: IOData, theta0, *, criterion: str = "p
         opts.setdefault("show_eval_warnings", False)
         solver = make_solver(nlp, opts, name="hwl_simulation")
         res = solver(x0, lbg=0.0, ubg=0.0)
-        theta, ics = split(res.x)
-        if structure.orders.na and np.all(np.isfinite(res.x)):
-            cost = free.cost(np.concatenate([theta] + [ic.ravel() for ic in ics]))
-        elif np.all(np.isfinite(res.x)):
-            cost = free.cost(free.x0(theta))
-        else:
-            cost = float("nan")
-        return theta, res, cost0, cost, ics
+        theta = split(res.x)[0]
+        cost = free.cost(free.x0(theta)) if np.all(np.isfinite(theta)) else float("nan")
+        return theta, res, cost0, cost, []
     raise ConfigError(f"criterion={criterion!r} is not known: use 'prediction' or 'simulation'")

@@ -382,6 +382,9 @@ def fit_simulation_error(problem: FreeRunProblem, theta0, *, max_iter: int = 500
     if not (cost0 <= blowup * ref):
         longest = max(r["M"] for r in problem.records)
         seg = max(4 * (problem.L + 1), 32)
+        # the shortest segments whose cost is finite (1: mu-step-ahead prediction error)
+        while seg > 1 and not np.isfinite(problem.cost(x, seg)):
+            seg //= 2
         while seg < longest:
             stages.append(seg)
             x, f, status, nj, nf = _levenberg_marquardt(
