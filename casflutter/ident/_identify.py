@@ -337,7 +337,8 @@ def _warn_offsets(data: IOData) -> None:
         if not arrs:
             continue
         a = np.concatenate(arrs, axis=0)
-        mean, std = np.abs(a.mean(axis=0)), a.std(axis=0)
+        with np.errstate(over="ignore", invalid="ignore"):
+            mean, std = np.abs(a.mean(axis=0)), a.std(axis=0)
         if np.any(mean > np.maximum(std, 1e-300)):
             warnings.warn(f"signal {name} has a mean of {float(mean.max()):.3g} against a "
                           f"standard deviation of {float(std[np.argmax(mean)]):.3g}; the HWL "

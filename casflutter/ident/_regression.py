@@ -160,8 +160,14 @@ def stage1(structure: HWLStructure, data: IOData, *, max_condition: float = 1e10
                         f"{structure.max_lag}) for {len(layout)} regression unknowns per output "
                         f"({structure.n_params} model parameters); record more data or lower "
                         "the orders")
-    Phi, Y = regressor_matrix(structure, data)
-    col_norm = np.linalg.norm(Phi, axis=0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        Phi, Y = regressor_matrix(structure, data)
+        col_norm = np.linalg.norm(Phi, axis=0)
+    if not (np.all(np.isfinite(Phi)) and np.all(np.isfinite(col_norm))):
+        raise DataError(f"the regression overflows: the powers up to "
+                        f"{max(structure.orders.p, structure.orders.q)} of the signals are not "
+                        "finite in double precision; scale the data (scale_data=True) or lower "
+                        "the polynomial degrees p, q")
     dead = [layout[c] for c in np.flatnonzero(col_norm == 0)]
     if dead:
         raise DataError(f"non-exciting input: regressor column(s) {dead[:4]} are identically "
