@@ -10,7 +10,9 @@ recursion starts from) estimated together with the model parameters.  Its Jacobi
 the sensitivity of ``y_sim`` obeys the same recursion as ``y_sim`` (see :mod:`._kernels`), so
 one compiled pass over the record gives residual and Jacobian in ``O(K)`` time and memory.
 
-The step is Levenberg--Marquardt with Moré's diagonal scaling and Nielsen's damping update.
+The step is Levenberg--Marquardt with Moré's diagonal scaling; the damping shrinks by 3 after
+a step whose decrease the Gauss--Newton model predicted well (ratio >= 1/4), grows by 2 after
+a poorly predicted one, and doubles repeatedly (2, 4, 8, ...) while trial steps are rejected.
 A trial step whose free run is not finite (or exceeds a divergence bound) is rejected like any
 step that does not decrease the cost: the damping grows and the step shrinks, so iterates stay
 in the region where the model runs free.  When the *starting* model already diverges, the fit
@@ -38,6 +40,12 @@ log = logging.getLogger("casflutter.ident")
 
 #: |y| (in the unit-RMS working units) beyond which a free run is declared divergent
 DIVERGENCE_BOUND = 1e8
+#: the acceptable level: this many consecutive steps each decreasing the cost by less than
+#: this fraction (Ipopt's ``acceptable_iter`` idea)
+ACCEPTABLE_ITER = 15
+ACCEPTABLE_DECREASE = 1e-6
+#: converged when this many consecutive steps together decrease the cost by less than tol
+STALL_WINDOW = 5
 
 
 @dataclass(frozen=True)
@@ -56,7 +64,11 @@ class LMResult:
     success : bool
         Converged (``Solve_Succeeded``) or, when allowed by the caller, acceptable.
     return_status : str
-        ``Solve_Succeeded``, ``Solved_To_Acceptable_Level``, ``Maximum_Iterations_Exceeded``,
+        ``Solve_Succeeded`` (relative cost decrease of one step or of the last
+        ``STALL_WINDOW`` steps together, step or scaled gradient below ``tol``),
+        ``Solved_To_Acceptable_Level`` (``ACCEPTABLE_ITER`` consecutive steps each below
+        ``ACCEPTABLE_DECREASE`` relative decrease, or no decreasing step while the scaled
+        gradient is small), ``Maximum_Iterations_Exceeded``,
         ``Maximum_WallTime_Exceeded``, ``Unstable_Free_Run`` or
         ``Search_Direction_Becomes_Too_Small`` (Ipopt's names where they exist).
     iterations : int
@@ -277,6 +289,8 @@ def _levenberg_marquardt(problem: FreeRunProblem, x, seg, *, max_iter, tol, dead
     lam = None
     nu = 2.0
     n_jac = 0
+    history = [f]
+    n_slow = 0          # consecutive steps with a relative decrease below ACCEPTABLE_DECREASE
     status = "Maximum_Iterations_Exceeded"
     for _ in range(max_iter):
         if time.perf_counter() > deadline:
@@ -337,17 +351,29 @@ def _levenberg_marquardt(problem: FreeRunProblem, x, seg, *, max_iter, tol, dead
         dx = np.sqrt(d2) * step
         small_step = np.linalg.norm(dx) <= tol * (np.linalg.norm(np.sqrt(d2) * x) + tol)
         small_decrease = (f - f_new) <= tol * f and pred <= tol * f
+        history.append(f_new)
+        # converged: the last STALL_WINDOW steps together decreased the cost by < tol
+        stalled = (len(history) > STALL_WINDOW
+                   and history[-1 - STALL_WINDOW] - f_new <= tol * f_new)
+        n_slow = n_slow + 1 if (f - f_new) <= ACCEPTABLE_DECREASE * f else 0
         x, r, cache, f = x_new, r_new, cache_new, f_new
-        lam *= max(1.0 / 3.0, 1.0 - (2.0 * ratio - 1.0) ** 3)
+        log.debug("LM seg=%d iteration %d: cost %.6e, ratio %.3f, lambda %.2e", seg, n_jac, f,
+                  ratio, lam)
+        # a good model of the decrease: trust it more; a poor one: damp more
+        lam = max(lam / 3.0, 1e-15) if ratio >= 0.25 else lam * 2.0
         nu = 2.0
-        if small_step or small_decrease or f <= 1e-30:
+        if small_step or small_decrease or stalled or f <= 1e-30:
             status = "Solve_Succeeded"
+            break
+        if n_slow >= ACCEPTABLE_ITER:
+            # creeping along an ill-conditioned valley: stop as Ipopt's acceptable level does
+            status = "Solved_To_Acceptable_Level"
             break
     return x, f, status, n_jac, n_fev
 
 
 def fit_simulation_error(problem: FreeRunProblem, theta0, *, max_iter: int = 500,
-                         tol: float = 1e-9, max_time: float | None = None,
+                         tol: float = 1e-8, max_time: float | None = None,
                          blowup: float = 10.0) -> LMResult:
     """Minimise the free-run criterion from ``theta0`` (module docstring).
 

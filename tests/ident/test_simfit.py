@@ -12,7 +12,7 @@ from casflutter.ident import (HWLModel, HWLStructure, IdentificationWarning, Uns
                               fit_report, identify, random_hwl_model, synthetic_data)
 from casflutter.ident import _identify as identify_module
 from casflutter.ident._kernels import free_run
-from casflutter.ident._simfit import FreeRunProblem, LMResult
+from casflutter.ident._simfit import FreeRunProblem, LMResult, fit_simulation_error
 
 
 def _fd_jacobian(prob, x, seg):
@@ -111,7 +111,8 @@ def test_cost_initial_is_the_free_run_cost(mimo_truth):
 
 def test_diverging_start_is_handled(mimo_truth):
     """A start whose free run overflows (autoregression x6) converges to the same optimum as
-    the stage-1 start, through the segment continuation; cost_initial is inf."""
+    the stage-1 start: through the segment continuation in the solver itself, and through
+    identify (which may first move to the prediction-error optimum); cost_initial is inf."""
     data = synthetic_data(mimo_truth, 2000, seed=5, noise=0.05)
     c = mimo_truth.coefficients()
     c["A"] = 6 * c["A"]
@@ -121,8 +122,17 @@ def test_diverging_start_is_handled(mimo_truth):
     ref = identify(data, mimo_truth.orders, criterion="simulation")
     res = identify(data, mimo_truth.orders, criterion="simulation", initial=bad)
     assert res.success and np.isinf(res.cost_initial)
-    assert res.cost == pytest.approx(ref.cost, rel=1e-8)
+    assert res.cost == pytest.approx(ref.cost, rel=1e-6)
     np.testing.assert_allclose(res.model.theta, ref.model.theta, rtol=1e-5, atol=1e-7)
+    # the solver alone, in the working units identify uses
+    sy, su, sv = data.scales()
+    work = data.scaled(sy, su, sv)
+    start = bad.rescaled(sy, su, sv).theta
+    prob = FreeRunProblem(mimo_truth.structure, work)
+    lm = fit_simulation_error(prob, start)
+    assert lm.success and np.isinf(lm.cost_initial)
+    assert lm.stages[0] > 0 and lm.stages[-1] == 0      # continuation, then whole records
+    assert lm.cost == pytest.approx(ref.cost, rel=1e-6)
 
 
 def test_mu_three_and_long_lags():
