@@ -31,6 +31,9 @@ _SOLVERS = ("auto", "gauss-newton", "ipopt")
 _CONVERGED = {"Solve_Succeeded", "not run"}
 _ACCEPTABLE = {"Solved_To_Acceptable_Level"}
 _TIMEOUT = {"Maximum_WallTime_Exceeded"}
+#: a simulation fit whose cost from the measured initial outputs exceeds this many times its
+#: cost from the estimated ones is refitted with the initial outputs fixed
+HIDDEN_MODE_FACTOR = 10.0
 
 
 class IdentificationWarning(UserWarning):
@@ -519,8 +522,19 @@ def identify(data: IOData, orders=(3, 1, 1, 1, 2, 2), *,
         start = _stable_start(problem, structure, work, theta0, settings)
         lm = fit_simulation_error(problem, start, max_iter=settings.iteration_limit,
                                   tol=settings.tol, max_time=settings.max_time)
-        if start is not theta0:
-            lm = replace(lm, cost_initial=problem.cost(problem.x0(theta0)))
+        if lm.success or lm.return_status in _ACCEPTABLE:
+            # estimated initial outputs can hide an unstable or badly damped mode that the
+            # input does not excite: from the measured outputs such a model runs far worse
+            measured = problem.cost(problem.x0(lm.theta))
+            if not measured <= HIDDEN_MODE_FACTOR * lm.cost + 1e-300:
+                log.info("simulation fit: from the measured initial outputs the cost is %.4e "
+                         "(estimated: %.4e); refitting with them fixed", measured, lm.cost)
+                fixed = FreeRunProblem(structure, work, settings.regularization, theta0,
+                                       estimate_initial=False)
+                lm2 = fit_simulation_error(fixed, lm.theta, max_iter=settings.iteration_limit,
+                                           tol=settings.tol, max_time=settings.max_time)
+                lm = replace(lm2, iterations=lm.iterations + lm2.iterations)
+        lm = replace(lm, cost_initial=problem.cost(problem.x0(theta0)))
         theta, success, status, iters = lm.theta, lm.success, lm.return_status, lm.iterations
         cost0, cost = lm.cost_initial, lm.cost
         ics = tuple(ic * sy + (my if settings.offset else 0.0) for ic in lm.initial_outputs)

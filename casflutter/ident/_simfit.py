@@ -43,7 +43,7 @@ DIVERGENCE_BOUND = 1e8
 #: the acceptable level: this many consecutive steps each decreasing the cost by less than
 #: this fraction (Ipopt's ``acceptable_iter`` idea)
 ACCEPTABLE_ITER = 15
-ACCEPTABLE_DECREASE = 1e-6
+ACCEPTABLE_DECREASE = 1e-5
 #: converged when this many consecutive steps together decrease the cost by less than tol
 STALL_WINDOW = 5
 
@@ -96,11 +96,12 @@ class FreeRunProblem:
     """Residual and exact Jacobian of the free-run criterion on fixed (working-unit) data.
 
     The decision vector is ``x = [theta, y0_record0, y0_record1, ...]`` with each ``y0`` the
-    ``H x N`` initial outputs flattened sample by sample.
+    ``H x N`` initial outputs flattened sample by sample (``x = theta`` with
+    ``estimate_initial=False``: every record starts from its measured outputs).
     """
 
     def __init__(self, structure: HWLStructure, data: IOData, regularization: float = 0.0,
-                 theta_ref=None):
+                 theta_ref=None, estimate_initial: bool = True):
         o = structure.orders
         self.structure = structure
         self.N, self.L = structure.n_modes, structure.max_lag
@@ -130,17 +131,22 @@ class FreeRunProblem:
             n_rows += M
         self.n_rows = n_rows
         self.scale = 0.5 / (n_rows * self.N)
-        self.n_ic = H * self.N
+        self.estimate_initial = bool(estimate_initial)
+        self.n_ic = H * self.N if self.estimate_initial else 0
         self.n_x = self.P + len(self.records) * self.n_ic
 
     # -- layout -----------------------------------------------------------------------
     def x0(self, theta) -> np.ndarray:
         """Decision vector from ``theta`` with the measured initial outputs."""
+        if not self.estimate_initial:
+            return np.asarray(theta, dtype=float).copy()
         return np.concatenate([np.asarray(theta, dtype=float)]
                               + [r["ic0"].ravel() for r in self.records])
 
     def split(self, x):
         """``(theta, [y0 (H, N) per record])``."""
+        if not self.estimate_initial:
+            return x[:self.P], [r["ic0"] for r in self.records]
         ics = [x[self.P + r * self.n_ic:self.P + (r + 1) * self.n_ic].reshape(self.H, self.N)
                for r in range(len(self.records))]
         return x[:self.P], ics
@@ -259,13 +265,17 @@ class FreeRunProblem:
             n = rec["M"] * self.N
             if self.H:
                 S = sensitivities(D, co["W"], self.lags, yused, int(seg), self.H)
-                if single:
+                if single and self.estimate_initial:
                     # columns [theta, initial outputs] are already the layout of x
                     S[:, :, self.P:] *= w
                     return S.reshape(n, self.n_x)
+                if single:
+                    return np.ascontiguousarray(S[:, :, :self.P]).reshape(n, self.P)
                 J[row:row + n, :self.P] = S[:, :, :self.P].reshape(n, self.P)
-                c0 = self.P + r * self.n_ic
-                J[row:row + n, c0:c0 + self.n_ic] = w * S[:, :, self.P:].reshape(n, self.n_ic)
+                if self.estimate_initial:
+                    c0 = self.P + r * self.n_ic
+                    J[row:row + n, c0:c0 + self.n_ic] = (
+                        w * S[:, :, self.P:].reshape(n, self.n_ic))
             else:
                 if single:
                     return D.reshape(n, self.P)

@@ -47,6 +47,13 @@ def test_sensitivities_match_finite_differences(orders, N, has_u, has_v, constan
     J = prob.jacobian(cache, seg)
     Jfd = _fd_jacobian(prob, x, seg)
     assert np.abs(J - Jfd).max() < 1e-7 * np.abs(J).max()
+    # the same with the initial outputs fixed at the measured ones
+    fixed = FreeRunProblem(s, data, regularization=0.1, estimate_initial=False)
+    xf = x[:s.n_params]
+    Jf = fixed.jacobian(fixed.residual(xf, seg)[1], seg)
+    assert Jf.shape == (fixed.n_rows * N, s.n_params)
+    Jffd = _fd_jacobian(fixed, xf, seg)
+    assert np.abs(Jf - Jffd).max() < 1e-7 * np.abs(Jf).max()
 
 
 def test_free_run_kernel_matches_numpy_recursion():
