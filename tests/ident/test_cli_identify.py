@@ -112,3 +112,11 @@ def test_bench_identify_simulation_small(tmp_path, capsys):
     assert doc["criterion"] == "simulation" and doc["ipopt_status"] == "Solve_Succeeded"
     assert doc["cost"] <= doc["scipy_reference"]["cost"] * (1 + 1e-9)
     assert doc["cost"] <= doc["cost_initial"]
+
+
+def test_max_time_exits_one_with_one_line(npz, capsys):
+    assert main(["identify", str(npz), "--orders", "2,1,1,1,2,2", "--criterion", "simulation",
+                 "--max-time", "1e-9"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert any("warning" in e and "max_time" in e for e in err)
+    assert err[-1].startswith("casflutter: identification stopped at --max-time")

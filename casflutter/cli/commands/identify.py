@@ -4,6 +4,10 @@ With ``--search [GRID]`` the orders are first chosen by free-run error on the he
 part of the records (``--validation``, default 30 %): every candidate of the grid
 (default ``na=1:4 p=1:3 q=1:3`` around ``--orders``) is identified and scored, the table of
 candidates is printed, and the chosen orders are then identified on all the data.
+
+Exit status: 0 for a converged fit (also one stopped at the acceptable level, with a warning
+line), 1 for an error, a fit that did not converge or diverges in free run, or a fit stopped
+by ``--max-time`` (its best iterate is still reported and written).
 """
 
 from __future__ import annotations
@@ -12,6 +16,7 @@ import json
 import math
 import os
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -88,7 +93,7 @@ def _load(args):
 
 
 def _main(args) -> int:
-    from ...ident import identify, parse_grid, select_orders
+    from ...ident import IdentificationWarning, identify, parse_grid, select_orders
     from ...realize import realize
 
     # every argument checked before any work
@@ -105,14 +110,18 @@ def _main(args) -> int:
                     max_time=args.max_time)
     data = _load(args)
     selection = None
-    if args.search is not None:
-        selection = select_orders(data, grid, base=orders, validation=args.validation,
-                                  **settings)
-        orders = selection.best.orders
-        if not args.json:
-            print(selection.table())
-            print(f"identifying {orders} on all the data")
-    res = identify(data, orders, **settings)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", IdentificationWarning)
+        if args.search is not None:
+            selection = select_orders(data, grid, base=orders, validation=args.validation,
+                                      **settings)
+            orders = selection.best.orders
+            if not args.json:
+                print(selection.table())
+                print(f"identifying {orders} on all the data")
+        res = identify(data, orders, **settings)
+    for w in caught:   # one line each on stderr
+        print(f"casflutter: warning: {w.message}", file=sys.stderr)
     real = realize(res.model, args.nf if args.nf else "auto")
     if args.out:
         res.model.save(args.out)
@@ -139,9 +148,9 @@ def _main(args) -> int:
               f"(exact-order bound {real.exact_order_bound})")
         if args.out:
             print(f"model written to {args.out}")
-    if not res.success:
-        print(f"casflutter: identification not converged ({res.return_status}); the best "
-              "iterate is reported", file=sys.stderr)
+    if res.return_status in ("Maximum_WallTime_Exceeded",):
+        print(f"casflutter: identification stopped at --max-time ({res.return_status}); the "
+              "best iterate is reported", file=sys.stderr)
         return 1
     return 0
 
