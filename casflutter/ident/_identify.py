@@ -93,6 +93,9 @@ class IdentificationSettings:
         status ``Maximum_WallTime_Exceeded`` and an :class:`IdentificationWarning`.
     tol : float
         Relative tolerance of the Gauss--Newton solver (cost decrease, step, gradient).
+    estimate_initial : bool
+        Estimate the initial outputs of each record with the parameters (Gauss--Newton
+        solver); ``False`` starts every record from its measured outputs.
     ipopt_options : dict
         Flat CasADi/Ipopt options, e.g. ``{"ipopt.tol": 1e-10}`` (defaults in
         ``casflutter._nlp.DEFAULT_IPOPT_OPTIONS``, the one place they are set).
@@ -110,6 +113,7 @@ class IdentificationSettings:
     max_iter: int | None = None
     max_time: float | None = None
     tol: float = 1e-8
+    estimate_initial: bool = True
     ipopt_options: dict = field(default_factory=dict)
 
     def __post_init__(self):
@@ -121,7 +125,7 @@ class IdentificationSettings:
             bad("criterion", f"use one of {_CRITERIA}")
         if self.solver not in _SOLVERS:
             bad("solver", f"use one of {_SOLVERS}")
-        for name in ("refine", "scale_data", "offset", "accept_acceptable"):
+        for name in ("refine", "scale_data", "offset", "accept_acceptable", "estimate_initial"):
             if not _is_bool(getattr(self, name)):
                 bad(name, "give True or False")
         if not (isinstance(self.shooting_interval, (int, np.integer))
@@ -518,11 +522,12 @@ def identify(data: IOData, orders=(3, 1, 1, 1, 2, 2), *,
         cost0 = cost = float("nan")
     elif settings.criterion == "simulation" and settings.solver in ("auto", "gauss-newton"):
         solver = "gauss-newton"
-        problem = FreeRunProblem(structure, work, settings.regularization, theta0)
+        problem = FreeRunProblem(structure, work, settings.regularization, theta0,
+                                 estimate_initial=settings.estimate_initial)
         start = _stable_start(problem, structure, work, theta0, settings)
         lm = fit_simulation_error(problem, start, max_iter=settings.iteration_limit,
                                   tol=settings.tol, max_time=settings.max_time)
-        if lm.success or lm.return_status in _ACCEPTABLE:
+        if settings.estimate_initial and (lm.success or lm.return_status in _ACCEPTABLE):
             # estimated initial outputs can hide an unstable or badly damped mode that the
             # input does not excite: from the measured outputs such a model runs far worse
             measured = problem.cost(problem.x0(lm.theta))

@@ -299,3 +299,19 @@ def test_free_run_kernel_reports_divergence_index():
     assert div == 19
     assert np.all(np.isnan(ybuf[1 + div:]))
     np.testing.assert_allclose(ybuf[1:1 + div, 0], 2.0 ** np.arange(1, div + 1) - 1)
+
+
+def test_fixed_initial_outputs_option(mimo_truth):
+    """estimate_initial=False: the records start from their measured outputs, and the cost
+    is the free run from them (the criterion fit_report scores)."""
+    data = synthetic_data(mimo_truth, 1000, seed=6, noise=0.05)
+    res = identify(data, mimo_truth.orders, criterion="simulation", estimate_initial=False)
+    rec, L = data.records[0], mimo_truth.max_lag
+    H = res.initial_outputs[0].shape[0]
+    np.testing.assert_allclose(res.initial_outputs[0], rec.y[L - H:L], rtol=1e-12)
+    sy = data.scales()[0]
+    ysim = res.model.simulate(rec.u, rec.v, y0=rec.y[:L])
+    assert res.cost == pytest.approx(0.5 * np.mean(((ysim[L:] - rec.y[L:]) / sy) ** 2),
+                                     rel=1e-9)
+    free = identify(data, mimo_truth.orders, criterion="simulation")
+    assert free.cost <= res.cost * (1 + 1e-9)
