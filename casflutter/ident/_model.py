@@ -631,7 +631,7 @@ class HWLModel:
         DataError
             When a polynomial's slope vanishes at the shift (the normalisation cannot hold).
         """
-        N, o = self.n_modes, self.orders
+        N = self.n_modes
         sy = np.broadcast_to(np.asarray(y_shift, float), (N,))
         su = np.broadcast_to(np.asarray(0.0 if u_shift is None else u_shift, float), (N,))
         sv = float(0.0 if v_shift is None else v_shift)

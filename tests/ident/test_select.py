@@ -1,6 +1,5 @@
 """Order selection by held-out free-run error (issue 13, item 3)."""
 
-import numpy as np
 import pytest
 
 from casflutter.errors import ConfigError, OrderError
