@@ -397,14 +397,12 @@ def _free_run_failure(model: HWLModel, data: IOData) -> str | None:
     return None
 
 
-def _stable_start(problem: FreeRunProblem, structure, work, theta0, settings):
-    """``theta0``, or the prediction-error optimum from it when ``theta0`` runs unstable
-    (or ten times worse than the zero output) and the prediction optimum runs free better.
-    The Gauss--Newton fit then needs no segment continuation in most such cases."""
-    ref = 0.5 * problem.scale * 2 * sum(float(np.sum(r["target"] ** 2)) for r in problem.records)
+def _simulation_start(problem: FreeRunProblem, structure, work, theta0, settings):
+    """The start of the simulation-error fit: the better free run of ``theta0`` (stage 1)
+    and of the prediction-error optimum reached from it (the paper's two-stage estimate,
+    a cheap Ipopt solve), so that the free-run fit refines the two-stage method's result
+    and rarely needs the segment continuation."""
     cost0 = problem.cost(problem.x0(theta0))
-    if cost0 <= 10 * ref:
-        return theta0
     opts = {"ipopt.max_iter": settings.iteration_limit}
     if settings.max_time is not None:
         opts["ipopt.max_wall_time"] = float(settings.max_time) / 4
@@ -413,8 +411,8 @@ def _stable_start(problem: FreeRunProblem, structure, work, theta0, settings):
     if not np.all(np.isfinite(theta_p)):
         return theta0
     cost_p = problem.cost(problem.x0(theta_p))
-    log.info("simulation fit: the stage-1 start runs free with cost %.4e, the prediction-error "
-             "optimum (%s) with %.4e", cost0, res.return_status, cost_p)
+    log.info("simulation fit: free-run cost %.4e from stage 1, %.4e from the prediction-error "
+             "optimum (%s)", cost0, cost_p, res.return_status)
     return theta_p if cost_p < cost0 else theta0
 
 
@@ -524,7 +522,8 @@ def identify(data: IOData, orders=(3, 1, 1, 1, 2, 2), *,
         solver = "gauss-newton"
         problem = FreeRunProblem(structure, work, settings.regularization, theta0,
                                  estimate_initial=settings.estimate_initial)
-        start = _stable_start(problem, structure, work, theta0, settings)
+        start = (theta0 if start_model is not None
+                 else _simulation_start(problem, structure, work, theta0, settings))
         lm = fit_simulation_error(problem, start, max_iter=settings.iteration_limit,
                                   tol=settings.tol, max_time=settings.max_time)
         if settings.estimate_initial and (lm.success or lm.return_status in _ACCEPTABLE):
