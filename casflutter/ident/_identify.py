@@ -9,6 +9,7 @@ from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from .._nlp import DEFAULT_IPOPT_OPTIONS, NLPResult
 from ..data import IOData, Record
@@ -352,7 +353,7 @@ def _warn_offsets(data: IOData) -> None:
             warnings.warn(f"signal {name} has a mean of {float(mean.max()):.3g} against a "
                           f"standard deviation of {float(std[np.argmax(mean)]):.3g}; the HWL "
                           "model has no constant term: pass offset=True to identify it with one",
-                          IdentificationWarning, stacklevel=3)
+                          IdentificationWarning, stacklevel=4)
             return
 
 
@@ -465,6 +466,13 @@ def identify(data: IOData, orders=(3, 1, 1, 1, 2, 2), *,
     >>> print(res.summary())                             # doctest: +SKIP
     """
     settings = IdentificationSettings.build(settings, **kwargs)
+    # single-threaded BLAS: the factorisations here are too small to gain from threads on a
+    # shared machine, and the result then does not depend on the thread count
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _identify(data, orders, settings, initial)
+
+
+def _identify(data, orders, settings: IdentificationSettings, initial) -> IdentificationResult:
     if not isinstance(data, IOData):
         raise DataError(f"data must be an IOData, got {type(data).__name__}; build one with "
                         "IOData.from_arrays(y=..., u=..., v=..., dt=...)")
@@ -586,12 +594,12 @@ def identify(data: IOData, orders=(3, 1, 1, 1, 2, 2), *,
     if status in _ACCEPTABLE and settings.accept_acceptable:
         warnings.warn(f"stage 2 stopped at the acceptable level ({status}, {iters} iterations, "
                       f"cost {cost0:.3e} -> {cost:.3e}); the result is returned",
-                      IdentificationWarning, stacklevel=2)
+                      IdentificationWarning, stacklevel=3)
         return result
     if status in _TIMEOUT:
         warnings.warn(f"stage 2 reached max_time={settings.max_time} s after {iters} "
                       f"iterations (cost {cost0:.3e} -> {cost:.3e}); the best iterate is "
-                      "returned", IdentificationWarning, stacklevel=2)
+                      "returned", IdentificationWarning, stacklevel=3)
         return result
     raise ConvergenceError(
         f"stage 2 ({settings.criterion} criterion, {solver}) did not converge: status "

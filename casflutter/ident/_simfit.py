@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import LinAlgError, cho_factor, cho_solve
+from threadpoolctl import threadpool_limits
 
 from ..data import IOData
 from ._kernels import free_run, sensitivities
@@ -407,6 +408,15 @@ def fit_simulation_error(problem: FreeRunProblem, theta0, *, max_iter: int = 500
     -------
     LMResult
     """
+    # single-threaded BLAS inside the fit: the products are too small to gain from threads on
+    # a shared machine (where they lose several times over), and the result then does not
+    # depend on the thread count
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _fit(problem, theta0, max_iter=max_iter, tol=tol, max_time=max_time,
+                    blowup=blowup)
+
+
+def _fit(problem, theta0, *, max_iter, tol, max_time, blowup) -> LMResult:
     t0 = time.perf_counter()
     deadline = np.inf if max_time is None else t0 + float(max_time)
     x = problem.x0(theta0)
