@@ -116,21 +116,25 @@ def _critical_vectors(A: np.ndarray, target: complex):
     return lam[k], q, p
 
 
-def _scan(measure, vrange, n_grid, what):
+def _scan(measure, vrange, n_grid, what, speed_scale=1.0, speed_unit=""):
     lo, hi = map(float, vrange)
     grid = np.linspace(lo, hi, n_grid)
     vals = np.array([measure(v) for v in grid])
+    u = f" {speed_unit}" if speed_unit else ""
     if vals[0] >= 0:
         raise ConfigError(f"the equilibrium is already unstable at the start of the speed range "
-                          f"V = {lo:g} ({what} {vals[0]:.3g} >= 0): lower the range's start")
+                          f"{lo * speed_scale:g}{u} ({what} {vals[0]:.3g} >= 0): lower the "
+                          "range's start (--vrange)")
     for k in range(1, n_grid):
         if vals[k - 1] < 0 <= vals[k]:
             return brentq(measure, grid[k - 1], grid[k], xtol=1e-13 * max(1.0, hi), rtol=1e-14)
-    raise ConfigError(f"no Hopf point in the speed range [{lo:g}, {hi:g}]: the equilibrium stays "
-                      f"stable ({what} {vals.max():.3g} at most); widen the range (--vrange)")
+    raise ConfigError(f"no flutter (Hopf) point in the speed range [{lo * speed_scale:g}, "
+                      f"{hi * speed_scale:g}]{u}: the equilibrium stays stable ({what} "
+                      f"{vals.max():.3g} at most); widen the range (--vrange)")
 
 
-def find_hopf(forms: MultilinearForms, vrange, n_grid: int = 121) -> CriticalPair:
+def find_hopf(forms: MultilinearForms, vrange, n_grid: int = 121, *, speed_scale: float = 1.0,
+              speed_unit: str = "") -> CriticalPair:
     """First Hopf point of the flow in ``vrange``: the abscissa of the oscillatory
     eigenvalues crossing zero (a real eigenvalue through zero is not a Hopf point).
 
@@ -144,7 +148,8 @@ def find_hopf(forms: MultilinearForms, vrange, n_grid: int = 121) -> CriticalPai
         osc = lam[np.abs(lam.imag) > 1e-9 * max(1.0, np.max(np.abs(lam)))]
         return float(np.max(osc.real)) if osc.size else -np.inf
 
-    Vh = _scan(abscissa, vrange, n_grid, "spectral abscissa of the oscillatory eigenvalues")
+    Vh = _scan(abscissa, vrange, n_grid, "spectral abscissa of the oscillatory eigenvalues",
+               speed_scale, speed_unit)
     A = forms.A(Vh)
     lam = np.linalg.eigvals(A)
     osc = lam[np.abs(lam.imag) > 0]
@@ -155,7 +160,8 @@ def find_hopf(forms: MultilinearForms, vrange, n_grid: int = 121) -> CriticalPai
     return CriticalPair(float(Vh), complex(ev), q, p, rate, A)
 
 
-def find_neimark_sacker(forms: MultilinearForms, vrange, n_grid: int = 121) -> CriticalPair:
+def find_neimark_sacker(forms: MultilinearForms, vrange, n_grid: int = 121, *,
+                        speed_scale: float = 1.0, speed_unit: str = "") -> CriticalPair:
     """First Neimark--Sacker point of the map in ``vrange``: the spectral radius of the
     complex eigenvalues crossing one.
 
@@ -169,7 +175,8 @@ def find_neimark_sacker(forms: MultilinearForms, vrange, n_grid: int = 121) -> C
         osc = lam[np.abs(lam.imag) > 1e-9]
         return float(np.max(np.abs(osc))) - 1.0 if osc.size else -np.inf
 
-    Vns = _scan(radius, vrange, n_grid, "spectral radius - 1 of the complex eigenvalues")
+    Vns = _scan(radius, vrange, n_grid, "spectral radius - 1 of the complex eigenvalues",
+                speed_scale, speed_unit)
     A = forms.A(Vns)
     lam = np.linalg.eigvals(A)
     osc = lam[np.abs(lam.imag) > 1e-9]

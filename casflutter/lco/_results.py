@@ -119,6 +119,9 @@ class LCOPoint:
         ``max_multiplier < 1``.
     trivial_error : float
         ``|mu_trivial - 1|``: the accuracy of the computed multipliers.
+    state : numpy.ndarray
+        A state on the orbit (phase zero): the initial state of a simulation that starts
+        on the LCO (the truth's ``[u, u', lags]``; the ROM loop's map state).
     """
 
     V: float
@@ -130,6 +133,7 @@ class LCOPoint:
     max_multiplier: float
     stable: bool
     trivial_error: float
+    state: np.ndarray = field(default=None, repr=False)
 
     def to_dict(self, speed=float) -> dict:
         """``{"V", "freq_hz", "amplitude", "stable"}`` with the speed converted by ``speed``."""

@@ -381,7 +381,7 @@ class _MapDisc:
                         amplitude={n: float(a) for n, a in zip(self.names, amp)},
                         mean={n: float(a) for n, a in zip(self.names, mean)},
                         multipliers=mults, max_multiplier=normal, stable=bool(normal < 1.0),
-                        trivial_error=tang)
+                        trivial_error=tang, state=S[:, 0].copy())
 
 
 def rom_lco_branch(rom: HWLModel, structure: ModalStructure, vrange, settings: LCOSettings | None = None,
@@ -430,12 +430,14 @@ def rom_lco_branch(rom: HWLModel, structure: ModalStructure, vrange, settings: L
     names, units, hfun = _rom_outputs(rom, structure, settings.sensor_kind, mode_names,
                                       sensor_names)
     forms = MultilinearForms(F)
-    cp = find_neimark_sacker(forms, (lo, hi), settings.n_grid)
+    cp = find_neimark_sacker(forms, (lo, hi), settings.n_grid, speed_scale=speed_scale,
+                             speed_unit=speed_unit)
     d = lyapunov_map(forms, cp)
     t_hopf = time.perf_counter() - t0
     theta0 = abs(np.angle(cp.eigenvalue))
     if not math.isfinite(d) or abs(d) < 1e-14:
-        raise ConfigError(f"the Neimark-Sacker point at V = {cp.V:.6g} is degenerate (critical "
+        raise ConfigError(f"the Neimark-Sacker point at {cp.V * speed_scale:.6g} {speed_unit} is "
+                          f"degenerate (critical "
                           f"coefficient {d:.3g}): no LCO branch leaves it")
     N = rom.n_modes
     dom = int(np.argmax(np.abs(cp.q[:2 * N:2])) * 2)       # largest modal displacement

@@ -126,7 +126,7 @@ class _OdeDisc:
                         amplitude={n: float(a) for n, a in zip(names, amp)},
                         mean={n: float(a) for n, a in zip(names, mean)},
                         multipliers=mu, max_multiplier=mmax, stable=bool(mmax < 1.0),
-                        trivial_error=float(abs(mu[k] - 1.0)))
+                        trivial_error=float(abs(mu[k] - 1.0)), state=x0.copy())
 
 
 def _state_scale(q: np.ndarray) -> np.ndarray:
@@ -172,12 +172,14 @@ def continue_lco(f: ca.Function, outputs: Outputs, vrange, settings: LCOSettings
         raise ConfigError(f"vrange = ({lo}, {hi}) must satisfy 0 < lo < hi")
     t0 = time.perf_counter()
     forms = MultilinearForms(f)
-    cp = find_hopf(forms, (lo, hi), settings.n_grid)
+    cp = find_hopf(forms, (lo, hi), settings.n_grid, speed_scale=speed_scale,
+                   speed_unit=speed_unit)
     l1 = lyapunov_flow(forms, cp)
     omega = cp.eigenvalue.imag
     t_hopf = time.perf_counter() - t0
     if not math.isfinite(l1) or abs(l1) < 1e-14 * max(1.0, np.max(np.abs(cp.A))):
-        raise ConfigError(f"the Hopf point at V = {cp.V:.6g} is degenerate (first Lyapunov "
+        raise ConfigError(f"the Hopf point at {cp.V * speed_scale:.6g} {speed_unit} is degenerate "
+                          f"(first Lyapunov "
                           f"coefficient {l1:.3g}): the system has no nonlinearity acting at "
                           "third order (e.g. a linear truth), so no LCO branch leaves it")
     nd = int(n_modes) if n_modes else cp.q.size
@@ -209,7 +211,8 @@ def continue_lco(f: ca.Function, outputs: Outputs, vrange, settings: LCOSettings
             first = res
             break
     if first is None:
-        raise ConvergenceError(f"the first periodic orbit next to the Hopf point V = {cp.V:.6g} "
+        raise ConvergenceError(f"the first periodic orbit next to the Hopf point at "
+                               f"{cp.V * speed_scale:.6g} {speed_unit} "
                                f"did not converge ({res.return_status}, residual "
                                f"{res.residual:.3g}); try more mesh intervals", res)
     X1 = first.x
