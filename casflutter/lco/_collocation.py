@@ -118,6 +118,15 @@ class Collocation:
         s = np.concatenate([[0.0], self.c])
         return np.concatenate([(i + s) / self.N for i in range(self.N)])
 
+    def collocation_times(self) -> np.ndarray:
+        """Scaled times ``tau`` of the Gauss points (interval-major)."""
+        return np.concatenate([(i + self.c) / self.N for i in range(self.N)])
+
+    def reference_from(self, derivative_fun) -> np.ndarray:
+        """A phase reference from ``derivative_fun(tau) -> (n, len(tau))``, the derivative of
+        a reference orbit with respect to ``tau``."""
+        return np.asarray(derivative_fun(self.collocation_times()), float).ravel(order="F")
+
     def initial_guess(self, shape_fun, T: float, V: float) -> np.ndarray:
         """Unknowns from ``shape_fun(tau) -> (n, len(tau))``."""
         return self.pack(shape_fun(self.node_times()), T, V)

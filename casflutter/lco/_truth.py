@@ -200,7 +200,8 @@ def continue_lco(f: ca.Function, outputs: Outputs, vrange, settings: LCOSettings
 
     phi = col.initial_guess(mode, 0.0, 0.0)
     phi[col.iT] = phi[col.iV] = 0.0
-    dphi = col.reference(col.initial_guess(mode, T0, cp.V))
+    dphi = col.reference_from(
+        lambda tau: np.real(2j * math.pi * qhat[:, None] * np.exp(2j * math.pi * tau)[None, :]))
     c_amp = phi / col.npts
     s_amp = eps * float(c_amp @ phi)
     first = None
