@@ -62,7 +62,7 @@ def tangent(disc, X: np.ndarray, ref: np.ndarray, c: np.ndarray, M: np.ndarray,
     return t / math.sqrt(float(np.sum(M * t * t)))
 
 
-def _locate_fold(disc, Xk, tk, ds, tv0, tv1, M, settings, vref):
+def _locate_fold(disc, Xk, tk, ds, tv0, tv1, M, settings):
     """Secant (Illinois) on the arclength ``s`` in ``(0, ds)`` for ``t_V(s) = 0``."""
     iV = disc.iV
     ref = disc.reference(Xk)
@@ -160,8 +160,7 @@ def continue_branch(disc, X1: np.ndarray, t1: np.ndarray, M: np.ndarray, setting
             break
         pn = disc.evaluate(Xn)
         if tk[iV] * tn[iV] < 0:
-            found = _locate_fold(disc, Xk, tk, step, float(tk[iV]), float(tn[iV]), M, settings,
-                                 V_ref)
+            found = _locate_fold(disc, Xk, tk, step, float(tk[iV]), float(tn[iV]), M, settings)
             if found is not None:
                 pf = disc.evaluate(found[0])
                 folds.append(Fold(V=float(found[0][iV]), amplitude=dict(pf.amplitude),

@@ -319,14 +319,6 @@ class LCOBranch:
         """Unit of output ``name``."""
         return self.output_units[self.outputs.index(name)]
 
-    def dominant_output(self) -> str:
-        """The output with the largest amplitude relative to its first branch value (the
-        one that carries the LCO), among those with a unit if any has one."""
-        last = self.points[-1].amplitude
-        first = self.points[0].amplitude
-        cands = [n for n, u in zip(self.outputs, self.output_units) if u] or list(self.outputs)
-        return max(cands, key=lambda n: last[n] / max(first[n], 1e-300) if first[n] > 0 else 0.0)
-
     def to_dict(self) -> dict:
         """The JSON document of ``casflutter lco`` (speeds in the problem's unit)."""
         h = self.hopf

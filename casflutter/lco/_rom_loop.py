@@ -353,7 +353,7 @@ class _MapDisc:
         self.dt = dt
         self._theta = 2.0 * np.pi * np.arange(n_fine) / n_fine
         self._h = outputs.map(n_fine)
-        self.w2 = None
+        self.w2 = np.ones((circ.n, 1))     # state weights of size(); set from the mode shape
 
     def solve(self, X0, ref, c, s):
         return self.circ.solve(X0, ref, c, s)
@@ -481,7 +481,7 @@ def rom_lco_branch(rom: HWLModel, structure: ModalStructure, vrange, settings: L
                         [1.0 / rho0 ** 2, 1.0 / (0.05 * cp.V) ** 2]])
     disc.w2 = (1.0 / dsc ** 2)[:, None]
     t1 = tangent(disc, X1, circ.reference(X1), c_amp, M)
-    hopf = HopfClassification(V=cp.V, omega=theta0 / float(rom.dt), freq_hz=rho0 / float(rom.dt),
+    hopf = HopfClassification(V=cp.V, omega=float(theta0 / rom.dt), freq_hz=float(rho0 / rom.dt),
                               lyapunov=d, crossing_rate=cp.crossing_rate, kind=kind,
                               branch_direction=direction, kind_from_branch=kind_branch,
                               consistent=kind == kind_branch, predicted_dV=dV_pred,

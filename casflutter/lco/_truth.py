@@ -55,8 +55,7 @@ def truth_outputs(truth, f: ca.Function, sensor_kind: str = "displacement") -> O
     V = ca.SX.sym("V")
     H = ca.DM(np.asarray(ms.sensor_rows, float))
     names, units, rows = [], [], []
-    nm = truth._names()
-    sunits = tuple(nm.get("sensor_units", ("",) * len(ms.sensor_names)))
+    sunits = truth.sensor_units()
     if getattr(truth, "lco_modal_outputs", True):
         names += list(ms.mode_names)
         units += [""] * N
@@ -90,6 +89,7 @@ class _OdeDisc:
         self.iV = col.iV
         self.outputs = outputs
         self._h = outputs.function.map(col.N * 16)
+        self.w2 = np.ones((col.n, 1))      # state weights of size(); set from the mode shape
 
     def solve(self, X0, ref, c, s):
         return self.col.solve(X0, ref, c, s)

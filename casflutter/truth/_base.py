@@ -257,6 +257,11 @@ class AeroelasticTruth(abc.ABC):
                               sensor_names=tuple(nm["sensor_names"]),
                               time_unit=nm["time_unit"], speed_index=nm["speed_index"])
 
+    def sensor_units(self) -> tuple[str, ...]:
+        """Units of the sensor rows' readings (``""`` where the problem gives none)."""
+        nm = self._names()
+        return tuple(nm.get("sensor_units", ("",) * len(nm["sensor_names"])))
+
     def _check_V(self, V: float) -> float:
         V = float(V)
         if not np.isfinite(V) or V <= 0:
