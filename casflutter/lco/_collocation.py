@@ -184,15 +184,15 @@ class Collocation:
         Jall = np.asarray(self._fx(W[:, self.colidx], np.full((1, N * m), V)))   # (n, n N m)
         h = 1.0 / N
         I = np.eye(n)
-        Dk = np.kron(self.D, I)                           # (m n, (m+1) n): sum_j D[k,j] w_j
+        # E[i] = sum_j D[k, j] dw_j - h T J_ik dw_k per interval, all intervals stacked
+        E = np.broadcast_to(np.kron(self.D, I), (N, m * n, (m + 1) * n)).copy()
+        J = Jall.reshape(n, N, m, n).transpose(1, 2, 0, 3)          # (N, m, n, n)
+        for k in range(m):
+            E[:, k * n:(k + 1) * n, (k + 1) * n:(k + 2) * n] -= h * T * J[:, k]
+        S = np.linalg.solve(E[:, :, n:], E[:, :, :n])               # interior from the start
+        Lint = np.kron(self.ell1[1:][None, :], I)                   # (n, m n)
+        Mi = self.ell1[0] * I - np.matmul(Lint, S)                  # (N, n, n)
         Mtot = np.eye(n)
-        Lint = np.kron(self.ell1[1:][None, :], I)          # (n, m n)
         for i in range(N):
-            E = Dk.copy()
-            for k in range(m):
-                J = Jall[:, (i * m + k) * n:(i * m + k + 1) * n]
-                E[k * n:(k + 1) * n, (k + 1) * n:(k + 2) * n] -= h * T * J
-            E0, Ei = E[:, :n], E[:, n:]
-            Mi = self.ell1[0] * I - Lint @ np.linalg.solve(Ei, E0)
-            Mtot = Mi @ Mtot
+            Mtot = Mi[i] @ Mtot
         return Mtot
