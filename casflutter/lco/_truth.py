@@ -62,7 +62,8 @@ def truth_outputs(truth, f: ca.Function, sensor_kind: str = "displacement") -> O
         rows.append(x[:N])
     if sensor_kind == "acceleration":
         rows.append(ca.mtimes(H, f(x, V)[N:2 * N]))
-        units += [f"{u}/{ms.time_unit}^2" if u else "" for u in sunits]
+        tu = ms.time_unit if ms.time_unit.isalpha() else f"({ms.time_unit})"
+        units += [f"{u}/{tu}^2" if u else "" for u in sunits]
     else:
         rows.append(ca.mtimes(H, x[:N]))
         units += list(sunits)

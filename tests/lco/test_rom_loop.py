@@ -94,3 +94,18 @@ def test_circles_against_simulate_loop(loop, branch, target):
     for j, name in enumerate(ms.sensor_names):
         assert sim.sensors.amplitude[j] == pytest.approx(p.amplitude[name], rel=0.02), name
     assert sim.modes.frequency_hz == pytest.approx(p.freq_hz, rel=0.02)
+
+
+def test_accelerometer_outputs_against_simulate_loop(loop):
+    """With sensor_kind="acceleration" the sensors are Hs u'' read at t_k as simulate_loop
+    reads accelerometers (the held force of the previous step)."""
+    rom, st, ms = loop
+    acc = ModalStructure(st.omega, st.zeta, st.alpha, Hs=st.Hs, sensor="acceleration")
+    br = rom_lco_branch(rom, acc, (0.6, 1.32), LCOSettings(harmonics=8, sensor_kind="acceleration"),
+                        mode_names=ms.mode_names, sensor_names=ms.sensor_names)
+    p = br.points[-1]
+    xs0 = np.zeros(2 * rom.n_modes)
+    xs0[2] = 0.01
+    sim = simulate_loop(rom, acc, p.V, 25000, xs0=xs0, window=0.2)
+    for j, name in enumerate(ms.sensor_names):
+        assert sim.sensors.amplitude[j] == pytest.approx(p.amplitude[name], rel=0.02), name

@@ -140,3 +140,16 @@ def test_subcritical_spring_has_a_fold_and_hysteresis():
     stable_f = np.interp(pu.V, Vs, [p.freq_hz for p in br.points[i + 1:]])
     assert amp == pytest.approx(stable_amp, rel=0.02)
     assert freq == pytest.approx(stable_f, rel=0.02)
+
+
+def test_acceleration_sensors_are_the_second_derivative(cubic):
+    """Sensors read as accelerations: near the Hopf point the cycle is nearly harmonic, so
+    their amplitude is (2 pi f)^2 times the displacement amplitude (1 %)."""
+    truth, disp = cubic
+    acc = lco_branch(truth, (1.5, 2.8), LCOSettings(sensor_kind="acceleration", max_points=4))
+    p = acc.points[-1]
+    q = min(disp.points, key=lambda z: abs(z.V - p.V))
+    assert q.V == pytest.approx(p.V, rel=1e-9)
+    w2 = (2 * np.pi * p.freq_hz) ** 2
+    assert p.amplitude["theta"] == pytest.approx(w2 * q.amplitude["theta"], rel=0.01)
+    assert acc.unit_of("theta") == "rad/(1/omega_theta)^2"
