@@ -22,9 +22,10 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
-from ._results import Fold, LCOPoint, LCOSettings
+from ..errors import ConvergenceError
+from ._results import SUBCRITICAL, SUPERCRITICAL, Fold, HopfClassification, LCOSettings
 
-__all__ = ["BranchRun", "continue_branch", "tangent"]
+__all__ = ["BranchRun", "BranchStart", "continue_branch", "run_from_hopf", "tangent"]
 
 log = logging.getLogger("casflutter.lco")
 
@@ -195,3 +196,119 @@ def continue_branch(disc, X1: np.ndarray, t1: np.ndarray, M: np.ndarray, setting
             break
     return BranchRun(X=X, points=pts, tangents=T, folds=folds, completed=completed,
                      stop_reason=reason)
+
+
+@dataclass(frozen=True)
+class BranchStart:
+    """What a discretisation provides to start a branch at a Hopf/Neimark--Sacker point.
+
+    Attributes
+    ----------
+    cp : CriticalPair
+        The critical pair (:mod:`._normal_form`).
+    lyapunov : float
+        ``l1`` (flow) or ``d`` (map).
+    radial : float
+        The cubic coefficient of the radial normal form, ``r' = mu r + radial r^3``
+        (``omega l1``) or ``r -> r (1 + beta + radial r^2)`` (``d``).
+    omega, freq_hz : float
+        Frequency of the critical pair.
+    discrete : bool
+    qhat : numpy.ndarray
+        The critical eigenvector scaled to 1 on its dominant displacement.
+    dominant : int
+        That displacement's index.
+    guess : callable
+        ``(amplitude, V) -> X0``: the mode with that amplitude, period at the Hopf value.
+    phi : numpy.ndarray
+        The mode of unit amplitude as an unknown vector (period and speed entries zero).
+    ref : numpy.ndarray
+        Its phase reference.
+    n_points : int
+        Orbit points per state in the unknowns.
+    period0 : float
+        Scale of the period-like unknown (period or rotation number at the Hopf point).
+    hint : str
+        What to try when the first orbit fails.
+    """
+
+    cp: object
+    lyapunov: float
+    radial: float
+    omega: float
+    freq_hz: float
+    discrete: bool
+    qhat: np.ndarray
+    dominant: int
+    guess: object
+    phi: np.ndarray
+    ref: np.ndarray
+    n_points: int
+    period0: float
+    hint: str
+
+
+def run_from_hopf(disc, start: BranchStart, settings: LCOSettings, vrange: tuple, *,
+                  speed_scale: float, speed_unit: str):
+    """Solve the first orbit next to the Hopf point, classify the point, continue.
+
+    The first orbit's amplitude along the critical mode is the one for which the normal
+    form predicts a speed offset of ``start_offset`` times the Hopf speed; the orbit is
+    solved with that amplitude fixed (its speed free), and the direction and size of the
+    offset found check the Lyapunov coefficient.
+
+    Returns
+    -------
+    (HopfClassification, BranchRun)
+
+    Raises
+    ------
+    ConvergenceError
+        The first orbit did not converge.
+    """
+    cp = start.cp
+    dV_target = settings.start_offset * cp.V
+    r = math.sqrt(dV_target * abs(cp.crossing_rate) / abs(start.radial))
+    eps = 2.0 * r * abs(cp.q[start.dominant])
+    dV_pred = -start.radial * r * r / cp.crossing_rate
+    phi = start.phi
+    c_amp = phi / start.n_points
+    s_amp = eps * float(c_amp @ phi)
+    first = None
+    for guess_dV in (dV_pred, -dV_pred, 0.0):
+        res = disc.solve(start.guess(eps, cp.V + guess_dV), start.ref, c_amp, s_amp)
+        if res.success:
+            first = res
+            break
+    if first is None:
+        what = "invariant circle" if start.discrete else "periodic orbit"
+        point = "Neimark-Sacker" if start.discrete else "Hopf"
+        raise ConvergenceError(f"the first {what} next to the {point} point at "
+                               f"{cp.V * speed_scale:.6g} {speed_unit} did not converge "
+                               f"({res.return_status}, residual {res.residual:.3g}); "
+                               f"{start.hint}", res)
+    X1 = first.x
+    dV1 = float(X1[disc.iV] - cp.V)
+    direction = 1 if dV1 > 0 else -1
+    kind = SUPERCRITICAL if start.lyapunov < 0 else SUBCRITICAL
+    kind_branch = SUPERCRITICAL if direction * cp.crossing_rate > 0 else SUBCRITICAL
+    # metric: the orbit in units of a reference amplitude (the amplitude at a 5 % speed
+    # change on the parabola through the first orbit), the period and the speed relative
+    Aref = eps * math.sqrt(0.05 * cp.V / max(abs(dV1), 1e-12 * cp.V))
+    Aref = min(max(Aref, eps), 1e4 * eps)
+    d = np.abs(start.qhat)
+    d = np.maximum(d, 1e-3 * d.max())
+    M = np.concatenate([np.tile(1.0 / (start.n_points * (Aref * d) ** 2), start.n_points),
+                        [1.0 / start.period0 ** 2, 1.0 / (0.05 * cp.V) ** 2]])
+    disc.w2 = (1.0 / d ** 2)[:, None]
+    t1 = tangent(disc, X1, disc.reference(X1), c_amp, M)
+    hopf = HopfClassification(V=cp.V, omega=float(start.omega), freq_hz=float(start.freq_hz),
+                              lyapunov=float(start.lyapunov), crossing_rate=cp.crossing_rate,
+                              kind=kind, branch_direction=direction, kind_from_branch=kind_branch,
+                              consistent=kind == kind_branch, predicted_dV=dV_pred,
+                              computed_dV=dV1, eigenvector=cp.q, discrete=start.discrete)
+    if not hopf.consistent:
+        log.warning("the Lyapunov coefficient (%s) and the branch direction (%s) disagree at "
+                    "V = %.6g", kind, kind_branch, cp.V)
+    run = continue_branch(disc, X1, t1, M, settings, vrange, cp.V, disc.size(X1))
+    return hopf, run

@@ -34,7 +34,6 @@ circle's normal multiplier over one LCO period (below 1: stable).
 
 from __future__ import annotations
 
-import logging
 import math
 import time
 
@@ -47,15 +46,11 @@ from .._nlp import RootResult, solve_newton
 from ..aeroelastic import ModalStructure
 from ..errors import ConfigError, ConvergenceError, DimensionError
 from ..ident import HWLModel, hwl_predict_function
-from ._branch import continue_branch, tangent
+from ._branch import BranchStart, run_from_hopf
 from ._normal_form import MultilinearForms, find_neimark_sacker, lyapunov_map
-from ._results import (SUBCRITICAL, SUPERCRITICAL, HopfClassification, LCOBranch, LCOPoint,
-                       LCOSettings)
+from ._results import LCOBranch, LCOPoint, LCOSettings
 
 __all__ = ["rom_loop_map", "InvariantCircle", "rom_lco_branch"]
-
-log = logging.getLogger("casflutter.lco")
-
 
 def rom_loop_map(rom: HWLModel, structure: ModalStructure) -> ca.Function:
     """The sampled-data ROM loop as a CasADi map ``F(s, V) -> s_next`` (module docstring).
@@ -442,10 +437,6 @@ def rom_lco_branch(rom: HWLModel, structure: ModalStructure, vrange, settings: L
     N = rom.n_modes
     dom = int(np.argmax(np.abs(cp.q[:2 * N:2])) * 2)       # largest modal displacement
     qhat = cp.q * np.exp(-1j * np.angle(cp.q[dom])) / abs(cp.q[dom])
-    dV_target = settings.start_offset * cp.V
-    r = math.sqrt(dV_target * abs(cp.crossing_rate) / abs(d))
-    eps = 2.0 * r * abs(cp.q[dom])
-    dV_pred = -d * r * r / cp.crossing_rate
     circ = InvariantCircle(F, settings.harmonics, tol=settings.tol,
                            max_newton=settings.max_newton)
     disc = _MapDisc(circ, names, hfun, float(rom.dt))
@@ -454,43 +445,14 @@ def rom_lco_branch(rom: HWLModel, structure: ModalStructure, vrange, settings: L
     mode_vals = np.real(qhat[:, None] * np.exp(1j * circ.theta)[None, :])
     phi = circ.from_values(mode_vals, 0.0, 0.0)
     phi[circ.irho] = phi[circ.iV] = 0.0
-    ref = circ.reference(phi)
-    c_amp = phi / circ.M
-    s_amp = eps * float(c_amp @ phi)
-    first = None
-    for guess_dV in (dV_pred, -dV_pred, 0.0):
-        res = circ.solve(circ.from_values(eps * mode_vals, rho0, cp.V + guess_dV), ref, c_amp,
-                         s_amp)
-        if res.success:
-            first = res
-            break
-    if first is None:
-        raise ConvergenceError(f"the first invariant circle next to the Neimark-Sacker point "
-                               f"V = {cp.V:.6g} did not converge ({res.return_status}, residual "
-                               f"{res.residual:.3g}); try more harmonics", res)
-    X1 = first.x
-    dV1 = float(X1[circ.iV] - cp.V)
-    direction = 1 if dV1 > 0 else -1
-    kind = SUPERCRITICAL if d < 0 else SUBCRITICAL
-    kind_branch = SUPERCRITICAL if direction * cp.crossing_rate > 0 else SUBCRITICAL
-    Aref = eps * math.sqrt(0.05 * cp.V / max(abs(dV1), 1e-12 * cp.V))
-    Aref = min(max(Aref, eps), 1e4 * eps)
-    dsc = np.abs(qhat)
-    dsc = np.maximum(dsc, 1e-3 * dsc.max())
-    M = np.concatenate([np.tile(1.0 / (circ.M * (Aref * dsc) ** 2), circ.M),
-                        [1.0 / rho0 ** 2, 1.0 / (0.05 * cp.V) ** 2]])
-    disc.w2 = (1.0 / dsc ** 2)[:, None]
-    t1 = tangent(disc, X1, circ.reference(X1), c_amp, M)
-    hopf = HopfClassification(V=cp.V, omega=float(theta0 / rom.dt), freq_hz=float(rho0 / rom.dt),
-                              lyapunov=d, crossing_rate=cp.crossing_rate, kind=kind,
-                              branch_direction=direction, kind_from_branch=kind_branch,
-                              consistent=kind == kind_branch, predicted_dV=dV_pred,
-                              computed_dV=dV1, eigenvector=cp.q, discrete=True)
-    if not hopf.consistent:
-        log.warning("the Neimark-Sacker coefficient (%s) and the branch direction (%s) disagree "
-                    "at V = %.6g", kind, kind_branch, cp.V)
+    start = BranchStart(
+        cp=cp, lyapunov=d, radial=d, omega=theta0 / float(rom.dt),
+        freq_hz=rho0 / float(rom.dt), discrete=True, qhat=qhat, dominant=dom,
+        guess=lambda eps, V: circ.from_values(eps * mode_vals, rho0, V), phi=phi,
+        ref=circ.reference(phi), n_points=circ.M, period0=rho0, hint="try more harmonics")
     t1b = time.perf_counter()
-    run = continue_branch(disc, X1, t1, M, settings, (lo, hi), cp.V, disc.size(X1))
+    hopf, run = run_from_hopf(disc, start, settings, (lo, hi), speed_scale=speed_scale,
+                              speed_unit=speed_unit)
     t_branch = time.perf_counter() - t1b
     return LCOBranch(problem=problem, system="rom_loop", hopf=hopf, points=tuple(run.points),
                      folds=tuple(run.folds), outputs=names, output_units=units,

@@ -10,7 +10,6 @@ first Lyapunov coefficient (:mod:`._normal_form`).
 
 from __future__ import annotations
 
-import logging
 import math
 import time
 from dataclasses import dataclass
@@ -18,19 +17,15 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from ..errors import ConfigError, ConvergenceError
+from ..errors import ConfigError
 from ..truth import problem_definition
-from ._branch import continue_branch, tangent
+from ._branch import BranchStart, run_from_hopf
 from ._collocation import Collocation
 from ._normal_form import MultilinearForms, find_hopf, lyapunov_flow
-from ._results import (SUBCRITICAL, SUPERCRITICAL, HopfClassification, LCOBranch, LCOPoint,
-                       LCOSettings)
+from ._results import LCOBranch, LCOPoint, LCOSettings
 
 __all__ = ["Outputs", "truth_outputs", "speed_convention", "lco_branch", "continue_lco",
            "default_vrange"]
-
-log = logging.getLogger("casflutter.lco")
-
 
 @dataclass(frozen=True)
 class Outputs:
@@ -130,11 +125,6 @@ class _OdeDisc:
                         trivial_error=float(abs(mu[k] - 1.0)), state=x0.copy())
 
 
-def _state_scale(q: np.ndarray) -> np.ndarray:
-    d = np.abs(q)
-    return np.maximum(d, 1e-3 * d.max())
-
-
 def continue_lco(f: ca.Function, outputs: Outputs, vrange, settings: LCOSettings | None = None,
                  *, problem: str = "", speed_scale: float = 1.0, speed_unit: str = "",
                  time_unit: str = "s", n_modes: int | None = None) -> LCOBranch:
@@ -186,11 +176,6 @@ def continue_lco(f: ca.Function, outputs: Outputs, vrange, settings: LCOSettings
     nd = int(n_modes) if n_modes else cp.q.size
     dom = int(np.argmax(np.abs(cp.q[:nd])))
     qhat = cp.q * np.exp(-1j * np.angle(cp.q[dom])) / abs(cp.q[dom])
-    # first orbit: speed offset start_offset * V_H predicted by the normal form
-    dV_target = settings.start_offset * cp.V
-    r = math.sqrt(dV_target * abs(cp.crossing_rate) / (omega * abs(l1)))
-    eps = 2.0 * r * abs(cp.q[dom])
-    dV_pred = -omega * l1 * r * r / cp.crossing_rate
     col = Collocation(f, settings.n_intervals, settings.degree, tol=settings.tol,
                       max_newton=settings.max_newton)
     disc = _OdeDisc(col, outputs)
@@ -201,46 +186,16 @@ def continue_lco(f: ca.Function, outputs: Outputs, vrange, settings: LCOSettings
 
     phi = col.initial_guess(mode, 0.0, 0.0)
     phi[col.iT] = phi[col.iV] = 0.0
-    dphi = col.reference_from(
-        lambda tau: np.real(2j * math.pi * qhat[:, None] * np.exp(2j * math.pi * tau)[None, :]))
-    c_amp = phi / col.npts
-    s_amp = eps * float(c_amp @ phi)
-    first = None
-    for guess_dV in (dV_pred, -dV_pred, 0.0):
-        X0 = col.initial_guess(lambda tau: eps * mode(tau), T0, cp.V + guess_dV)
-        res = col.solve(X0, dphi, c_amp, s_amp)
-        if res.success:
-            first = res
-            break
-    if first is None:
-        raise ConvergenceError(f"the first periodic orbit next to the Hopf point at "
-                               f"{cp.V * speed_scale:.6g} {speed_unit} "
-                               f"did not converge ({res.return_status}, residual "
-                               f"{res.residual:.3g}); try more mesh intervals", res)
-    X1 = first.x
-    dV1 = float(X1[col.iV] - cp.V)
-    direction = 1 if dV1 > 0 else -1
-    kind = SUPERCRITICAL if l1 < 0 else SUBCRITICAL
-    kind_branch = SUPERCRITICAL if direction * cp.crossing_rate > 0 else SUBCRITICAL
-    # metric: orbit in units of a reference amplitude (the amplitude at a 5 % speed change
-    # on the parabola through the first orbit), period and speed relative
-    Aref = eps * math.sqrt(0.05 * cp.V / max(abs(dV1), 1e-12 * cp.V))
-    Aref = min(max(Aref, eps), 1e4 * eps)
-    d = _state_scale(qhat)
-    M = np.concatenate([np.tile(1.0 / (col.npts * (Aref * d) ** 2), col.npts),
-                        [1.0 / T0 ** 2, 1.0 / (0.05 * cp.V) ** 2]])
-    disc.w2 = (1.0 / d ** 2)[:, None]
-    t1 = tangent(disc, X1, col.reference(X1), c_amp, M)
-    hopf = HopfClassification(V=cp.V, omega=omega, freq_hz=omega / (2 * math.pi), lyapunov=l1,
-                              crossing_rate=cp.crossing_rate, kind=kind,
-                              branch_direction=direction, kind_from_branch=kind_branch,
-                              consistent=kind == kind_branch, predicted_dV=dV_pred,
-                              computed_dV=dV1, eigenvector=cp.q, discrete=False)
-    if not hopf.consistent:
-        log.warning("the first Lyapunov coefficient (%s) and the branch direction (%s) disagree "
-                    "at V = %.6g", kind, kind_branch, cp.V)
+    start = BranchStart(
+        cp=cp, lyapunov=l1, radial=omega * l1, omega=omega, freq_hz=omega / (2 * math.pi),
+        discrete=False, qhat=qhat, dominant=dom,
+        guess=lambda eps, V: col.initial_guess(lambda tau: eps * mode(tau), T0, V),
+        phi=phi, n_points=col.npts, period0=T0, hint="try more mesh intervals",
+        ref=col.reference_from(lambda tau: np.real(2j * math.pi * qhat[:, None]
+                                                   * np.exp(2j * math.pi * tau)[None, :])))
     t1b = time.perf_counter()
-    run = continue_branch(disc, X1, t1, M, settings, (lo, hi), cp.V, disc.size(X1))
+    hopf, run = run_from_hopf(disc, start, settings, (lo, hi), speed_scale=speed_scale,
+                              speed_unit=speed_unit)
     t_branch = time.perf_counter() - t1b
     return LCOBranch(problem=problem, system="truth", hopf=hopf, points=tuple(run.points),
                      folds=tuple(run.folds), outputs=outputs.names, output_units=outputs.units,
