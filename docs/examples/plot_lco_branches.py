@@ -35,7 +35,7 @@ from casflutter._resources import problems_dir
 
 QUICK = os.environ.get("CASFLUTTER_DOCS_QUICK") == "1"   # set by `make docs`
 settings = LCOSettings()                                  # 120 points at most per branch
-wing_settings = LCOSettings(max_points=25 if QUICK else 120)
+wing_settings = LCOSettings(max_points=12 if QUICK else 120)
 
 # %%
 # 1. Typical section with a cubic pitch spring
@@ -109,7 +109,7 @@ wing = lco_branch(truth, (0.8, 1.5), wing_settings)
 ms = truth.modal_structure()
 rom = HWLModel.load(problems_dir() / "seed_wing_rom" / "rom.npz")
 structure = ModalStructure(ms.omega, ms.zeta, ms.alpha, Hs=ms.sensor_rows, sensor="displacement")
-rom_branch = rom_lco_branch(rom, structure, (0.8, 1.5), LCOSettings(max_points=20 if QUICK else 60),
+rom_branch = rom_lco_branch(rom, structure, (0.8, 1.5), LCOSettings(max_points=10 if QUICK else 60),
                             mode_names=ms.mode_names, sensor_names=ms.sensor_names,
                             problem="seed wing ROM loop", speed_scale=truth.airspeed(1.0),
                             speed_unit="m/s")
