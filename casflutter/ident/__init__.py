@@ -10,9 +10,10 @@ through the recursion of eq. 3, or Ipopt on a multiple-shooting NLP).
 from ._identify import (FitReport, IdentificationResult, IdentificationSettings,  # noqa: F401
                         IdentificationWarning, fit_report, identify)
 from ._model import (HWLModel, HWLStructure, UnstableModelWarning,  # noqa: F401
-                     hwl_predict_function, hwl_simulate_function, paper_parameter_count)
+                     paper_parameter_count)
 from ._orders import HWLOrders  # noqa: F401
 from ._regression import Stage1Result, stage1  # noqa: F401
 from ._select import (OrderCandidate, OrderSelection, order_grid, parse_grid,  # noqa: F401
                       select_orders)
 from ._synthetic import duffing_data, random_hwl_model, synthetic_data  # noqa: F401
+from ._twins import hwl_predict_function, hwl_simulate_function  # noqa: F401

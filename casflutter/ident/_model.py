@@ -28,8 +28,8 @@ Then the linearisation about zero keeps exactly the mu-Markov system ``{A, H, h,
 (paper §III.A.1) and the higher polynomial coefficients measure the nonlinearity directly.
 The normalisation needs a non-zero linear part; a purely nonlinear path cannot be represented.
 
-The same formulas are evaluated by numpy and by CasADi (:func:`hwl_predict_function`,
-:func:`hwl_simulate_function`): one code path, so the twins agree to rounding.
+The same formulas are evaluated by numpy and by CasADi (the twins in :mod:`._twins`): one
+code path, so they agree to rounding.
 """
 
 from __future__ import annotations
@@ -46,8 +46,7 @@ from ..errors import DataError, DimensionError, OrderError
 from ._kernels import free_run
 from ._orders import HWLOrders
 
-__all__ = ["HWLStructure", "HWLModel", "hwl_predict_function", "hwl_simulate_function",
-           "paper_parameter_count", "UnstableModelWarning"]
+__all__ = ["HWLStructure", "HWLModel", "paper_parameter_count", "UnstableModelWarning"]
 
 
 #: |y| above which a free run counts as diverged (its square still fits in a double)
@@ -269,42 +268,6 @@ def _ar_part(structure: HWLStructure, W, y, n_samples: int):
         for l, w in enumerate(W["ar"][m], start=1):
             total = total + (block ** l) @ w.T
     return total
-
-
-def ar_weights(structure: HWLStructure, W) -> "ca.MX | np.ndarray":
-    """The autoregressive weights ``A^(m) ∘ alpha^[l]`` stacked in one column (the only
-    parameters the free-run recursion needs)."""
-    o = structure.orders
-    mats = [W["ar"][m][l] for m in range(o.na) for l in range(o.q)]
-    if mats and isinstance(mats[0], (ca.MX, ca.SX, ca.DM)):
-        return ca.vertcat(*[ca.vec(w) for w in mats])
-    return np.concatenate([np.ravel(w, order="F") for w in mats])
-
-
-def recursion_step(structure: HWLStructure) -> ca.Function:
-    """One step of the free-run recursion: ``(hist, xin_k, w_ar) -> hist_next``.
-
-    ``hist = [y(k-1); ...; y(k-H)]`` (each block N long, ``H`` the largest output lag);
-    ``xin_k`` the input part of eq. 3 at time k; ``w_ar`` from :func:`ar_weights`.  The first
-    N entries of ``hist_next`` are ``y(k)``.  Built from SX so that ``mapaccum`` over long
-    records runs at compiled-expression speed.
-    """
-    o, N = structure.orders, structure.n_modes
-    lags = o.ar_lags()
-    H = max(lags)
-    hist = ca.SX.sym("hist", H * N)
-    xk = ca.SX.sym("xin", N)
-    w_ar = ca.SX.sym("w_ar", o.na * o.q * N * N)
-    yk = xk
-    pos = 0
-    for lag in lags:
-        past = hist[(lag - 1) * N:lag * N]
-        for l in range(1, o.q + 1):
-            w = ca.reshape(w_ar[pos:pos + N * N], N, N)
-            pos += N * N
-            yk = yk - ca.mtimes(w, past ** l)
-    new = ca.vertcat(yk, hist[:(H - 1) * N]) if H > 1 else yk
-    return ca.Function("hwl_step", [hist, xk, w_ar], [new])
 
 
 @dataclass(frozen=True)
@@ -695,58 +658,3 @@ class HWLModel:
         const = ", constant term" if s.constant else ""
         return (f"HWLModel(N={s.n_modes}, {s.orders}, inputs {'+'.join(ins)}{const}, "
                 f"{s.n_params} parameters, dt={self.dt:g} s)")
-
-
-def _sym_signals(structure: HWLStructure, n_samples: int):
-    N = structure.n_modes
-    theta = ca.MX.sym("theta", structure.n_params)
-    u = ca.MX.sym("u", n_samples, N) if structure.has_u else None
-    v = ca.MX.sym("v", n_samples, 1) if structure.has_v else None
-    return theta, u, v
-
-
-def hwl_predict_function(structure: HWLStructure, n_samples: int) -> ca.Function:
-    """CasADi twin of :meth:`HWLModel.predict`.
-
-    ``f(theta, y, [u], [v]) -> yhat`` with ``yhat`` of shape ``(K - max_lag, N)`` (the rows
-    where a prediction exists).  Inputs u, v appear only when the structure has them.
-    """
-    theta, u, v = _sym_signals(structure, n_samples)
-    y = ca.MX.sym("y", n_samples, structure.n_modes)
-    W = structure.weights(theta)
-    yhat = _input_part(structure, W, u, v, n_samples)
-    if structure.orders.na:
-        yhat = yhat - _ar_part(structure, W, y, n_samples)
-    args = [theta, y] + [s for s in (u, v) if s is not None]
-    names = ["theta", "y"] + [n for n, s in (("u", u), ("v", v)) if s is not None]
-    return ca.Function("hwl_predict", args, [yhat], names, ["yhat"])
-
-
-def hwl_simulate_function(structure: HWLStructure, n_samples: int) -> ca.Function:
-    """CasADi twin of :meth:`HWLModel.simulate`, built with ``mapaccum``.
-
-    ``f(theta, y0, [u], [v]) -> ysim`` with ``y0`` the first ``max_lag`` outputs
-    (``max_lag x N``) and ``ysim`` of shape ``(K - max_lag, N)``.
-    """
-    o = structure.orders
-    N, L = structure.n_modes, structure.max_lag
-    theta, u, v = _sym_signals(structure, n_samples)
-    y0 = ca.MX.sym("y0", L, N)
-    W = structure.weights(theta)
-    xin = _input_part(structure, W, u, v, n_samples)  # (K-L, N)
-    n_steps = n_samples - L
-    lags = o.ar_lags()
-    if lags:
-        H = max(lags)  # history length carried by the recursion
-        step = recursion_step(structure)
-        acc = step.mapaccum("hwl_recursion", n_steps)
-        # initial history from y0: rows L-1, L-2, ..., L-H
-        rows = [y0[L - 1 - d, :].T for d in range(H)]
-        hist0 = ca.vertcat(*rows)
-        traj = acc(hist0, xin.T, ca.repmat(ar_weights(structure, W), 1, n_steps))  # (H*N, n_steps)
-        ysim = traj[:N, :].T
-    else:
-        ysim = xin
-    args = [theta, y0] + [s for s in (u, v) if s is not None]
-    names = ["theta", "y0"] + [n for n, s in (("u", u), ("v", v)) if s is not None]
-    return ca.Function("hwl_simulate", args, [ysim], names, ["ysim"])

@@ -25,7 +25,8 @@ import numpy as np
 from .._nlp import make_solver
 from ..data import IOData
 from ..errors import ConfigError
-from ._model import HWLStructure, _input_part, ar_weights, recursion_step
+from ._model import HWLStructure, _input_part
+from ._twins import ar_weights, recursion_step
 from ._regression import regressor_matrix, weights_matrix
 from ._simfit import FreeRunProblem
 
