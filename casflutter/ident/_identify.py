@@ -260,10 +260,12 @@ class IdentificationResult:
         data; ``"not run"`` without stage 2).
     iterations : int
     cost, cost_initial : float
-        Stage-2 criterion at the solution and at the start, both evaluated the same way
-        (scaled units: half the mean squared error of the unit-RMS outputs, plus the
-        regularisation).  For the simulation criterion both are free runs (the start from
-        the measured initial outputs); ``inf`` when the free run diverges.
+        Stage-2 criterion at the solution and at the starting model (``initial_model``),
+        both evaluated the same way (scaled units: half the mean squared error of the
+        unit-RMS outputs, plus the regularisation).  For the simulation criterion both are
+        free runs (the starting model's from the measured initial outputs; the solver itself
+        may start from the prediction-error optimum when that runs free better); ``inf`` when
+        the free run diverges.
     t_stage1, t_stage2, wall_time : float
         Seconds.
     condition_number : float

@@ -145,3 +145,25 @@ def test_stage1_overflow_is_a_data_error():
         identify(data, (1, 1, 1, 0, 3, 3), scale_data=False)
     with pytest.raises(DataError):
         stage1(random_hwl_model(1, (1, 1, 1, 0, 3, 3), has_v=False).structure, data)
+
+
+def test_ipopt_defaults_come_from_one_place(data, monkeypatch):
+    """Stage 2 adds no Ipopt option of its own (the defaults live in _nlp), and max_iter
+    maps onto ipopt.max_iter; the Gauss-Newton limit defaults to the same number."""
+    from casflutter import _nlp
+    from casflutter.ident import _refine
+
+    seen = []
+    real = _refine.make_solver
+
+    def spy(nlp, options=None, name="nlp"):
+        seen.append(dict(options or {}))
+        return real(nlp, options, name)
+
+    monkeypatch.setattr(_refine, "make_solver", spy)
+    identify(data, (2, 1, 1, 1, 2, 2))
+    assert "ipopt.max_iter" not in seen[-1]
+    identify(data, (2, 1, 1, 1, 2, 2), max_iter=7)
+    assert seen[-1]["ipopt.max_iter"] == 7
+    assert (IdentificationSettings().iteration_limit
+            == _nlp.DEFAULT_IPOPT_OPTIONS["ipopt.max_iter"] == 500)
