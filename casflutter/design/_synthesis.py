@@ -93,7 +93,7 @@ class SynthesisOptions:
     """Stop a start's H∞ phase when γ fell by less than ``stall_tol`` (relative) over this
     many iterations (counted in iterations: deterministic)."""
     stall_tol: float = 1e-4
-    """See ``stall_window``."""
+    """See ``stall_window`` (at most ``10 tol``)."""
     abandon_after: int = 40
     """A start whose γ is still above ``abandon_ratio`` times the best start's after this many
     H∞ iterations is stopped (deterministic: counted in iterations)."""
@@ -346,7 +346,8 @@ class _Phase:
                 break
             if self.kind == "hinf" and len(history) > 1 and it > opts.stall_window and \
                     history_at[-1] >= it - 1 and _stalled(history, history_at, it,
-                                                          opts.stall_window, opts.stall_tol):
+                                                          opts.stall_window,
+                                                          min(opts.stall_tol, 10 * opts.tol)):
                 log.info("%s: stalled at gamma %.6g (less than %.1e relative decrease in %d "
                          "iterations)", label, f, opts.stall_tol, opts.stall_window)
                 break
