@@ -13,7 +13,7 @@ given as a continuous ``control.StateSpace`` with N outputs ``y`` and inputs
 
 where for state sensors ``C2 = [Hs 0]`` and ``D21 = D22 = 0`` exactly as in the paper;
 for accelerometers the zm rows carry the aerodynamic and disturbance feed-through
-(see :mod:`._structure`).
+(see :mod:`casflutter.structure`).
 """
 
 from __future__ import annotations
@@ -24,10 +24,12 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
+from .._linalg import spectral_abscissa
 from ..errors import DimensionError
-from ._structure import ModalStructure
+from ..structure import ModalStructure
 
-__all__ = ["AeroelasticSystem", "AeroelasticLoop", "aeroelastic_loop", "split_sigma_f"]
+__all__ = ["AeroelasticSystem", "AeroelasticLoop", "ParametricSystem", "aeroelastic_loop",
+           "split_sigma_f"]
 
 
 def split_sigma_f(sigma_f, n_modes: int | None = None):
@@ -157,6 +159,9 @@ class AeroelasticSystem:
         RuntimeWarning
             When Σf (the ROM) is unstable on its own, i.e. ΣAE is unstable at V = 0.
         """
+        if not isinstance(structure, ModalStructure):
+            raise DimensionError(f"structure must be a casflutter.structure.ModalStructure "
+                                 f"(Σs), got {type(structure).__name__}")
         parts = split_sigma_f(sigma_f, structure.n_modes)
         sys = cls(structure, *parts)
         if warn_unstable and not sys.rom_stable:
@@ -184,7 +189,7 @@ class AeroelasticSystem:
     @property
     def rom_spectral_abscissa(self) -> float:
         """max Re λ(Af) (−inf for a static Σf)."""
-        return float(np.max(np.linalg.eigvals(self.Af).real)) if self.n_f else -np.inf
+        return spectral_abscissa(self.Af)
 
     @property
     def rom_stable(self) -> bool:
@@ -193,8 +198,9 @@ class AeroelasticSystem:
 
     @property
     def mode_states(self) -> list[np.ndarray]:
-        """State indices ``[u_i, u̇_i]`` of each structural mode (for eigenvector participation)."""
-        return [np.array([2 * i, 2 * i + 1]) for i in range(self.n_modes)]
+        """State indices ``[u_i, u̇_i]`` of each structural mode in ΣAE's state ``(x_s, x_f)``
+        (for eigenvector participation)."""
+        return self.structure.mode_states
 
     def state_matrix(self, V: float) -> np.ndarray:
         """Â(V) of eq. 8a."""
@@ -241,7 +247,7 @@ class AeroelasticSystem:
         A = self.state_matrix(V)
         B1 = np.vstack([Bs, np.zeros((nf, s.n_modes))])
         B2 = np.concatenate([V2 * Bs @ self.df, self.bf])
-        Hx, Hf = s.sensor_rows()
+        Hx, Hf = s.sensor_matrices()
         C2 = np.hstack([Hx + V2 * Hf @ self.Df @ Cs, V2 * Hf @ self.Cf])
         D21 = Hf.copy()
         D22 = V2 * Hf @ self.df
@@ -252,3 +258,64 @@ class AeroelasticSystem:
 def aeroelastic_loop(sigma_f, structure: ModalStructure, V: float) -> AeroelasticLoop:
     """ΣAE(V) (eq. 8-9) from Σf and Σs; see :class:`AeroelasticSystem`."""
     return AeroelasticSystem.from_parts(sigma_f, structure).loop(V)
+
+
+@dataclass(frozen=True)
+class ParametricSystem:
+    """ΣAE(V) of a parametric ROM: Σf interpolated at the same V as the loop is closed.
+
+    Attributes
+    ----------
+    rom : casflutter.realize.ParametricROM
+        ROMs identified at several speeds, interpolated in V.
+    structure : ModalStructure
+        Σs.
+
+    Raises
+    ------
+    DimensionError
+        The ROMs' outputs do not match Σs's modes (both named).
+    """
+
+    rom: object
+    structure: ModalStructure
+
+    def __post_init__(self):
+        N = self.rom.n_modes
+        if N != self.structure.n_modes:
+            raise DimensionError(f"the ROMs have {N} outputs but Σs has "
+                                 f"{self.structure.n_modes} modes; they must be equal")
+
+    def system_at(self, V: float) -> AeroelasticSystem:
+        """ΣAE with Σf of the interpolated ROM at V (control.StateSpace route).
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        AeroelasticSystem
+        """
+        return AeroelasticSystem.from_parts(self.rom.sigma_f(V), self.structure,
+                                            warn_unstable=False)
+
+    def state_matrix(self, V: float) -> np.ndarray:
+        """Â(V) of eq. 8a with Σf interpolated at the same V.
+
+        The origin mode of a branch is judged by the nearest natural frequency
+        (``structure.omega``; the class has no ``mode_states``): the canonical realisation's
+        states are not balanced, so eigenvector energy fractions would be dominated by the
+        aerodynamic states.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        ndarray
+        """
+        return AeroelasticSystem(self.structure, *self.rom.sigma_f_matrices(V)).state_matrix(V)

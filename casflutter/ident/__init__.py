@@ -2,8 +2,12 @@
 
 ``identify(data, orders)`` runs stage 1 (over-parameterised least squares and rank-one SVD,
 Bai 1998, extended to MIMO) and stage 2 (an Ipopt NLP through CasADi).
+``identify_common_denominator(data, na, nb)`` identifies the linear model with one scalar
+denominator by variable projection (for aerodynamics linear in the motion).
 """
 
+from ._common_denominator import (CommonDenominatorResult,  # noqa: F401
+                                  identify_common_denominator)
 from ._identify import (FitReport, IdentificationResult, IdentificationSettings,  # noqa: F401
                         fit_report, identify)
 from ._model import (HWLModel, HWLStructure, hwl_predict_function,  # noqa: F401

@@ -1,4 +1,5 @@
-"""Full-order truth simulators that stand in for the paper's CFD.
+"""Full-order truth simulators that stand in for the paper's CFD, and the experiments run on
+them.
 
 Given prescribed modal displacements (and flap) they return the generalised aerodynamic
 forces ``y`` of eq. (6), so identification runs on them as it would on CFD output; their
@@ -11,21 +12,40 @@ own linear state space in the speed index ``V`` gives the true flutter speed.
 - :class:`SeedWing` -- the paper's wind-tunnel wing with tip store (five modes at the
   paper's frequencies, strip theory with Wagner lags per strip, saturating lift, flap,
   tip-store accelerometers), nonlinear, calibrated to the paper's Vf and LCO.
+- :func:`load_problem` -- a problem by name, with parameter changes.
+- :func:`truth_records` -- chirp records of a truth (the paper's CFD runs, §IV.A).
+- :func:`truth_lco`, :func:`closed_loop_truth`, :func:`suppression_run`,
+  :func:`truth_loop_sweep` -- the truth's own LCO, and the truth in closed loop with a
+  controller (the wind tunnel, paper Fig. 11).
+- :func:`frozen_aero_truth` -- the truth with its aerodynamics frozen at one speed: what a
+  ROM with the V² scaling of eq. 8 represents.
 """
 
 from ._aero import JONES_A, JONES_B, jones_C, strip_coefficients, theodorsen_T
-from ._base import AeroelasticTruth, AeroMatrices, ModalStructure, SimulationResult
+from ._base import AeroelasticTruth, AeroMatrices, SimulationResult
+from ._closed_loop import (SuppressionResult, SuppressionSettings, TruthLoopSimulation,
+                           TruthLoopSweep, closed_loop_truth, gain_schedule, suppression_run,
+                           truth_loop_matrix, truth_loop_sweep)
+from ._frozen import frozen_aero_truth
 from ._goland import GolandParams, GolandWing
+from ._lco import TruthLco, truth_lco
+from ._params import parse_sets
+from ._records import RecordSettings, truth_records
+from ._registry import PROBLEMS, load_problem, problem_definition, problem_names
 from ._seed_wing import (SEED_FREQUENCIES_HZ, SEED_MODE_NAMES, SEED_SENSOR_ROWS, SEED_U_REF,
                          SeedWing, SeedWingParams)
-from ._registry import PROBLEMS, load_problem, problem_definition, problem_names
 from ._typical_section import TypicalSection, TypicalSectionParams
 
 __all__ = [
-    "AeroelasticTruth", "AeroMatrices", "ModalStructure", "SimulationResult",
+    "AeroelasticTruth", "AeroMatrices", "SimulationResult",
     "TypicalSection", "TypicalSectionParams", "GolandWing", "GolandParams",
     "SeedWing", "SeedWingParams", "SEED_FREQUENCIES_HZ", "SEED_MODE_NAMES", "SEED_SENSOR_ROWS",
     "SEED_U_REF",
-    "PROBLEMS", "problem_names", "load_problem", "problem_definition",
+    "PROBLEMS", "problem_names", "load_problem", "problem_definition", "parse_sets",
+    "RecordSettings", "truth_records", "frozen_aero_truth",
+    "TruthLco", "truth_lco",
+    "TruthLoopSimulation", "closed_loop_truth", "gain_schedule", "SuppressionSettings",
+    "SuppressionResult", "suppression_run", "truth_loop_matrix", "TruthLoopSweep",
+    "truth_loop_sweep",
     "JONES_A", "JONES_B", "jones_C", "theodorsen_T", "strip_coefficients",
 ]

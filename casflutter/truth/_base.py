@@ -31,9 +31,10 @@ from scipy.interpolate import make_interp_spline
 from scipy.linalg import eigh
 
 from ..errors import ConfigError, DataError, DimensionError
+from ..structure import ModalStructure
 from ._aero import JONES_A, check_timepts, integrate_lags, sample_derivatives
 
-__all__ = ["AeroMatrices", "ModalStructure", "SimulationResult", "AeroelasticTruth"]
+__all__ = ["AeroMatrices", "SimulationResult", "AeroelasticTruth"]
 
 
 @dataclass(frozen=True)
@@ -56,65 +57,6 @@ class AeroMatrices:
     Gv: np.ndarray
     Gv1: np.ndarray
     lams: tuple[float, float]
-
-
-@dataclass(frozen=True)
-class ModalStructure:
-    """The structural data of eq. (6)-(7) for a truth model.
-
-    Attributes
-    ----------
-    omega : numpy.ndarray
-        In-vacuo natural frequencies ``omega_i`` [rad per time unit], ascending.
-    zeta : numpy.ndarray
-        Modal damping ratios ``zeta_i``.
-    alpha : float
-        Flow constant ``alpha`` of eq. (6): the structure is
-        ``u'' + 2 zeta omega u' + omega^2 u = alpha V^2 y``.
-    mode_names : tuple of str
-        A name per mode (e.g. ``"plunge"``, ``"pitch"``, ``"bending 1"``).
-    shapes : numpy.ndarray
-        ``Phi``, ``(n, N)``: physical/assumed-mode coordinates ``x = Phi u``.
-    coordinate_names : tuple of str
-        Names of the ``n`` physical coordinates.
-    sensor_rows : numpy.ndarray
-        ``Hs`` of eq. (7), ``(ns, N)``: sensor readings ``z_m = Hs u`` (displacements; the
-        accelerations are ``Hs u''``).
-    sensor_names : tuple of str
-        A name per sensor row.
-    time_unit : str
-        The unit of time of ``omega`` and of ``timepts``.
-    speed_index : str
-        The convention of the speed index ``V``.
-    """
-
-    omega: np.ndarray
-    zeta: np.ndarray
-    alpha: float
-    mode_names: tuple[str, ...]
-    shapes: np.ndarray
-    coordinate_names: tuple[str, ...]
-    sensor_rows: np.ndarray
-    sensor_names: tuple[str, ...]
-    time_unit: str
-    speed_index: str
-
-    @property
-    def n_modes(self) -> int:
-        """Number of modes ``N``."""
-        return int(self.omega.size)
-
-    def As_Bs(self) -> tuple[np.ndarray, np.ndarray]:
-        """The matrices ``As = diag(A_s^i)``, ``Bs = diag(B_s^i)`` of eq. (7)."""
-        N = self.n_modes
-        As = np.zeros((2 * N, 2 * N))
-        Bs = np.zeros((2 * N, N))
-        for i in range(N):
-            As[2 * i, 2 * i + 1] = 1.0
-            As[2 * i + 1, 2 * i] = -self.omega[i] ** 2
-            As[2 * i + 1, 2 * i + 1] = -2.0 * self.zeta[i] * self.omega[i]
-            Bs[2 * i + 1, i] = self.alpha
-        return As, Bs
 
 
 @dataclass(frozen=True)
@@ -231,25 +173,57 @@ class AeroelasticTruth(abc.ABC):
         """The same problem with some parameters changed (unknown names raise ConfigError)."""
         return type(self)(self.params.with_updates(**changes))
 
-    @classmethod
-    def from_sets(cls, sets=()):
-        """The problem with ``["name=value", ...]`` applied to the published parameters."""
-        return cls(cls.Params.from_sets(sets))
-
     @property
     def n_modes(self) -> int:
         """Number of structural modes ``N``."""
         return int(self._omega.size)
 
     def modal_structure(self) -> ModalStructure:
-        """Frequencies, damping, flow constant, mode shapes, sensor rows and names."""
+        """Σs of the truth (eq. 6-7): frequencies, damping, flow constant, mode shapes, the
+        problem's sensor rows (read as displacements unless the problem says otherwise) and
+        the names of modes, coordinates and sensors.
+
+        Returns
+        -------
+        casflutter.structure.ModalStructure
+        """
         nm = self._names()
         return ModalStructure(omega=self._omega.copy(), zeta=self._zeta(), alpha=self.alpha,
-                              mode_names=tuple(nm["mode_names"]), shapes=self._Phi.copy(),
+                              Hs=np.asarray(nm["sensor_rows"], float),
+                              sensor=nm.get("sensor", "displacement"),
+                              mode_names=tuple(nm["mode_names"]),
+                              sensor_names=tuple(nm["sensor_names"]), shapes=self._Phi.copy(),
                               coordinate_names=tuple(nm["coordinate_names"]),
-                              sensor_rows=np.asarray(nm["sensor_rows"], float),
-                              sensor_names=tuple(nm["sensor_names"]),
                               time_unit=nm["time_unit"], speed_index=nm["speed_index"])
+
+    @property
+    def mode_states(self) -> list[np.ndarray]:
+        """Indices ``[u_i, u'_i]`` of each mode in the truth's state ``[u, u', lags]`` (for the
+        origin-mode attribution of :func:`casflutter.aeroelastic.find_flutter`)."""
+        N = self.n_modes
+        return [np.array([i, N + i]) for i in range(N)]
+
+    def displaced_state(self, mode: int, deflection: float) -> np.ndarray:
+        """The truth's structural state ``[u, u']`` at rest with mode ``mode`` displaced.
+
+        Parameters
+        ----------
+        mode : int
+            0-based mode index.
+        deflection : float
+            Modal displacement ``u_mode``.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(2N,)``: an initial state of :meth:`simulate` (the flow at rest).
+        """
+        N = self.n_modes
+        if not 0 <= int(mode) < N:
+            raise DimensionError(f"mode {mode} is not one of the {N} modes (0-based)")
+        x = np.zeros(2 * N)
+        x[int(mode)] = deflection
+        return x
 
     def _check_V(self, V: float) -> float:
         V = float(V)

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any, Iterable, Mapping
 
+from .. import _resources
 from .._resources import read_toml
 from ..errors import ConfigError
 from ._base import AeroelasticTruth
@@ -20,10 +22,6 @@ PROBLEMS: dict[str, type[AeroelasticTruth]] = {
     "seed_wing": SeedWing,
 }
 
-def _problems_dir() -> Path:
-    from .._resources import problems_dir
-
-    return problems_dir()
 
 
 def problem_names() -> list[str]:
@@ -38,22 +36,30 @@ def _cls(name: str) -> type[AeroelasticTruth]:
         raise ConfigError(f"unknown problem {name!r}; available: {', '.join(PROBLEMS)}") from None
 
 
-def load_problem(name: str, sets=()) -> AeroelasticTruth:
-    """The truth model of problem ``name`` with ``--set``-style changes applied.
+def load_problem(name: str, params: Mapping[str, Any] | Iterable[str] = ()) -> AeroelasticTruth:
+    """The truth model of problem ``name`` with parameter changes: the one way from a problem
+    name and parameters to a truth.
 
     Parameters
     ----------
     name : str
         A name from :func:`problem_names`.
-    sets : iterable of str
-        ``"name=value"`` items (unknown names raise :class:`ConfigError` listing the valid
+    params : mapping or iterable of str
+        ``{name: value}`` or ``--set``-style ``"name=value"`` items, applied to the
+        published parameters (unknown names raise :class:`ConfigError` listing the valid
         ones).
 
     Returns
     -------
     AeroelasticTruth
+
+    Raises
+    ------
+    ConfigError
+        Unknown problem or parameter, or a non-physical value.
     """
-    return _cls(name).from_sets(sets)
+    cls = _cls(name)
+    return cls(cls.Params.from_sets(params))
 
 
 def problem_definition(name: str, problems_dir: str | Path | None = None) -> dict:
@@ -66,7 +72,7 @@ def problem_definition(name: str, problems_dir: str | Path | None = None) -> dic
         without the repository's ``problems/`` folder: pass ``problems_dir``).
     """
     _cls(name)
-    root = Path(problems_dir) if problems_dir is not None else _problems_dir()
+    root = Path(problems_dir) if problems_dir is not None else _resources.problems_dir()
     path = root / name / "problem.toml"
     if not path.is_file():
         raise ConfigError(f"problem definition {path} not found; pass problems_dir= pointing "
