@@ -104,8 +104,17 @@ class AeroelasticLoop:
     n_f: int
 
     def statespace(self, include_modal: bool = False) -> control.StateSpace:
-        """ΣAE as ``control.StateSpace`` with inputs ``[w_1..w_N, v]`` and outputs ``zm``
-        (followed by the modal displacements ``u`` when ``include_modal``)."""
+        """ΣAE as ``control.StateSpace`` with inputs ``[w_1..w_N, v]`` and outputs ``zm``.
+
+        Parameters
+        ----------
+        include_modal : bool
+            Also the modal displacements ``u`` as outputs (after ``zm``).
+
+        Returns
+        -------
+        control.StateSpace
+        """
         C, D = self.C2, np.hstack([self.D21, self.D22[:, None]])
         outs = [f"zm[{j}]" for j in range(C.shape[0])]
         if include_modal:
@@ -117,7 +126,12 @@ class AeroelasticLoop:
                           outputs=outs, name="Sigma_AE")
 
     def poles(self) -> np.ndarray:
-        """Eigenvalues of Â(V)."""
+        """Eigenvalues of Â(V).
+
+        Returns
+        -------
+        ndarray, complex
+        """
         return np.linalg.eigvals(self.A)
 
 
@@ -149,10 +163,24 @@ class AeroelasticSystem:
                    ) -> "AeroelasticSystem":
         """Build from Σf (continuous ``control.StateSpace``) and Σs.
 
+        Parameters
+        ----------
+        sigma_f : control.StateSpace
+            Continuous Σf with N outputs and inputs ``[u_1..u_N(, v)]``.
+        structure : ModalStructure
+            Σs (a truth's :meth:`modal_structure` goes in as it is).
+        warn_unstable : bool
+            Warn when Σf is unstable on its own.
+
+        Returns
+        -------
+        AeroelasticSystem
+
         Raises
         ------
         DimensionError
-            When Σf's outputs do not match Σs's modes (both named) or Σf is discrete.
+            When Σf's outputs do not match Σs's modes (both named), Σf is discrete, or
+            ``structure`` is not a :class:`ModalStructure`.
 
         Warns
         -----
@@ -203,7 +231,17 @@ class AeroelasticSystem:
         return self.structure.mode_states
 
     def state_matrix(self, V: float) -> np.ndarray:
-        """Â(V) of eq. 8a."""
+        """Â(V) of eq. 8a.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        ndarray, shape (2N + nf, 2N + nf)
+        """
         s = self.structure
         V2 = float(V) ** 2
         As, Bs, Cs = s.As, s.Bs, s.Cs
@@ -214,9 +252,20 @@ class AeroelasticSystem:
     def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
         """State matrix of ΣAE(V) closed with ``v = K zm`` (positive feedback, paper Fig. 3).
 
-        ``controller`` is a continuous ``control.StateSpace`` K with ``n_sensors`` inputs and
-        one output; the closed-loop state is ``(x, x_K)``.  An algebraic loop through
-        ``D22 Dk`` (accelerometers with a direct flap feed-through) is solved exactly.
+        An algebraic loop through ``D22 Dk`` (accelerometers with a direct flap feed-through)
+        is solved exactly.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+        controller : control.StateSpace
+            Continuous K with ``n_sensors`` inputs and one output.
+
+        Returns
+        -------
+        ndarray
+            The state matrix of ``(x, x_K)``.
         """
         lp = self.loop(V)
         Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in
@@ -239,7 +288,17 @@ class AeroelasticSystem:
         return np.block([[lp.A + B2 @ vx, B2 @ vk], [Bk @ zx, Ak + Bk @ zk]])
 
     def loop(self, V: float) -> AeroelasticLoop:
-        """ΣAE at speed index V (eq. 8-9), with flap input v and disturbance w."""
+        """ΣAE at speed index V (eq. 8-9), with flap input v and disturbance w.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        AeroelasticLoop
+        """
         s = self.structure
         V2 = float(V) ** 2
         nf = self.n_f
@@ -256,7 +315,21 @@ class AeroelasticSystem:
 
 
 def aeroelastic_loop(sigma_f, structure: ModalStructure, V: float) -> AeroelasticLoop:
-    """ΣAE(V) (eq. 8-9) from Σf and Σs; see :class:`AeroelasticSystem`."""
+    """ΣAE(V) (eq. 8-9) from Σf and Σs; see :class:`AeroelasticSystem`.
+
+    Parameters
+    ----------
+    sigma_f : control.StateSpace
+        Continuous Σf.
+    structure : ModalStructure
+        Σs.
+    V : float
+        Speed index.
+
+    Returns
+    -------
+    AeroelasticLoop
+    """
     return AeroelasticSystem.from_parts(sigma_f, structure).loop(V)
 
 

@@ -65,6 +65,18 @@ def envelope_growth_rate(timepts, x) -> float:
     (insensitive to a static offset), placed at the mid time; σ is the slope of its
     logarithm.  Falls back on a fit of log|x| when fewer than three swings exist
     (non-oscillatory records).
+
+    Parameters
+    ----------
+    timepts : array_like, shape (n,)
+        Sample times.
+    x : array_like, shape (n,)
+        The record.
+
+    Returns
+    -------
+    float
+        σ (``-inf`` for a record at rest).
     """
     t, x = np.asarray(timepts, dtype=float), np.asarray(x, dtype=float)
     mx, _ = find_peaks(x)
@@ -89,7 +101,21 @@ def dominant_frequency(timepts, x) -> tuple[float, np.ndarray, np.ndarray]:
     """Fundamental frequency [Hz] of a uniformly sampled record by FFT peak.
 
     The record is de-meaned and Hann-windowed; the peak bin is refined by parabolic
-    interpolation of the log magnitude.  Returns ``(f_hz, freq_hz, amplitude_spectrum)``.
+    interpolation of the log magnitude.
+
+    Parameters
+    ----------
+    timepts : array_like, shape (n,)
+        Uniform sample times.
+    x : array_like, shape (n,)
+        The record.
+
+    Returns
+    -------
+    f_hz : float
+        The fundamental frequency (``nan`` for fewer than 8 samples).
+    freq_hz, amplitude_spectrum : ndarray
+        The one-sided amplitude spectrum.
     """
     t, x = np.asarray(timepts, dtype=float), np.asarray(x, dtype=float)
     n = x.size
@@ -116,7 +142,9 @@ def analyze_response(timepts, X, *, window: float = 0.3, tol: float = 0.05,
     Parameters
     ----------
     timepts : array_like (n,)
+        Sample times.
     X : array_like (n,) or (n, channels)
+        The record, one column per channel.
     window : float
         Fraction (0, 1] of the record, at its end, that is analysed.
     tol : float
@@ -125,6 +153,10 @@ def analyze_response(timepts, X, *, window: float = 0.3, tol: float = 0.05,
         A window amplitude below this is a decay.
     blowup : float
         An amplitude above this (or non-finite) is a divergence.
+
+    Returns
+    -------
+    ResponseAnalysis
     """
     t = np.asarray(timepts, dtype=float)
     X = np.asarray(X, dtype=float)

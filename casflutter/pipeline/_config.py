@@ -82,7 +82,12 @@ class ProblemSection:
             raise ConfigError(f"set: {exc}") from None
 
     def load(self):
-        """The truth simulator (:func:`casflutter.truth.load_problem`)."""
+        """The truth simulator (:func:`casflutter.truth.load_problem`).
+
+        Returns
+        -------
+        AeroelasticTruth
+        """
         return load_problem(self.name, self.set)
 
 
@@ -365,7 +370,12 @@ class RunConfig:
                               key="sensors.rows", problem=self.problem.name)
 
     def to_dict(self) -> dict:
-        """The configuration as nested plain values (``config.json``)."""
+        """The configuration as nested plain values (``config.json``).
+
+        Returns
+        -------
+        dict
+        """
         return asdict(self)
 
 
@@ -398,7 +408,12 @@ def config_path(problem: str, name: str = "run") -> Path:
 
 
 def default_config_path() -> Path:
-    """The default configuration shipped with the package (the seed wing's study)."""
+    """The default configuration shipped with the package (the seed wing's study).
+
+    Returns
+    -------
+    Path
+    """
     return config_path("seed_wing", "run")
 
 

@@ -274,7 +274,12 @@ class RunResult:
                                                          self.flutter_truth.Vf)
 
     def explanation(self) -> str:
-        """The ROM's flutter-speed error and its cause, in words."""
+        """The ROM's flutter-speed error and its cause, in words.
+
+        Returns
+        -------
+        str
+        """
         def pct(x):
             return "n/a" if x is None else f"{100 * x:+.3f}%"
         text = (f"ROM identified at V0 = {self.config.data.V0:g}: Vf error "

@@ -32,7 +32,24 @@ __all__ = ["Realization", "era", "inverse_tustin", "tustin_to_continuous", "cont
 
 
 def choose_order(hankel_sv: np.ndarray, tol: float = 1e-9) -> int:
-    """Number of Hankel singular values above ``tol`` times the largest."""
+    """Number of Hankel singular values above ``tol`` times the largest.
+
+    Parameters
+    ----------
+    hankel_sv : array_like
+        Hankel singular values, decreasing.
+    tol : float
+        Relative threshold.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    OrderError
+        All singular values are zero.
+    """
     s = np.asarray(hankel_sv, dtype=float)
     if s.size == 0 or s[0] <= 0:
         raise OrderError("all Hankel singular values are zero: the linear part of the model "
@@ -56,6 +73,8 @@ def era(markov: np.ndarray, order: int | str = "auto", *, dt: float = 1.0,
         Sampling time of the result.
     hankel_blocks : int, optional
         Block rows (= block columns) of the Hankel matrix; default ``(n - 1) // 2``.
+    tol : float
+        Relative threshold of the ``"auto"`` order.
 
     Returns
     -------
@@ -196,7 +215,13 @@ class Realization:
         return self.order
 
     def split(self):
-        """``(Af, Bf, bf, Cf, Df, df)`` of eq. 5 (``bf``/``df`` None without flap input)."""
+        """The blocks of Σf (eq. 5).
+
+        Returns
+        -------
+        tuple of ndarray
+            ``(Af, Bf, bf, Cf, Df, df)``; ``bf``, ``df`` are ``None`` without a flap input.
+        """
         s = self.sigma_f
         N = s.noutputs
         B, D = np.asarray(s.B), np.asarray(s.D)
@@ -212,11 +237,18 @@ def realize(model, order: int | str = "auto", *, tol: float = 1e-9,
     Parameters
     ----------
     model : casflutter.ident.HWLModel
+        The identified ROM.
     order : int or "auto"
         ``nf``; ``"auto"`` keeps Hankel singular values above ``tol`` (relative).
+    tol : float
+        Relative threshold of the ``"auto"`` order.
     n_markov : int, optional
         Number of Markov parameters used (default: enough for a Hankel matrix of
         ``max(4 * max_lag, 60)`` blocks).
+
+    Returns
+    -------
+    Realization
     """
     o = model.orders
     N = model.n_modes

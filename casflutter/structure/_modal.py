@@ -345,7 +345,12 @@ class ModalStructure:
         return Hx, Hf
 
     def eigenvalues(self) -> np.ndarray:
-        """Analytic structural poles ``-ζω ± jω√(1-ζ²)`` (pairs, mode by mode)."""
+        """Analytic structural poles ``-ζω ± jω√(1-ζ²)`` (pairs, mode by mode).
+
+        Returns
+        -------
+        ndarray, shape (2N,), complex
+        """
         out = []
         for w, z in zip(self.omega, self.zeta):
             r = np.sqrt(complex(1.0 - z * z))

@@ -45,6 +45,21 @@ def quadratic_coefficients(matrix_fn: Callable[[float], np.ndarray],
                            check_V: float = 2.5, rtol: float = 1e-9):
     """``(A0, A1, A2)`` with ``A(V) = A0 + V A1 + V² A2``, verified at ``check_V``.
 
+    Parameters
+    ----------
+    matrix_fn : callable
+        ``V -> A(V)``.
+    V_nodes : sequence of three floats
+        Speeds at which ``A`` is sampled.
+    check_V : float
+        Speed of the check.
+    rtol : float
+        Relative tolerance of the check.
+
+    Returns
+    -------
+    A0, A1, A2 : ndarray
+
     Raises
     ------
     ConfigError
@@ -223,6 +238,25 @@ def flutter_sensitivity_nlp(problem: str = "typical_section",
     ``dVf/dθ = (∂w*/∂p)[V] · ∂p/∂θ`` where ``p = (A0, A1, A2, c)`` and ``∂p/∂θ`` is a central
     difference of the quadratic coefficients (``c`` held fixed).  Same result type as
     :func:`flutter_sensitivity` (``method = "parametric NLP"``).
+
+    Parameters
+    ----------
+    problem : str
+        Truth problem name.
+    parameters : sequence of str, optional
+        Parameters to differentiate by (default: all).
+    params : mapping, optional
+        Parameter values of the nominal point (default: the published ones).
+    V_range : (float, float)
+        Range of the coarse scan.
+    n_scan : int
+        Points of the coarse scan.
+    rel_step : float
+        Relative step of the difference of the quadratic coefficients.
+
+    Returns
+    -------
+    FlutterSensitivity
     """
     params = dict(params or {})
     model = load_problem(problem, params)
@@ -268,8 +302,11 @@ def flutter_sensitivity_nlp(problem: str = "typical_section",
 def truth_hopf(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dict[str, Any]:
     """Sweep evaluator: truth flutter speed by the cached Hopf NLP.
 
-    Parameters and settings as for :func:`truth_flutter` (``problem``, any truth
-    parameter, ``V_min``, ``V_max``), plus ``n_scan`` (coarse scan points, default 41).
+    Parameters
+    ----------
+    params, settings : mapping
+        As for :func:`casflutter.study.truth_flutter_evaluator` (``problem``, any truth
+        parameter, ``V_min``, ``V_max``), plus ``n_scan`` (coarse scan points, default 41).
 
     Returns
     -------

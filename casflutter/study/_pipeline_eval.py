@@ -140,7 +140,12 @@ def _pair(value, i):
 
 
 def flatten_summary(summary: Mapping[str, Any]) -> dict[str, Any]:
-    """One row of columns from ``RunResult.summary`` (the content of ``summary.json``).
+    """One row of columns from ``RunResult.summary()`` (the content of ``summary.json``).
+
+    Parameters
+    ----------
+    summary : mapping
+        The summary of a run.
 
     Returns
     -------

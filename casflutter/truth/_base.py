@@ -434,6 +434,27 @@ class AeroelasticTruth(abc.ABC):
 
         return f
 
+    def _simulation_inputs(self, timepts, x0, v, nx: int):
+        """Checked inputs of a simulation: the times, the full initial state (``[u, u']`` is
+        completed with the lag states at rest), the flap samples and their quintic spline
+        (``None`` without flap motion)."""
+        t = np.asarray(timepts, float)
+        if t.ndim != 1 or t.size < 2 or np.any(np.diff(t) <= 0):
+            raise DataError("timepts must be a 1-D increasing array of at least 2 samples")
+        N = self.n_modes
+        x0 = np.asarray(x0, float).reshape(-1)
+        if x0.size == 2 * N:
+            x0 = np.concatenate([x0, np.zeros(nx - 2 * N)])
+        if x0.size != nx:
+            raise DimensionError(f"x0 must have length 2N = {2 * N} or {nx} (with lag states), "
+                                 f"got {x0.size}")
+        if v is None:
+            return t, x0, np.zeros(t.size), None
+        vs = _as_1d("v", v, t.size)
+        if t.size < 6:
+            raise DataError("a flap history needs at least 6 samples")
+        return t, x0, vs, make_interp_spline(t, vs, k=5)
+
     def simulate(self, timepts: np.ndarray, x0: np.ndarray, V: float,
                  v: np.ndarray | None = None, *, rtol: float = 1e-9,
                  atol: float = 1e-12) -> SimulationResult:
@@ -458,26 +479,11 @@ class AeroelasticTruth(abc.ABC):
         -------
         SimulationResult
         """
-        t = np.asarray(timepts, float)
-        if t.ndim != 1 or t.size < 2 or np.any(np.diff(t) <= 0):
-            raise DataError("timepts must be a 1-D increasing array of at least 2 samples")
         c = self._coupled(V)
         A, Bf, Minv, N = c["A"], c["Bflap"], c["Minv"], c["N"]
         nx = A.shape[0]
-        x0 = np.asarray(x0, float).reshape(-1)
-        if x0.size == 2 * N:
-            x0 = np.concatenate([x0, np.zeros(nx - 2 * N)])
-        if x0.size != nx:
-            raise DimensionError(f"x0 must have length 2N = {2 * N} or {nx} (with lag states), "
-                                 f"got {x0.size}")
-        if v is None:
-            vs = np.zeros(t.size)
-            vfun = None
-        else:
-            vs = _as_1d("v", v, t.size)
-            if t.size < 6:
-                raise DataError("a flap history needs at least 6 samples")
-            vfun = make_interp_spline(t, vs, k=5)
+        t, x0, vs, vfun = self._simulation_inputs(timepts, x0, v, nx)
+        if vfun is not None:
             vd1, vd2 = vfun.derivative(1), vfun.derivative(2)
         Phi = self._Phi
         has_nl = self._nonlinear_force(np.zeros(Phi.shape[0])) is not None

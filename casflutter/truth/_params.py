@@ -46,11 +46,25 @@ class ParamsMixin:
                 for f in dataclasses.fields(cls)]
 
     def as_dict(self) -> dict[str, float]:
-        """Parameters as a plain dict."""
+        """Parameters as a plain dict.
+
+        Returns
+        -------
+        dict
+        """
         return dataclasses.asdict(self)
 
     def with_updates(self, **changes: float):
         """A copy with some parameters changed.
+
+        Parameters
+        ----------
+        **changes : float
+            New values by parameter name.
+
+        Returns
+        -------
+        Parameters of this class.
 
         Raises
         ------

@@ -25,7 +25,12 @@ PROBLEMS: dict[str, type[AeroelasticTruth]] = {
 
 
 def problem_names() -> list[str]:
-    """Names of the problems that have a truth simulator."""
+    """Names of the problems that have a truth simulator.
+
+    Returns
+    -------
+    list of str
+    """
     return list(PROBLEMS)
 
 
@@ -64,6 +69,18 @@ def load_problem(name: str, params: Mapping[str, Any] | Iterable[str] = ()) -> A
 
 def problem_definition(name: str, problems_dir: str | Path | None = None) -> dict:
     """The TOML definition ``problems/NAME/problem.toml`` (published reference values).
+
+    Parameters
+    ----------
+    name : str
+        Problem name.
+    problems_dir : path, optional
+        Folder of the problem definitions (default: the package's).
+
+    Returns
+    -------
+    dict
+        The tables of the file.
 
     Raises
     ------
