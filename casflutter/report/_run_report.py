@@ -59,7 +59,7 @@ def flap_pulse_comparison(truth, model, structure, V: float, *, dt: float,
     for k, t0 in enumerate((0.2, 0.9, 1.6, 2.3)):
         w = 0.05 + 0.03 * k
         v += (-1) ** k * amplitude * np.exp(-0.5 * ((t - t0) / (0.35 * w)) ** 2)
-    sim_t = truth.simulate(t, np.zeros(2 * truth.n_modes), V, v=v)
+    sim_t = truth.simulate(t, truth.modal_state(), V, v=v)
     sim_r = simulate_loop(model, structure, V, t.size, v=v)
     motion = {"acceleration": sim_t.uddot, "velocity": sim_t.udot, "displacement": sim_t.u}
     return {"timepts": t, "v": v, "truth_zm": motion[structure.sensor] @ structure.Hs.T,

@@ -159,9 +159,8 @@ def _lco_amplitude(model, V: float, options: Mapping[str, Any]) -> dict[str, flo
     T = float(options.get("lco_time", 600.0))
     n = int(options.get("lco_samples", 6001))
     x0 = float(options.get("lco_x0", 0.01))
-    N = model.n_modes
     t = np.linspace(0.0, T, n)
-    sim = model.simulate(t, np.concatenate([np.full(N, x0), np.zeros(N)]), V)
+    sim = model.simulate(t, model.modal_state(u=np.full(model.n_modes, x0)), V)
     if not sim.success:
         raise RuntimeError(f"LCO simulation failed at V = {V:g}: {sim.message}")
     shapes = model.modal_structure().shapes

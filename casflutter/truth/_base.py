@@ -203,6 +203,31 @@ class AeroelasticTruth(abc.ABC):
         N = self.n_modes
         return [np.array([i, N + i]) for i in range(N)]
 
+    def modal_state(self, u=None, udot=None) -> np.ndarray:
+        """The truth's structural state ``[u, u']`` of given modal displacements and
+        velocities (an initial state of :meth:`simulate`, the flow at rest).
+
+        Parameters
+        ----------
+        u, udot : array_like, shape (N,), optional
+            Modal displacements and velocities (default zero).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(2N,)``.
+        """
+        N = self.n_modes
+        x = np.zeros(2 * N)
+        for values, offset, name in ((u, 0, "u"), (udot, N, "udot")):
+            if values is None:
+                continue
+            v = np.asarray(values, dtype=float).ravel()
+            if v.size != N:
+                raise DimensionError(f"{name} has {v.size} entries, the truth has {N} modes")
+            x[offset:offset + N] = v
+        return x
+
     def displaced_state(self, mode: int, deflection: float) -> np.ndarray:
         """The truth's structural state ``[u, u']`` at rest with mode ``mode`` displaced.
 
@@ -221,9 +246,9 @@ class AeroelasticTruth(abc.ABC):
         N = self.n_modes
         if not 0 <= int(mode) < N:
             raise DimensionError(f"mode {mode} is not one of the {N} modes (0-based)")
-        x = np.zeros(2 * N)
-        x[int(mode)] = deflection
-        return x
+        u = np.zeros(N)
+        u[int(mode)] = deflection
+        return self.modal_state(u)
 
     def _check_V(self, V: float) -> float:
         V = float(V)

@@ -53,6 +53,8 @@ def test_displaced_state_follows_each_models_ordering():
     assert_allclose(x[wing.n_modes:], 0.0)
     assert_allclose(ms.modal_state(u=[1, 2, 3, 4, 5], udot=[6, 7, 8, 9, 10]),
                     [1, 6, 2, 7, 3, 8, 4, 9, 5, 10])
+    assert_allclose(wing.modal_state(u=[1, 2, 3, 4, 5], udot=[6, 7, 8, 9, 10]),
+                    [1, 2, 3, 4, 5, 6, 7, 8, 9, 10])
     with pytest.raises(DimensionError, match="mode 5"):
         ms.displaced_state(5, 0.1)
     with pytest.raises(DimensionError, match="mode 7"):
