@@ -9,7 +9,6 @@
 - :func:`build_lft` — the uncertainty LFT of eq. 10-15 (Lemmas 1-2).
 """
 
-from ..structure import SENSOR_KINDS, ModalStructure
 from ._flutter import Crossing, FlutterResult, find_flutter, origin_modes
 from ._lft import AeroelasticLFT, build_lft
 from ._loop import (AeroelasticLoop, AeroelasticSystem, ParametricSystem, aeroelastic_loop,
@@ -18,7 +17,6 @@ from ._simulate import LoopSimulation, simulate_loop
 from ._tracking import EigenTracking, eig_sorted_by_reference, track_eigenvalues
 
 __all__ = [
-    "ModalStructure", "SENSOR_KINDS",
     "AeroelasticSystem", "AeroelasticLoop", "ParametricSystem", "aeroelastic_loop",
     "split_sigma_f",
     "EigenTracking", "track_eigenvalues", "eig_sorted_by_reference",

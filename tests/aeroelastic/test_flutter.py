@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from casflutter.aeroelastic import (AeroelasticSystem, ModalStructure, find_flutter,
-                                    track_eigenvalues)
+from casflutter.aeroelastic import AeroelasticSystem, find_flutter, track_eigenvalues
+from casflutter.structure import ModalStructure
 from casflutter import truth
 from casflutter.errors import ConfigError
 

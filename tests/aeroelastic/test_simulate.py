@@ -7,7 +7,8 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.signal import cont2discrete
 
-from casflutter.aeroelastic import ModalStructure, simulate_loop
+from casflutter.aeroelastic import simulate_loop
+from casflutter.structure import ModalStructure
 from casflutter.data import analyze_response
 from casflutter.errors import DimensionError
 from casflutter.ident import random_hwl_model

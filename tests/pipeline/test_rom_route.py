@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from casflutter.aeroelastic import AeroelasticSystem, ModalStructure, ParametricSystem
+from casflutter.aeroelastic import AeroelasticSystem, ParametricSystem
+from casflutter.structure import ModalStructure
 from casflutter.errors import ConfigError, DimensionError
 from casflutter.ident import HWLModel
 from casflutter.pipeline import config_path, load_config, run
