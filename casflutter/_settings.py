@@ -23,6 +23,7 @@ from __future__ import annotations
 import collections.abc
 import dataclasses
 import math
+import re
 import types
 import typing
 from typing import Any, Mapping
@@ -156,6 +157,9 @@ def _located(exc: ConfigError, path: str, names) -> ConfigError:
     head = msg.split(" ", 1)[0].split("=", 1)[0].split("[", 1)[0].rstrip(":.,")
     if head in names:
         return ConfigError(f"{path}.{msg}")
+    named = re.search(r"\b(" + "|".join(map(re.escape, names)) + r")\s*=", msg)
+    if named:  # a stage's own message naming the field somewhere inside
+        return ConfigError(f"{path}.{named.group(1)}: {msg}")
     return ConfigError(f"[{path}] {msg}")
 
 

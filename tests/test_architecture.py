@@ -15,8 +15,8 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1] / "casflutter"
 
 #: the stages, left to right; a module may import its own stage and those to its left
-LAYERS = ["structure", "data", "truth", "ident", "realize", "aeroelastic", "design", "verify",
-          "report", "pipeline", "study", "cli"]
+LAYERS = ["structure", "data", "truth", "ident", "realize", "aeroelastic", "lco", "design",
+          "verify", "report", "pipeline", "study", "cli"]
 #: helpers every stage may use
 INFRASTRUCTURE = {"errors", "_nlp", "_resources", "_settings", "_linalg", "__init__"}
 #: known exceptions: design/ still calls verify/ for its exact norms (the synthesis issue

@@ -9,13 +9,14 @@
 from ._config import (STAGES, ClosedLoopSection, ControllerSettings, DataSection,
                       FlutterSection, LcoSection, ParametricSection, ProblemSection, RomSection,
                       RunConfig, SensorsSection, SolverSection, VerifySection, config_path,
-                      default_config_path, load_config)
+                      default_config_path, flutter_config, load_config)
 from ._result import ClosedLoopChecks, LcoResult, ParametricResult, RunResult, SimulationCheck
 from ._run import run
 
 __all__ = [
     "run", "RunResult", "LcoResult", "ParametricResult", "SimulationCheck", "ClosedLoopChecks",
-    "RunConfig", "load_config", "default_config_path", "config_path", "STAGES",
+    "RunConfig", "load_config", "default_config_path", "config_path", "flutter_config",
+    "STAGES",
     "ProblemSection", "DataSection", "RomSection", "FlutterSection", "LcoSection",
     "ControllerSettings", "VerifySection", "ClosedLoopSection", "ParametricSection",
     "SensorsSection", "SolverSection",

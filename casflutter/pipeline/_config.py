@@ -39,12 +39,13 @@ from ..design import SynthesisOptions
 from ..errors import ConfigError
 from ..ident import HWLOrders, IdentificationSettings
 from ..structure import SENSOR_KINDS, check_sensor_rows
-from ..truth import RecordSettings, SuppressionSettings, load_problem, problem_names
+from ..truth import (RecordSettings, SuppressionSettings, file_problem_names, load_problem,
+                     problem_definition, problem_names)
 
 __all__ = ["RunConfig", "ProblemSection", "DataSection", "RomSection", "FlutterSection",
            "LcoSection", "ControllerSettings", "VerifySection", "ClosedLoopSection",
            "ParametricSection", "SensorsSection", "SolverSection", "STAGES", "load_config",
-           "default_config_path", "config_path"]
+           "default_config_path", "config_path", "flutter_config"]
 
 #: Optional stages, in the order they run (``RunConfig.stages``).
 STAGES = ("frozen", "parametric", "lco", "controller", "closed_loop", "suppression")
@@ -69,13 +70,19 @@ class ProblemSection:
     """``[problem]``: which truth, and its parameter changes."""
 
     name: str = "seed_wing"
-    """A problem name (``casflutter problems``)."""
+    """A problem name (``casflutter problems``) or the path of a problem TOML file."""
     set: dict = field(default_factory=dict)
     """Parameter changes ``{name = value}``, checked by the truth's parameter class."""
 
     def __post_init__(self):
-        if self.name not in problem_names():
-            raise ConfigError(f"name = {self.name!r}: allowed {', '.join(problem_names())}")
+        try:
+            load_problem(self.name)
+        except ConfigError as exc:
+            if not str(exc).startswith("unknown problem"):
+                raise ConfigError(f"name = {self.name!r}: {exc}") from None
+            raise ConfigError(f"name = {self.name!r}: allowed "
+                              f"{', '.join(problem_names() + file_problem_names())}, or a "
+                              "problem TOML file") from None
         try:
             load_problem(self.name, self.set)
         except ConfigError as exc:
@@ -405,6 +412,62 @@ def config_path(problem: str, name: str = "run") -> Path:
                           "write one (the tables of casflutter.pipeline.RunConfig) or pass a "
                           "configuration file")
     return path
+
+
+#: The ROM route of ``casflutter flutter`` on a problem without a ``flutter.toml``: the
+#: settings every ROM route shares (a problem file's ``[rom]`` table adds its own).
+_ROUTE = {"stages": ["frozen", "parametric"], "rom.method": "common_denominator",
+          "rom.nf": "auto", "data.coupling_delay": 0, "flutter.max_refine": 8,
+          "flutter.n_grid": 201, "sensors.kind": "displacement"}
+#: the keys of a problem file's ``[rom]`` table and the configuration keys they set
+_ROUTE_KEYS = {"V0": "data.V0", "dt": "data.dt", "duration": "data.duration",
+               "band": "data.band", "amplitude": "data.amplitude", "taper": "data.taper",
+               "flap": "data.flap", "na": "rom.na", "nb": "rom.nb",
+               "V_range": "flutter.V_range", "n_grid": "flutter.n_grid",
+               "n_speeds": "parametric.n_speeds"}
+
+
+def flutter_config(problem: str, *, updates=None) -> RunConfig:
+    """The ROM-route configuration of ``casflutter flutter PROBLEM``.
+
+    ``problems/PROBLEM/flutter.toml`` when the problem has one; otherwise (a problem file,
+    e.g. a rig section) the shared route settings with the ``[rom]`` table of the problem's
+    definition (``V0``, ``V_range``, ``dt``, ``duration``, ``band`` and optionally
+    ``amplitude``, ``taper``, ``flap``, ``na``, ``nb``, ``n_grid``, ``n_speeds``).
+
+    Parameters
+    ----------
+    problem : str
+        Problem name or problem file.
+    updates : mapping, optional
+        Changes by dotted path (as :func:`load_config`).
+
+    Returns
+    -------
+    RunConfig
+
+    Raises
+    ------
+    ConfigError
+        No route settings for the problem, or an invalid key or value (named).
+    """
+    if problem in problem_names():
+        return load_config(config_path(problem, "flutter"), updates=updates)
+    table = dict(problem_definition(problem).get("rom", {}))
+    unknown = [k for k in table if k not in _ROUTE_KEYS]
+    if unknown:
+        raise ConfigError(f"unknown key {unknown[0]!r} in the [rom] table of {problem}; "
+                          f"allowed: {', '.join(_ROUTE_KEYS)}")
+    missing = [k for k in ("V0", "V_range", "dt", "duration", "band") if k not in table]
+    if missing:
+        raise ConfigError(f"problem {problem} has no ROM-route settings for "
+                          f"{', '.join(missing)}: add them to its [rom] table")
+    route = {**_ROUTE, **{_ROUTE_KEYS[k]: v for k, v in table.items()},
+             "problem.name": str(problem), **(updates or {})}
+    table = {}
+    for key, value in route.items():
+        set_dotted(table, RunConfig, key, value)
+    return build_settings(RunConfig, table)
 
 
 def default_config_path() -> Path:

@@ -12,7 +12,10 @@ own linear state space in the speed index ``V`` gives the true flutter speed.
 - :class:`SeedWing` -- the paper's wind-tunnel wing with tip store (five modes at the
   paper's frequencies, strip theory with Wagner lags per strip, saturating lift, flap,
   tip-store accelerometers), nonlinear, calibrated to the paper's Vf and LCO.
-- :func:`load_problem` -- a problem by name, with parameter changes.
+- :class:`PitchPlungeSection` -- a dimensional pitch--plunge rig section read from a TOML
+  file (``kind = "pitch_plunge"``; Wagner or quasi-steady aerodynamics, polynomial pitch
+  spring, flap), e.g. the Texas A&M NATA section in ``problems/nata``.
+- :func:`load_problem` -- a problem by name or file, with parameter changes.
 - :func:`truth_records` -- chirp records of a truth (the paper's CFD runs, §IV.A).
 - :func:`truth_lco`, :func:`closed_loop_truth`, :func:`suppression_run`,
   :func:`truth_loop_sweep` -- the truth's own LCO, and the truth in closed loop with a
@@ -31,7 +34,9 @@ from ._goland import GolandParams, GolandWing
 from ._lco import TruthLco, truth_lco
 from ._params import parse_sets
 from ._records import RecordSettings, truth_records
-from ._registry import PROBLEMS, load_problem, problem_definition, problem_names
+from ._pitch_plunge import FlapCoefficients, PitchPlungeParams, PitchPlungeSection
+from ._registry import (PROBLEMS, file_problem_names, load_problem, load_problem_file,
+                        problem_definition, problem_label, problem_names)
 from ._seed_wing import (SEED_FREQUENCIES_HZ, SEED_MODE_NAMES, SEED_SENSOR_ROWS, SEED_U_REF,
                          SeedWing, SeedWingParams)
 from ._typical_section import TypicalSection, TypicalSectionParams
@@ -41,7 +46,9 @@ __all__ = [
     "TypicalSection", "TypicalSectionParams", "GolandWing", "GolandParams",
     "SeedWing", "SeedWingParams", "SEED_FREQUENCIES_HZ", "SEED_MODE_NAMES", "SEED_SENSOR_ROWS",
     "SEED_U_REF",
-    "PROBLEMS", "problem_names", "load_problem", "problem_definition", "parse_sets",
+    "PitchPlungeSection", "PitchPlungeParams", "FlapCoefficients",
+    "PROBLEMS", "problem_names", "file_problem_names", "load_problem", "load_problem_file",
+    "problem_definition", "problem_label", "parse_sets",
     "RecordSettings", "truth_records", "frozen_aero_truth",
     "TruthLco", "truth_lco",
     "TruthLoopSimulation", "closed_loop_truth", "gain_schedule", "SuppressionSettings",

@@ -26,7 +26,7 @@ def register(subparsers) -> None:
                     "with a parametric ROM interpolated in V; compare with the truth.  Speeds "
                     "in the problem's unit (speed index for the typical section, m/s for the "
                     "Goland wing).")
-    p.add_argument("problem", help="problem name (see `casflutter problems`)")
+    p.add_argument("problem", help="problem name (see `casflutter problems`) or rig TOML file")
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="NAME=VALUE",
                    help="change a problem parameter (repeatable)")
     p.add_argument("--vrange", nargs=2, type=float, metavar=("LO", "HI"), default=None,
@@ -152,11 +152,12 @@ def _fmt(x, unit="") -> str:
 
 def run(args) -> int:
     """Handler: run the route, print or write JSON, save the figure."""
-    from ...pipeline import config_path, load_config, run as run_config
-    from ...truth import load_problem, parse_sets
+    from ...pipeline import flutter_config, run as run_config
+    from ...truth import load_problem, parse_sets, problem_label
 
     changes = parse_sets(args.sets)
     truth = load_problem(args.problem, changes)
+    label = problem_label(args.problem)
     _, from_unit, vunit = _speed_conv(truth)
     updates = {"problem.set": changes}
     if args.vrange is not None:
@@ -164,12 +165,12 @@ def run(args) -> int:
         updates["flutter.V_range"] = [from_unit(lo), from_unit(hi)]
     if args.v0 is not None:
         updates["data.V0"] = from_unit(args.v0)
-    cfg = load_config(config_path(args.problem, "flutter"), updates=updates)
+    cfg = flutter_config(args.problem, updates=updates)
     if args.no_parametric:
         cfg = replace(cfg, stages=tuple(s for s in cfg.stages if s != "parametric"))
     result = run_config(cfg, quiet=True, write=False)
-    doc = summarize(result, args.problem)
-    fig_path = args.figure if args.figure is not None else f"{args.problem}_flutter.png"
+    doc = summarize(result, label)
+    fig_path = args.figure if args.figure is not None else f"{label}_flutter.png"
     if fig_path.lower() != "none":
         _figure(result, fig_path, float(truth.modal_structure().omega.max()),
                 "speed index " + truth.modal_structure().speed_index.split(",")[0])
@@ -181,7 +182,7 @@ def run(args) -> int:
         sys.stdout.write("\n")
         return 0
     u = doc["units"]
-    print(f"{args.problem}: flutter speed ({u['V_flutter']}), frequency ({u['omega_flutter']})")
+    print(f"{label}: flutter speed ({u['V_flutter']}), frequency ({u['omega_flutter']})")
     print(f"  {'':16} {'V_flutter':>14} {'omega_flutter':>14} {'mode':>12} {'V_divergence':>14}")
     for key, label in (("truth", "truth"), ("rom", f"ROM at V0={doc['rom_V0']:.4g}"),
                        ("frozen_aero_truth", "frozen-aero truth"),
