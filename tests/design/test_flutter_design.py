@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from casflutter.aeroelastic import AeroelasticSystem, ModalStructure, build_lft
+from casflutter.aeroelastic import AeroelasticSystem, build_lft
+from casflutter.structure import ModalStructure
 from casflutter.design import SynthesisOptions, design_flutter_controller, loop_abscissa
 from casflutter.errors import ConfigError
 from casflutter.verify import verify_controller
