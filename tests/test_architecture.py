@@ -18,7 +18,7 @@ ROOT = Path(__file__).resolve().parents[1] / "casflutter"
 LAYERS = ["structure", "data", "truth", "ident", "realize", "aeroelastic", "lco", "design",
           "verify", "report", "pipeline", "study", "cli"]
 #: helpers every stage may use
-INFRASTRUCTURE = {"errors", "_nlp", "_resources", "_settings", "_linalg", "__init__"}
+INFRASTRUCTURE = {"errors", "_nlp", "_resources", "_settings", "_linalg", "_threads", "__init__"}
 #: known exceptions: design/ still calls verify/ for its exact norms (the synthesis issue
 #: removes it; design must not share code with the verification)
 KNOWN = {("design", "verify")}
