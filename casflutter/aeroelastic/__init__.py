@@ -14,6 +14,7 @@
 
 from ._flutter import Crossing, FlutterResult, find_flutter, origin_modes
 from ._lft import AeroelasticLFT, build_lft
+from ._pk import PKResult, pk_flutter
 from ._rfa_system import RFASystem
 from ._loop import AeroelasticLoop, AeroelasticSystem, aeroelastic_loop, split_sigma_f
 from ._simulate import (LoopSimulation, ResponseAnalysis, analyze_response, dominant_frequency,
@@ -26,7 +27,7 @@ __all__ = [
     "AeroelasticSystem", "AeroelasticLoop", "aeroelastic_loop", "split_sigma_f",
     "EigenTracking", "track_eigenvalues", "eig_sorted_by_reference",
     "Crossing", "FlutterResult", "find_flutter", "origin_modes",
-    "AeroelasticLFT", "build_lft", "RFASystem",
+    "AeroelasticLFT", "build_lft", "RFASystem", "PKResult", "pk_flutter",
     "LoopSimulation", "ResponseAnalysis", "simulate_loop", "analyze_response",
     "envelope_growth_rate", "dominant_frequency",
 ]
