@@ -93,7 +93,7 @@ class RFASettings:
     weighting: str = "element"
     element_floor: float = 1e-2
     k_max: float | None = None
-    max_iter: int = 500
+    max_iter: int = 1000
     tol: float = 1e-10
 
     def __post_init__(self):
@@ -322,11 +322,17 @@ def _order_constraints(lg, n):
 
 
 def _solve(nlp, x0, lbx, ubx, lbg, ubg, settings, name) -> NLPResult:
+    # the objective is log(residual / data): a gradient of 1e-5 changes it negligibly, and at
+    # fits near the rounding floor the gradient is noise of about that size
     opts = {"ipopt.max_iter": int(settings.max_iter), "ipopt.tol": float(settings.tol),
-            "ipopt.acceptable_tol": 1e-6}
+            "ipopt.acceptable_tol": 1e-5, "ipopt.acceptable_iter": 10}
     res = solve_nlp(nlp, x0, options=opts, name=name, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg,
                     accept_acceptable=True)
-    if not res.success:
+    # exactly rational data: the residual reaches the floor of the objective, its curvature
+    # there is enormous and Ipopt stops on a vanishing step -- at the global minimum
+    exact = (res.return_status == "Search_Direction_Becomes_Too_Small"
+             and res.f < np.log(1e3 * _FIT_FLOOR))
+    if not (res.success or exact):
         raise ConvergenceError(
             f"the {name} lag-root optimisation did not converge (Ipopt: {res.return_status} "
             f"after {res.iterations} iterations); raise max_iter, change n_lags or "
@@ -347,8 +353,14 @@ def _projected_lags(k, Y, settings, lg):
     return Yp, Qh, Rh
 
 
+#: floor of the relative residual inside the logarithm: keeps the objective bounded (and its
+#: Hessian finite) when the data are exactly rational in the lag roots (a fit error of 1e-10)
+_FIT_FLOOR = 1e-20
+
+
 def _log_objective(J, Yp):
-    return ca.log(J / float(np.sum(Yp ** 2)))
+    """``log(J / ||Yp||^2 + floor)``: the scale-free objective of both fits."""
+    return ca.log(J / float(np.sum(Yp ** 2)) + _FIT_FLOOR)
 
 
 def _fit_roger_lags(k, Y, settings, bounds, lg0) -> tuple[np.ndarray, NLPResult]:
@@ -363,23 +375,33 @@ def _fit_roger_lags(k, Y, settings, bounds, lg0) -> tuple[np.ndarray, NLPResult]
 
 
 def _fit_ms_lags(k, Y, w, settings, bounds, lg0, E0, N, M):
-    n = settings.n_lags
-    lg = ca.SX.sym("log_gamma", n)
-    Ev = ca.SX.sym("E", n * M)
+    # MX (matrix-valued) expressions: the element-by-element SX graph of this objective
+    # is large and its exact Hessian slow to build; D comes from its normal equations row by
+    # row, the residual is then formed explicitly (accurate to first order in D's rounding)
+    n, nk = settings.n_lags, k.size
+    lg = ca.MX.sym("log_gamma", n)
+    Ev = ca.MX.sym("E", n * M)
     E = ca.reshape(Ev, M, n).T                            # (n, M), row-major in Ev
-    Yp, Qh, Rh = _projected_lags(k, Y, settings, lg)
-    Bh = ca.mtimes(Qh.T, ca.DM(Yp))                       # (n, N M) coordinates in span(H)
-    J = ca.sumsqr(ca.DM(Yp) - ca.mtimes(Qh, Bh))          # the part no lag can reach
-    K = ca.mtimes(Rh.T, Rh)
-    C = ca.mtimes(Rh.T, Bh)
+    P0 = _poly_basis(k, settings.poly_order)
+    Yp = Y - P0 @ np.linalg.lstsq(P0, Y, rcond=None)[0]
+    gam = ca.exp(lg)
+    k2 = ca.DM(k * k)
+    den = ca.repmat(k2, 1, n) + ca.repmat((gam * gam).T, nk, 1)
+    G = ca.vertcat(ca.repmat(k2, 1, n) / den,
+                   ca.repmat(ca.DM(k), 1, n) * ca.repmat(gam.T, nk, 1) / den)
+    H = G - ca.mtimes(ca.DM(P0), ca.mtimes(ca.DM(np.linalg.pinv(P0)), G))
+    H = H / ca.repmat(ca.sqrt(ca.sum1(H * H)), 2 * nk, 1)
+    K = ca.mtimes(H.T, H)
+    C = ca.mtimes(H.T, ca.DM(Yp))                          # (n, N M)
+    J = 0
     for i in range(N):
-        # row i of D by its normal equations, then the residual in span(H) formed explicitly
         Ew = E * ca.repmat(ca.DM(w[i]).T, n, 1)
         rhs = ca.sum2(Ew * C[:, i * M:(i + 1) * M])
-        Di = ca.solve(K * ca.mtimes(Ew, Ew.T), rhs)
-        J = J + ca.sumsqr(Bh[:, i * M:(i + 1) * M] - ca.mtimes(Rh, Ew * ca.repmat(Di, 1, M)))
+        Di = ca.solve(K * ca.mtimes(Ew, Ew.T), rhs)       # row i of D (unit-column basis)
+        J = J + ca.sumsqr(ca.DM(Yp[:, i * M:(i + 1) * M]) - ca.mtimes(H, Ew * ca.repmat(Di, 1, M)))
     sep = np.log1p(settings.min_separation)
-    g = ca.vertcat(_order_constraints(lg, n), *[ca.sumsqr(E[j, :]) for j in range(n)])
+    g = ca.vertcat(*[lg[j + 1] - lg[j] for j in range(n - 1)],
+                   *[ca.sumsqr(E[j, :]) for j in range(n)])
     lbg = np.concatenate([np.full(n - 1, sep), np.ones(n)])
     ubg = np.concatenate([np.full(n - 1, np.inf), np.ones(n)])
     x0 = np.concatenate([lg0, E0.ravel()])
@@ -388,6 +410,41 @@ def _fit_ms_lags(k, Y, w, settings, bounds, lg0, E0, N, M):
     res = _solve({"x": ca.vertcat(lg, Ev), "f": _log_objective(J, Yp), "g": g}, x0, lbx, ubx,
                  lbg, ubg, settings, "minimum_state_rfa")
     return np.exp(res.x[:n]), res.x[n:].reshape(n, M), res
+
+
+MS_PER_ROOT = 2
+
+
+def _ms_start(k, Y, w, s: RFASettings, kmax, bounds, N, M):
+    """Starting roots and ``E`` of the minimum-state fit: Roger's optimum with
+    ``ceil(n_lags / per_root)`` roots, each root's lag matrix split into its ``per_root`` leading
+    singular directions (rows of ``E``), the copies of a root spread by the separation factor."""
+    per_root = MS_PER_ROOT
+    n = s.n_lags
+    nr = int(np.ceil(n / per_root))
+    sr = replace(s, method="roger", n_lags=nr, initial_lags=None)
+    gamma, _ = _fit_roger_lags(k, Y, sr, bounds, _initial_lags(sr, kmax, bounds))
+    X = _roger_lstsq(k, Y, gamma, s.poly_order) / w.reshape(1, -1)
+    lagm = X[s.poly_order + 1:].reshape(nr, N, M)
+    counts = np.full(nr, n // nr)
+    counts[:n % nr] += 1
+    factor = 1.0 + max(s.min_separation, 1e-3)
+    roots, rows = [], []
+    for j in range(nr):
+        Vt = np.linalg.svd(lagm[j])[2]
+        for c in range(counts[j]):
+            roots.append(gamma[j] * factor ** (c - 0.5 * (counts[j] - 1)))
+            rows.append(Vt[c % Vt.shape[0]])
+    order = np.argsort(roots)
+    lg = np.log(np.asarray(roots)[order])
+    lo, hi = np.log(bounds[0]), np.log(bounds[1])
+    sep = np.log1p(s.min_separation)
+    lg = np.clip(lg, lo, hi)
+    for j in range(1, n):
+        lg[j] = max(lg[j], lg[j - 1] + sep)
+    for j in range(n - 2, -1, -1):
+        lg[j] = min(lg[j], lg[j + 1] - sep)
+    return lg, np.asarray(rows)[order]
 
 
 def fit_rfa(table: GAFTable, settings: RFASettings | None = None,
@@ -434,21 +491,19 @@ def fit_rfa(table: GAFTable, settings: RFASettings | None = None,
     scale = _element_scale(Q, s)
     w = 1.0 / scale                                       # (N, M)
     Y = _stack(Q) * w.reshape(1, -1)
-    lg0 = _initial_lags(s, kmax, bounds)
-    gamma, res = _fit_roger_lags(k, Y, replace(s, method="roger"), bounds, lg0)
-    log.info("Roger lag roots %s (%d Ipopt iterations, %s)", np.round(gamma, 5),
-             res.iterations, res.return_status)
-    X = _roger_lstsq(k, Y, gamma, s.poly_order) / w.reshape(1, -1)
-    A = np.zeros((3, N, M))
-    A[:s.poly_order + 1] = X[:s.poly_order + 1].reshape(-1, N, M)
-    lagm = X[s.poly_order + 1:].reshape(s.n_lags, N, M)
     if s.method == "roger":
-        D = np.hstack(list(lagm))
+        gamma, res = _fit_roger_lags(k, Y, s, bounds, _initial_lags(s, kmax, bounds))
+        log.info("Roger lag roots %s (%d Ipopt iterations, %s)", np.round(gamma, 5),
+                 res.iterations, res.return_status)
+        X = _roger_lstsq(k, Y, gamma, s.poly_order) / w.reshape(1, -1)
+        A = np.zeros((3, N, M))
+        A[:s.poly_order + 1] = X[:s.poly_order + 1].reshape(-1, N, M)
+        D = np.hstack(list(X[s.poly_order + 1:].reshape(s.n_lags, N, M)))
         R = np.repeat(-gamma, M)
         E = np.vstack([np.eye(M)] * s.n_lags)
     else:
-        E0 = np.array([np.linalg.svd(Aj)[2][0] for Aj in lagm])
-        gamma, E, res = _fit_ms_lags(k, Y, w, s, bounds, np.log(gamma), E0, N, M)
+        lg0, E0 = _ms_start(k, Y, w, s, kmax, bounds, N, M)
+        gamma, E, res = _fit_ms_lags(k, Y, w, s, bounds, lg0, E0, N, M)
         log.info("minimum-state lag roots %s (%d Ipopt iterations, %s)", np.round(gamma, 5),
                  res.iterations, res.return_status)
         D, X0 = _ms_lstsq(k, Y, w, gamma, E, s.poly_order, N, M)
