@@ -204,7 +204,8 @@ def pk_flutter(table: GAFTable, structure: ModalStructure, speeds, *, U_ref: flo
         raise ConfigError(f"table must be a casflutter.data.GAFTable, got {type(table).__name__}")
     if table.n_modes != structure.n_modes:
         raise DimensionError(f"the table has {table.n_modes} modes but the structure has "
-                             f"{structure.n_modes}; use the same modes for Q(ik) and the modal data")
+                             f"{structure.n_modes}; use the same modes for Q(ik) and the modal "
+                             "data")
     U_ref = table.U_ref if U_ref is None else float(U_ref)
     if U_ref is None or not np.isfinite(U_ref) or U_ref <= 0:
         raise ConfigError("U_ref (airspeed per unit speed index) is needed: give U_ref= or a "

@@ -166,7 +166,9 @@ class RationalApproximation:
     mode_names, input_names : tuple of str
         Rows and columns of Q.
     nlp : NLPResult
-        The Ipopt solve of the lag roots.
+        The Ipopt solve of the lag roots (``Solve_Succeeded``, ``Solved_To_Acceptable_Level``,
+        or ``Search_Direction_Becomes_Too_Small`` when the data are exactly rational in the
+        roots and the residual sits at the rounding floor).
     """
 
     method: str
@@ -226,11 +228,12 @@ class RationalApproximation:
         return self.evaluate_p(1j * np.asarray(k, dtype=float))
 
     def summary(self) -> str:
-        """One line: method, lag roots, overall and worst element fit error."""
+        """One line: method, lag roots, overall and worst element fit error, Ipopt status."""
         i, j = np.unravel_index(np.argmax(self.error_rel), self.error_rel.shape)
         return (f"{self.method} RFA, {self.n_lags} lag roots {np.round(self.gamma, 4).tolist()}, "
                 f"{self.n_lag_states} lag states; fit error {self.fit_error:.2e}, worst element "
-                f"({self.mode_names[i]}, {self.input_names[j]}) {self.error_rel[i, j]:.2e}")
+                f"({self.mode_names[i]}, {self.input_names[j]}) {self.error_rel[i, j]:.2e}; "
+                f"Ipopt {self.nlp.return_status}")
 
 
 # ---- bases --------------------------------------------------------------------------------
@@ -398,7 +401,8 @@ def _fit_ms_lags(k, Y, w, settings, bounds, lg0, E0, N, M):
         Ew = E * ca.repmat(ca.DM(w[i]).T, n, 1)
         rhs = ca.sum2(Ew * C[:, i * M:(i + 1) * M])
         Di = ca.solve(K * ca.mtimes(Ew, Ew.T), rhs)       # row i of D (unit-column basis)
-        J = J + ca.sumsqr(ca.DM(Yp[:, i * M:(i + 1) * M]) - ca.mtimes(H, Ew * ca.repmat(Di, 1, M)))
+        model = ca.mtimes(H, Ew * ca.repmat(Di, 1, M))
+        J = J + ca.sumsqr(ca.DM(Yp[:, i * M:(i + 1) * M]) - model)
     sep = np.log1p(settings.min_separation)
     g = ca.vertcat(*[lg[j + 1] - lg[j] for j in range(n - 1)],
                    *[ca.sumsqr(E[j, :]) for j in range(n)])
@@ -412,14 +416,15 @@ def _fit_ms_lags(k, Y, w, settings, bounds, lg0, E0, N, M):
     return np.exp(res.x[:n]), res.x[n:].reshape(n, M), res
 
 
-MS_PER_ROOT = 2
+#: minimum-state start: Roger's fit with one root per this many lag states
+_MS_PER_ROOT = 2
 
 
 def _ms_start(k, Y, w, s: RFASettings, kmax, bounds, N, M):
     """Starting roots and ``E`` of the minimum-state fit: Roger's optimum with
     ``ceil(n_lags / per_root)`` roots, each root's lag matrix split into its ``per_root`` leading
     singular directions (rows of ``E``), the copies of a root spread by the separation factor."""
-    per_root = MS_PER_ROOT
+    per_root = _MS_PER_ROOT
     n = s.n_lags
     nr = int(np.ceil(n / per_root))
     sr = replace(s, method="roger", n_lags=nr, initial_lags=None)
