@@ -2,7 +2,9 @@
 
 ``problem dict -> nlpsol -> checked stats -> frozen NLPResult``.  Identification,
 synthesis and the parametric studies all go through :func:`make_solver` /
-:func:`solve_nlp`; nobody else calls ``casadi.nlpsol``.
+:func:`solve_nlp`; nobody else calls ``casadi.nlpsol``.  Square nonlinear systems (the
+collocation of periodic orbits in :mod:`casflutter.lco`, built as CasADi functions) go
+through :func:`solve_newton`.
 """
 
 from __future__ import annotations
@@ -13,10 +15,13 @@ from typing import Any, Mapping
 
 import casadi as ca
 import numpy as np
+from scipy.linalg import lu_factor, lu_solve
+from scipy.sparse.linalg import splu
 
 from .errors import ConvergenceError
 
-__all__ = ["NLPResult", "NLPSolver", "make_solver", "solve_nlp", "DEFAULT_IPOPT_OPTIONS"]
+__all__ = ["NLPResult", "NLPSolver", "make_solver", "solve_nlp", "DEFAULT_IPOPT_OPTIONS",
+           "RootResult", "solve_newton"]
 
 #: Quiet Ipopt defaults; every key may be overridden through ``options``.
 DEFAULT_IPOPT_OPTIONS: dict[str, Any] = {
@@ -147,3 +152,128 @@ def solve_nlp(nlp: Mapping[str, Any], x0, *, options: Mapping[str, Any] | None =
               name: str = "nlp", **kwargs) -> NLPResult:
     """Build and solve once. Keyword arguments are those of :meth:`NLPSolver.__call__`."""
     return make_solver(nlp, options, name)(x0, **kwargs)
+
+
+# ---- square nonlinear systems (collocation of periodic orbits, invariant circles) --------
+@dataclass(frozen=True)
+class RootResult:
+    """Outcome of one Newton solve of ``g(x) = 0``.
+
+    Attributes
+    ----------
+    x : ndarray
+        Solution (or last iterate when ``success`` is False).
+    residual : float
+        ``max |g(x)|`` at ``x``.
+    success : bool
+        True when the residual is finite and at most the tolerance.
+    return_status : str
+        ``"success"``, ``"max_iter"``, ``"singular_jacobian"``, ``"non_finite"`` or
+        ``"no_descent"`` (the damped step could not reduce the residual).
+    iterations : int
+        Newton iterations.
+    wall_time : float
+        Wall-clock seconds of the solve.
+    factor : scipy.sparse.linalg.SuperLU or None
+        LU factors of the last Jacobian factorised (at the last iterate but one), for
+        callers that solve further systems with it (continuation tangents).
+    """
+
+    x: np.ndarray
+    residual: float
+    success: bool
+    return_status: str
+    iterations: int
+    wall_time: float
+    factor: Any = field(default=None, repr=False, compare=False)
+
+
+class _DenseLU:
+    """LU factors of a dense matrix with the ``solve`` method of ``SuperLU``."""
+
+    def __init__(self, A: np.ndarray):
+        self._lu = lu_factor(A, check_finite=True)
+        if np.any(np.diag(self._lu[0]) == 0):
+            raise np.linalg.LinAlgError("singular matrix")
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        return lu_solve(self._lu, b)
+
+
+def solve_newton(residual, jacobian, x0, *, tol: float = 1e-10, max_iter: int = 20,
+                 name: str = "root") -> RootResult:
+    """Damped Newton iteration for a square sparse system ``g(x) = 0``.
+
+    Used for the bordered collocation systems of :mod:`casflutter.lco`, whose residual and
+    sparse Jacobian are CasADi functions (``casadi.rootfinder`` would rebuild the Jacobian
+    of the dense phase and arclength rows symbolically, which costs seconds per problem,
+    and its ``newton`` plugin reports success on non-finite iterates).  Each step solves
+    with a sparse LU factorisation; the step is halved (at most five times) until the
+    residual norm decreases.
+
+    Parameters
+    ----------
+    residual : callable
+        ``x -> g(x)`` (1-D array).
+    jacobian : callable
+        ``x -> dg/dx`` (``scipy.sparse`` matrix, or a dense ``numpy`` array).
+    x0 : array_like
+        Initial guess.
+    tol : float
+        Convergence: ``max |g| <= tol``.
+    max_iter : int
+        Newton iterations.
+    name : str
+        Name used in log messages.
+
+    Returns
+    -------
+    RootResult
+        Never raises on non-convergence: read ``success``.
+    """
+    t0 = time.perf_counter()
+    x = np.asarray(x0, dtype=float).ravel().copy()
+    g = np.asarray(residual(x), float).ravel()
+    nrm = float(np.max(np.abs(g), initial=0.0))
+    status, it, lu = "max_iter", 0, None
+    while it < max_iter:
+        if not np.isfinite(nrm):
+            status = "non_finite"
+            break
+        if nrm <= tol:
+            status = "success"
+            break
+        try:
+            J = jacobian(x)
+            lu = _DenseLU(J) if isinstance(J, np.ndarray) else splu(J.tocsc())
+            dx = lu.solve(-g)
+        except (RuntimeError, np.linalg.LinAlgError, ValueError):
+            status = "singular_jacobian"
+            break
+        if not np.all(np.isfinite(dx)):
+            status = "singular_jacobian"
+            break
+        it += 1
+        lam, accepted = 1.0, False
+        for _ in range(6):
+            xt = x + lam * dx
+            gt = np.asarray(residual(xt), float).ravel()
+            nt = float(np.max(np.abs(gt), initial=0.0))
+            if np.isfinite(nt) and nt < nrm * (1.0 - 1e-4 * lam):
+                accepted = True
+                break
+            lam *= 0.5
+        if not accepted:
+            # accept a full step that stalls at round-off level, otherwise give up
+            if np.isfinite(nt) and nt <= 10.0 * tol:
+                x, g, nrm = xt, gt, nt
+                continue
+            status = "no_descent"
+            break
+        x, g, nrm = xt, gt, nt
+    else:
+        if np.isfinite(nrm) and nrm <= tol:
+            status = "success"
+    ok = status == "success"
+    return RootResult(x=x, residual=nrm, success=ok, return_status=status, iterations=it,
+                      wall_time=time.perf_counter() - t0, factor=lu)

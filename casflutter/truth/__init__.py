@@ -11,6 +11,9 @@ own linear state space in the speed index ``V`` gives the true flutter speed.
 - :class:`SeedWing` -- the paper's wind-tunnel wing with tip store (five modes at the
   paper's frequencies, strip theory with Wagner lags per strip, saturating lift, flap,
   tip-store accelerometers), nonlinear, calibrated to the paper's Vf and LCO.
+- :class:`PitchPlungeSection` -- a dimensional pitch--plunge rig section read from a TOML
+  file (``kind = "pitch_plunge"``; Wagner or quasi-steady aerodynamics, polynomial pitch
+  spring, flap), e.g. the Texas A&M NATA section in ``problems/nata``.
 """
 
 from ._aero import JONES_A, JONES_B, jones_C, strip_coefficients, theodorsen_T
@@ -18,7 +21,9 @@ from ._base import AeroelasticTruth, AeroMatrices, ModalStructure, SimulationRes
 from ._goland import GolandParams, GolandWing
 from ._seed_wing import (SEED_FREQUENCIES_HZ, SEED_MODE_NAMES, SEED_SENSOR_ROWS, SEED_U_REF,
                          SeedWing, SeedWingParams)
-from ._registry import PROBLEMS, load_problem, problem_definition, problem_names
+from ._pitch_plunge import FlapCoefficients, PitchPlungeParams, PitchPlungeSection
+from ._registry import (PROBLEMS, file_problem_names, load_problem, load_problem_file,
+                        problem_definition, problem_label, problem_names)
 from ._typical_section import TypicalSection, TypicalSectionParams
 
 __all__ = [
@@ -26,6 +31,8 @@ __all__ = [
     "TypicalSection", "TypicalSectionParams", "GolandWing", "GolandParams",
     "SeedWing", "SeedWingParams", "SEED_FREQUENCIES_HZ", "SEED_MODE_NAMES", "SEED_SENSOR_ROWS",
     "SEED_U_REF",
-    "PROBLEMS", "problem_names", "load_problem", "problem_definition",
+    "PitchPlungeSection", "PitchPlungeParams", "FlapCoefficients",
+    "PROBLEMS", "problem_names", "file_problem_names", "load_problem", "load_problem_file",
+    "problem_definition", "problem_label",
     "JONES_A", "JONES_B", "jones_C", "theodorsen_T", "strip_coefficients",
 ]

@@ -24,6 +24,7 @@ from __future__ import annotations
 import abc
 from dataclasses import dataclass
 
+import casadi as ca
 import control
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -226,6 +227,11 @@ class AeroelasticTruth(abc.ABC):
     def _zeta(self) -> np.ndarray:
         return np.full(self._omega.size, float(getattr(self.params, "zeta", 0.0)))
 
+    def _modal_damping(self) -> np.ndarray:
+        """Modal damping matrix ``D`` of ``u'' + D u' + ...`` (``diag(2 zeta omega)`` unless a
+        problem has physical dampers that couple the modes)."""
+        return np.diag(2.0 * self._zeta() * self._omega)
+
     # ---- public ----------------------------------------------------------------------
     def with_updates(self, **changes: float):
         """The same problem with some parameters changed (unknown names raise ConfigError)."""
@@ -250,6 +256,11 @@ class AeroelasticTruth(abc.ABC):
                               sensor_rows=np.asarray(nm["sensor_rows"], float),
                               sensor_names=tuple(nm["sensor_names"]),
                               time_unit=nm["time_unit"], speed_index=nm["speed_index"])
+
+    def sensor_units(self) -> tuple[str, ...]:
+        """Units of the sensor rows' readings (``""`` where the problem gives none)."""
+        nm = self._names()
+        return tuple(nm.get("sensor_units", ("",) * len(nm["sensor_names"])))
 
     def _check_V(self, V: float) -> float:
         V = float(V)
@@ -348,9 +359,8 @@ class AeroelasticTruth(abc.ABC):
         a0 = 1.0 - sum(JONES_A)
         Mm = np.eye(N) - P @ am.Mx @ Phi
         Minv = np.linalg.inv(Mm)
-        zeta = self._zeta()
         Ku = -np.diag(self._omega ** 2) + P @ (am.Kx + a0 * am.W @ am.Gx) @ Phi
-        Cu = -np.diag(2.0 * zeta * self._omega) + P @ (am.Cx + a0 * am.W @ am.Gx1) @ Phi
+        Cu = -self._modal_damping() + P @ (am.Cx + a0 * am.W @ am.Gx1) @ Phi
         Z = [A * lam * P @ am.W for A, lam in zip(JONES_A, am.lams)]
         Bv = [P @ (am.Fv + a0 * am.W @ am.Gv), P @ (am.Fv1 + a0 * am.W @ am.Gv1), P @ am.Fv2]
         nx = 2 * N + 2 * ng
@@ -442,6 +452,72 @@ class AeroelasticTruth(abc.ABC):
         return control.ss(A, B, C, D, states=states, inputs=inputs, outputs=outputs,
                           name=f"{type(self).__name__}_V{V:g}".replace(".", "p"))
 
+    # ---- CasADi vector field (periodic orbits, casflutter.lco) -----------------------
+    #: speeds at which the V-polynomial coefficients of the coupled matrices are sampled
+    _V_NODES: tuple[float, float, float] = (0.5, 1.0, 2.0)
+
+    def _quadratic_in_V(self, fun) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Exact coefficients ``(c0, c1, c2)`` of ``fun(V) = c0 + c1 V + c2 V^2``.
+
+        Theodorsen's strip coefficients and the Jones lag rates are linear or quadratic in
+        the airspeed, so every block of the coupled operator is a quadratic polynomial in
+        ``V``: the coefficients follow from three speeds (:attr:`_V_NODES`), and a fourth
+        speed checks that the polynomial is exact.
+
+        Raises
+        ------
+        ConfigError
+            If ``fun`` is not quadratic in ``V`` (a truth whose operator is not).
+        """
+        v = np.asarray(self._V_NODES, float)
+        F = [np.asarray(fun(float(vk)), float) for vk in v]
+        Vd = np.vander(v, 3, increasing=True)
+        coef = np.linalg.solve(Vd, np.array([f.ravel() for f in F]))
+        c = [coef[k].reshape(F[0].shape) for k in range(3)]
+        vt = 1.7 * v[-1]
+        ref = np.asarray(fun(vt), float)
+        err = np.max(np.abs(c[0] + vt * c[1] + vt * vt * c[2] - ref), initial=0.0)
+        if err > 1e-9 * max(np.max(np.abs(ref), initial=0.0), 1e-300):
+            raise ConfigError(f"{type(self).__name__}: the coupled operator is not quadratic in "
+                              f"the speed (mismatch {err:.3g}); its CasADi vector field needs "
+                              "its own implementation")
+        return c[0], c[1], c[2]
+
+    def vector_field(self) -> ca.Function:
+        """The nonlinear truth without flap as a CasADi function ``f(x, V) -> dx/dt``.
+
+        The state is that of :meth:`simulate`, ``x = [u, u', z1, z2]``; ``f`` is the linear
+        coupled operator of :meth:`state_matrix` (written exactly as a quadratic polynomial
+        in ``V``, see :meth:`_quadratic_in_V`) plus the nonlinear structural force
+        ``f_nl`` of the problem, the same right-hand side as :meth:`flap_dynamics` with the
+        flap at rest.  Periodic orbits (LCO) are solved and continued on it
+        (:mod:`casflutter.lco`).
+
+        Returns
+        -------
+        casadi.Function
+            ``f(x, V)``: ``x`` of length ``2N + 2 ng``, ``V`` the speed index; output
+            ``dx/dt``.
+        """
+        A0, A1, A2 = self._quadratic_in_V(lambda V: self._coupled(V)["A"])
+        Minv = self._coupled(self._V_NODES[0])["Minv"]
+        if not np.allclose(Minv, self._coupled(self._V_NODES[-1])["Minv"], rtol=1e-12,
+                           atol=0.0):
+            raise ConfigError(f"{type(self).__name__}: the apparent mass depends on the speed; "
+                              "its CasADi vector field needs its own implementation")
+        N, nx = self.n_modes, A0.shape[0]
+        x = ca.SX.sym("x", nx)
+        V = ca.SX.sym("V")
+        dx = ca.mtimes(ca.DM(A0) + V * ca.DM(A1) + V * V * ca.DM(A2), x)
+        Phi = self._Phi
+        if self._nonlinear_force(np.zeros(Phi.shape[0])) is not None:
+            xp = ca.mtimes(ca.DM(Phi), x[:N])
+            fnl = self._nonlinear_force(xp)
+            fnl = ca.vertcat(*[fnl[i] for i in range(Phi.shape[0])])
+            corr = ca.mtimes(ca.DM(Minv @ Phi.T), fnl)
+            dx = ca.vertcat(dx[:N], dx[N:2 * N] - corr, dx[2 * N:])
+        return ca.Function("truth_vector_field", [x, V], [dx], ["x", "V"], ["xdot"])
+
     # ---- nonlinear simulation --------------------------------------------------------
     def flap_dynamics(self, V: float, linear: bool = False):
         """The truth as ``f(s, v, v', v'') -> (ds/dt, u'')`` for a flap driven from outside
@@ -526,8 +602,7 @@ class AeroelasticTruth(abc.ABC):
                         for tt, s in zip(t, S)])
         u, ud = S[:, :N], S[:, N:2 * N]
         # eq. (6): alpha V^2 y = u'' + 2 zeta omega u' + omega^2 u + Phi^T f_nl
-        zeta = self._zeta()
-        aV2y = acc + ud * (2 * zeta * self._omega) + u * self._omega ** 2
+        aV2y = acc + ud @ self._modal_damping().T + u * self._omega ** 2
         if has_nl:
             aV2y = aV2y + np.array([Phi.T @ self._nonlinear_force(Phi @ ui) for ui in u])
         V = self._check_V(V)

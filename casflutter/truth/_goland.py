@@ -285,6 +285,7 @@ class GolandWing(AeroelasticTruth):
                 "sensor_rows": rows,
                 "sensor_names": ("tip plunge [m]", "tip pitch [rad]",
                                  "tip leading edge [m]", "tip trailing edge [m]"),
+                "sensor_units": ("m", "rad", "m", "m"),
                 "time_unit": "s",
                 "speed_index": "V = U / (b omega_ref), omega_ref = (pi/2L) sqrt(GJ/I)"}
 

@@ -1,4 +1,10 @@
-"""The registry of truth problems and their definitions in ``problems/``."""
+"""The registry of truth problems and their definitions in ``problems/``.
+
+A problem is named by one of :data:`PROBLEMS` (a built-in truth class with published
+defaults), by a TOML file describing a rig section (``kind = "pitch_plunge"``, see
+:mod:`._pitch_plunge`), or by the name of a folder of ``problems/`` whose ``problem.toml`` is
+such a file (e.g. ``nata``).
+"""
 
 from __future__ import annotations
 
@@ -8,10 +14,12 @@ from .._resources import read_toml
 from ..errors import ConfigError
 from ._base import AeroelasticTruth
 from ._goland import GolandWing
+from ._pitch_plunge import PITCH_PLUNGE_KIND, PitchPlungeSection
 from ._seed_wing import SeedWing
 from ._typical_section import TypicalSection
 
-__all__ = ["PROBLEMS", "problem_names", "load_problem", "problem_definition"]
+__all__ = ["PROBLEMS", "FILE_KINDS", "problem_names", "file_problem_names", "load_problem",
+           "load_problem_file", "problem_definition", "problem_label"]
 
 #: name -> truth class
 PROBLEMS: dict[str, type[AeroelasticTruth]] = {
@@ -19,6 +27,10 @@ PROBLEMS: dict[str, type[AeroelasticTruth]] = {
     "goland": GolandWing,
     "seed_wing": SeedWing,
 }
+
+#: ``kind`` of a problem file -> truth class reading it
+FILE_KINDS: dict[str, type[AeroelasticTruth]] = {PITCH_PLUNGE_KIND: PitchPlungeSection}
+
 
 def _problems_dir() -> Path:
     from .._resources import problems_dir
@@ -31,11 +43,77 @@ def problem_names() -> list[str]:
     return list(PROBLEMS)
 
 
+def file_problem_names() -> list[str]:
+    """Names of the folders of ``problems/`` holding a problem file (``kind = ...``)."""
+    try:
+        root = _problems_dir()
+    except FileNotFoundError:
+        return []
+    out = []
+    for path in sorted(root.glob("*/problem.toml")):
+        if path.parent.name in PROBLEMS:
+            continue
+        try:
+            if read_toml(path, "problem definition").get("kind") in FILE_KINDS:
+                out.append(path.parent.name)
+        except ConfigError:
+            continue
+    return out
+
+
+def _file_of(name: str) -> Path | None:
+    """The problem file meant by ``name`` (a TOML path, a folder holding ``problem.toml``, or
+    a folder of ``problems/``), or None for a built-in or unknown name."""
+    name = str(name)
+    if name in PROBLEMS:
+        return None
+    path = Path(name)
+    if path.suffix == ".toml" or path.is_file():
+        if not path.is_file():
+            raise ConfigError(f"problem file {path} not found: the file does not exist")
+        return path
+    if path.is_dir() and (path / "problem.toml").is_file():
+        return path / "problem.toml"
+    if name in file_problem_names():
+        return _problems_dir() / name / "problem.toml"
+    return None
+
+
 def _cls(name: str) -> type[AeroelasticTruth]:
     try:
         return PROBLEMS[name]
     except KeyError:
-        raise ConfigError(f"unknown problem {name!r}; available: {', '.join(PROBLEMS)}") from None
+        avail = list(PROBLEMS) + file_problem_names()
+        raise ConfigError(f"unknown problem {name!r}; available: {', '.join(avail)}, or a "
+                          "problem TOML file (kind = \"pitch_plunge\")") from None
+
+
+def load_problem_file(path, sets=()) -> AeroelasticTruth:
+    """The truth described by a problem TOML file (``kind = "pitch_plunge"``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    sets : iterable of str
+        ``"name=value"`` items applied to the file's values.
+
+    Raises
+    ------
+    ConfigError
+        Missing file, invalid TOML, unknown ``kind``, missing/unknown keys or non-physical
+        values (the message names the key).
+    """
+    path = Path(path)
+    data = read_toml(path, "problem file")
+    kind = data.get("kind")
+    if kind not in FILE_KINDS:
+        raise ConfigError(f"problem file {path}: key 'kind' must be one of "
+                          f"{', '.join(map(repr, FILE_KINDS))}, got {kind!r}")
+    default = path.parent.name if path.name == "problem.toml" else path.stem
+    name = dict(data.get("problem", {})).get("name", default)
+    return FILE_KINDS[kind].from_mapping(data, name=name, source=f"problem file {path}",
+                                         sets=sets)
 
 
 def load_problem(name: str, sets=()) -> AeroelasticTruth:
@@ -44,7 +122,8 @@ def load_problem(name: str, sets=()) -> AeroelasticTruth:
     Parameters
     ----------
     name : str
-        A name from :func:`problem_names`.
+        A name from :func:`problem_names` or :func:`file_problem_names`, or the path of a
+        problem TOML file (see :func:`load_problem_file`).
     sets : iterable of str
         ``"name=value"`` items (unknown names raise :class:`ConfigError` listing the valid
         ones).
@@ -53,7 +132,21 @@ def load_problem(name: str, sets=()) -> AeroelasticTruth:
     -------
     AeroelasticTruth
     """
+    path = _file_of(name)
+    if path is not None:
+        return load_problem_file(path, sets)
     return _cls(name).from_sets(sets)
+
+
+def problem_label(name: str) -> str:
+    """A short name for output files and titles: the built-in name, or the ``[problem]``
+    name of a problem file (else its folder or stem)."""
+    path = _file_of(name)
+    if path is None:
+        return str(name)
+    data = read_toml(path, "problem file")
+    default = path.parent.name if path.name == "problem.toml" else path.stem
+    return str(dict(data.get("problem", {})).get("name", default))
 
 
 def problem_definition(name: str, problems_dir: str | Path | None = None) -> dict:
@@ -65,6 +158,9 @@ def problem_definition(name: str, problems_dir: str | Path | None = None) -> dic
         Unknown problem, or the definition file is not found (e.g. an installed package
         without the repository's ``problems/`` folder: pass ``problems_dir``).
     """
+    path = _file_of(name)
+    if path is not None:
+        return read_toml(path, "problem definition")
     _cls(name)
     root = Path(problems_dir) if problems_dir is not None else _problems_dir()
     path = root / name / "problem.toml"

@@ -91,6 +91,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import casadi as ca
 import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.interpolate import make_interp_spline
@@ -476,6 +477,53 @@ class SeedWing(AeroelasticTruth):
             return ds, acc
 
         return f
+
+    def vector_field(self) -> ca.Function:
+        """The nonlinear wing without flap as a CasADi function ``f(x, V) -> dx/dt``.
+
+        The right-hand side of :meth:`flap_dynamics` with the flap at rest, state
+        ``x = [u, u', z1, z2]``: the strip operator of :meth:`aero_matrices` (each block a
+        quadratic polynomial in ``V``, see :meth:`_quadratic_in_V`), the saturating lift and
+        the leading-edge suction of :meth:`_nonlinear_circulation` written with CasADi's
+        ``tanh``.
+
+        Returns
+        -------
+        casadi.Function
+            ``f(x, V)`` with ``x`` of length ``10 + 2 n_strips``.
+        """
+        p = self.params
+        N = self.n_modes
+        blocks = {}
+        for name in ("Cx", "W", "Gx", "Gx1"):
+            blocks[name] = self._quadratic_in_V(
+                lambda V, name=name: getattr(self.aero_matrices(V), name))
+        lam = self._quadratic_in_V(lambda V: np.array(self.aero_matrices(V).lams))
+        c_lo = self._coupled(self._V_NODES[0])
+        Minv, ng = c_lo["Minv"], c_lo["ng"]
+        w2 = self._omega ** 2
+        c2 = 2 * self._zeta() * self._omega
+        a0 = 1.0 - sum(JONES_A)
+        A1, A2 = JONES_A
+        x = ca.SX.sym("x", 2 * N + 2 * ng)
+        V = ca.SX.sym("V")
+
+        def poly(c):
+            return ca.DM(c[0]) + V * ca.DM(c[1]) + V * V * ca.DM(c[2])
+
+        uu, ud = x[:N], x[N:2 * N]
+        z1, z2 = x[2 * N:2 * N + ng], x[2 * N + ng:]
+        lv = poly(lam)
+        g = ca.mtimes(poly(blocks["Gx"]), uu) + ca.mtimes(poly(blocks["Gx1"]), ud)
+        geff = a0 * g + A1 * lv[0] * z1 + A2 * lv[1] * z2
+        s = V * p.U_ref * p.alpha_sat
+        gsat = s * ca.tanh(geff / s)
+        X = p.suction * p.rho * p.b * p.lift_slope * gsat ** 2
+        qx = -ca.mtimes(ca.DM(self._e), X) * self._dy / p.modal_mass
+        rhs_f = ca.mtimes(poly(blocks["Cx"]), ud) + ca.mtimes(poly(blocks["W"]), gsat) + qx
+        acc = ca.mtimes(ca.DM(Minv), -w2 * uu - c2 * ud + rhs_f)
+        dx = ca.vertcat(ud, acc, -lv[0] * z1 + g, -lv[1] * z2 + g)
+        return ca.Function("seed_wing_vector_field", [x, V], [dx], ["x", "V"], ["xdot"])
 
     def _names(self) -> dict:
         return {"mode_names": SEED_MODE_NAMES,

@@ -157,5 +157,6 @@ class TypicalSection(AeroelasticTruth):
             names = [f"{names[0]} {i + 1}" for i in range(2)]
         return {"mode_names": names, "coordinate_names": ("h/b", "theta"),
                 "sensor_rows": Phi.copy(), "sensor_names": ("h/b", "theta"),
+                "sensor_units": ("-", "rad"),
                 "time_unit": "s" if p.omega_theta != 1.0 else "1/omega_theta",
                 "speed_index": "V = U / (b omega_theta)"}

@@ -46,7 +46,7 @@ for order in orders:
 
 # %%
 # The verified γ against the controller order, and the largest singular value of the
-# closed loop from ``w`` to ``z`` for each controller.
+# closed loop from :math:`w` to :math:`z` for each controller.
 fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(9, 3.5))
 ax0.plot(orders, [results[k].gamma for k in orders], "o-", label="fixed order")
 ax0.axhline(gamma_full, color="C3", ls="--", label="full order (hinfsyn)")

@@ -52,9 +52,9 @@ fig.axes[1].set_xlabel(r"speed index $V = U/(b\,\omega_{ref})$"
                        f"  ({b * omega_ref:.1f} m/s per unit)")
 
 # %%
-# The ROM route.  Records of the truth are taken at ``V0``; the single-speed ROM with the
-# ``V²`` scaling over-predicts the flutter speed, and the truth with its aerodynamics frozen
-# at ``V0`` shows that this error is the scaling's, not the identification's.  A parametric
+# The ROM route.  Records of the truth are taken at :math:`V_0`; the single-speed ROM with the
+# :math:`V^2` scaling over-predicts the flutter speed, and the truth with its aerodynamics frozen
+# at :math:`V_0` shows that this error is the scaling's, not the identification's.  A parametric
 # ROM (ROMs at several speeds, interpolated in V) follows the truth.
 settings = rom_settings("goland", n_speeds=3 if QUICK else 7, duration=1.0 if QUICK else 2.0,
                         n_grid=61 if QUICK else 201)

@@ -39,7 +39,7 @@ fig.tight_layout()
 
 # %%
 # Hankel singular values of the linearised model and the order of Σf.  The exact McMillan
-# degree is ``N * max(mu + na - 1, r + mu + nb) = 25``; the paper's ``nf = 15`` is a
+# degree is :math:`N \max(\mu + n_a - 1,\ r + \mu + n_b) = 25`; the paper's :math:`n_f = 15` is a
 # balanced truncation of it.
 real = realize(result.model)
 S = real.hankel_singular_values

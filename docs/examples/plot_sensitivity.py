@@ -1,4 +1,4 @@
-"""
+r"""
 Flutter-speed sensitivities (``casflutter sensitivity``)
 ========================================================
 
@@ -12,7 +12,7 @@ speed (:func:`casflutter.study.flutter_speed_fd`).
 
 The configuration is ``problems/studies/sensitivity_hp1.toml``: the HP-1 typical section with
 1 % structural damping.  The table is ranked by the normalised sensitivity
-``(p / V_f) dV_f/dp`` (per cent change of ``V_f`` per per cent change of ``p``).
+:math:`(p / V_f)\, \mathrm{d}V_f/\mathrm{d}p` (per cent change of :math:`V_f` per per cent change of :math:`p`).
 """
 
 import os

@@ -10,8 +10,8 @@ the imaginary axis (paper §III.B), divergence the speed where a real eigenvalue
 through zero.  The speeds are compared with the published values stored beside the problem
 (``problems/typical_section/problem.toml``).
 
-Then the paper's ROM route is run on the same truth: chirp records at one speed ``V0``, an
-identified ROM, Σf (eq. 5) and ΣAE(V) with the ``V²`` scaling of eq. 8, next to the truth.
+Then the paper's ROM route is run on the same truth: chirp records at one speed :math:`V_0`, an
+identified ROM, Σf (eq. 5) and ΣAE(V) with the :math:`V^2` scaling of eq. 8, next to the truth.
 """
 
 import os
@@ -41,7 +41,7 @@ print(f"divergence: V_d = {result.divergence.V:.4f} (reference {ref['divergence'
 
 # %%
 # The V–g and V–f diagrams: the damping ratio of the pitch branch falls through zero at
-# ``V_f``, where its frequency has nearly merged with the plunge branch.
+# :math:`V_f`, where its frequency has nearly merged with the plunge branch.
 fig = plot_vg_vf(result, hz=False)
 fig.axes[1].set_xlabel(r"speed index $V = U/(b\,\omega_\theta)$")
 fig.axes[1].set_ylabel(r"frequency / $\omega_\theta$")
@@ -52,9 +52,9 @@ fig = plot_root_locus(result)
 
 # %%
 # The ROM route (the paper's method on this truth).  The ROM is identified at a single
-# speed ``V0``; the ``V²`` scaling of ΣAE then freezes the aerodynamic time scale at ``V0``
+# speed :math:`V_0`; the :math:`V^2` scaling of ΣAE then freezes the aerodynamic time scale at :math:`V_0`
 # (reduced frequency and lag rates), which is the error the explanation quantifies.  A
-# parametric ROM identified at several speeds and interpolated in ``V`` removes it.
+# parametric ROM identified at several speeds and interpolated in :math:`V` removes it.
 settings = rom_settings("typical_section", n_speeds=3 if QUICK else 7,
                         n_grid=61 if QUICK else 201)
 route = rom_flutter(truth, settings, parametric=True)

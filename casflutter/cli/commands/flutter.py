@@ -24,7 +24,7 @@ def register(subparsers) -> None:
                     "with a parametric ROM interpolated in V; compare with the truth.  Speeds "
                     "in the problem's unit (speed index for the typical section, m/s for the "
                     "Goland wing).")
-    p.add_argument("problem", help="problem name (see `casflutter problems`)")
+    p.add_argument("problem", help="problem name (see `casflutter problems`) or rig TOML file")
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="NAME=VALUE",
                    help="change a problem parameter (repeatable)")
     p.add_argument("--vrange", nargs=2, type=float, metavar=("LO", "HI"), default=None,
@@ -149,9 +149,13 @@ def _fmt(x, unit="") -> str:
 def run(args) -> int:
     """Handler: run the route, print or write JSON, save the figure."""
     from ...pipeline import rom_flutter, rom_settings
-    from ...truth import load_problem
+    from ...truth import load_problem, problem_definition, problem_label
 
     truth = load_problem(args.problem, args.sets)
+    label = problem_label(args.problem)
+    # a problem file carries its own [rom] table (a built-in name's is read by rom_settings)
+    rom_table = dict(problem_definition(args.problem).get("rom", {})) \
+        if label != args.problem else {}
     _, from_unit, vunit = _speed_conv(truth)
     over = {}
     if args.vrange is not None:
@@ -159,10 +163,10 @@ def run(args) -> int:
         over["V_range"] = (from_unit(lo), from_unit(hi))
     if args.v0 is not None:
         over["V0"] = from_unit(args.v0)
-    settings = rom_settings(args.problem, **over)
+    settings = rom_settings(args.problem, **{**rom_table, **over})
     result = rom_flutter(truth, settings, parametric=not args.no_parametric)
-    doc = summarize(result, truth, args.problem)
-    fig_path = args.figure if args.figure is not None else f"{args.problem}_flutter.png"
+    doc = summarize(result, truth, label)
+    fig_path = args.figure if args.figure is not None else f"{label}_flutter.png"
     if fig_path.lower() != "none":
         _figure(result, fig_path, float(truth.modal_structure().omega.max()),
                 "speed index " + truth.modal_structure().speed_index.split(",")[0])
@@ -174,7 +178,7 @@ def run(args) -> int:
         sys.stdout.write("\n")
         return 0
     u = doc["units"]
-    print(f"{args.problem}: flutter speed ({u['V_flutter']}), frequency ({u['omega_flutter']})")
+    print(f"{label}: flutter speed ({u['V_flutter']}), frequency ({u['omega_flutter']})")
     print(f"  {'':16} {'V_flutter':>14} {'omega_flutter':>14} {'mode':>12} {'V_divergence':>14}")
     for key, label in (("truth", "truth"), ("rom", f"ROM at V0={doc['rom_V0']:.4g}"),
                        ("frozen_aero_truth", "frozen-aero truth"),

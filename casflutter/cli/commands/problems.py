@@ -16,7 +16,7 @@ def register(subparsers) -> None:
         description="List the benchmark problems with a truth simulator, every parameter "
                     "(default = published case; change with --set name=value in the "
                     "commands that take a problem) and the published reference values.")
-    p.add_argument("name", nargs="?", help="show only this problem")
+    p.add_argument("name", nargs="?", help="show only this problem (a name or a rig TOML file)")
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="NAME=VALUE",
                    help="show the parameters with these changes applied (validated)")
     p.add_argument("--json", action="store_true", help="machine-readable output")
@@ -24,12 +24,17 @@ def register(subparsers) -> None:
 
 
 def _info(name: str, sets) -> dict:
-    from ...truth import load_problem, problem_definition
+    from ...truth import load_problem, problem_definition, problem_label
 
     model = load_problem(name, sets)
     params = model.params
-    rows = [{"name": n, "value": getattr(params, n), "default": d, "unit": u, "doc": doc}
-            for n, d, u, doc in params.describe()]
+    if getattr(model, "definition", None) is None:   # built-in: values beside the defaults
+        rows = [{"name": n, "value": getattr(params, n), "default": d, "unit": u, "doc": doc}
+                for n, d, u, doc in params.describe()]
+    else:                                            # a problem file: the file is the default
+        rows = [{"name": n, "value": v, "default": v, "unit": u, "doc": doc}
+                for n, v, u, doc in params.describe()]
+    name = problem_label(name)
     try:
         definition = problem_definition(name)
     except ConfigError:
@@ -45,9 +50,9 @@ def _info(name: str, sets) -> dict:
 
 def run(args) -> int:
     """Handler: print the listing; unknown problem or parameter names raise ConfigError."""
-    from ...truth import problem_names
+    from ...truth import file_problem_names, problem_names
 
-    names = [args.name] if args.name else problem_names()
+    names = [args.name] if args.name else problem_names() + file_problem_names()
     infos = [_info(n, args.sets) for n in names]
     if args.json:
         print(json.dumps(infos, indent=2))
@@ -61,7 +66,9 @@ def run(args) -> int:
         w = max(len(r["name"]) for r in info["parameters"])
         for r in info["parameters"]:
             mark = "" if r["value"] == r["default"] else f"  (default {r['default']:g})"
-            print(f"    {r['name']:<{w}} = {r['value']:<12g} [{r['unit']}]  {r['doc']}{mark}")
+            value = f"{r['value']:<12g}" if isinstance(r["value"], (int, float)) else \
+                f"{r['value']!s:<12}"
+            print(f"    {r['name']:<{w}} = {value} [{r['unit']}]  {r['doc']}{mark}")
         if info["reference"]:
             print("  published reference values:")
             for key, vals in info["reference"].items():

@@ -1,0 +1,275 @@
+"""LCO branches of the continuous-time truths (``x' = f(x, V)``) by collocation.
+
+The branch starts at the Hopf point of the undeflected equilibrium with the critical
+(linear) mode shape: the first orbit is solved with its amplitude along that mode fixed
+at the value for which the normal form predicts a speed offset of ``start_offset`` times the
+Hopf speed, then it is continued in ``V`` by pseudo-arclength (:mod:`._branch`).  The
+direction in which the first orbit leaves the Hopf point, and its speed offset, check the
+first Lyapunov coefficient (:mod:`._normal_form`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from ..errors import ConfigError
+from ..truth import problem_definition
+from ._branch import BranchStart, run_from_hopf
+from ._collocation import Collocation
+from ._normal_form import MultilinearForms, find_hopf, lyapunov_flow
+from ._results import LCOBranch, LCOPoint, LCOSettings
+
+__all__ = ["Outputs", "truth_outputs", "speed_convention", "lco_branch", "continue_lco",
+           "default_vrange"]
+
+@dataclass(frozen=True)
+class Outputs:
+    """Named outputs ``y = h(x, V)`` whose amplitudes are reported (modes and sensors)."""
+
+    names: tuple
+    units: tuple
+    function: ca.Function
+
+
+def truth_outputs(truth, f: ca.Function, sensor_kind: str = "displacement") -> Outputs:
+    """Modal displacements (by mode name) and sensors (by sensor name) of a truth.
+
+    Sensors are ``Hs u`` (``sensor_kind = "displacement"``) or ``Hs u''`` with ``u''`` from
+    the vector field (``"acceleration"``).  A truth whose coordinates are already the
+    physical ones (``lco_modal_outputs = False``, the rig sections) reports its sensors only.
+    """
+    ms = truth.modal_structure()
+    N = ms.n_modes
+    nx = int(f.size1_in(0))
+    x = ca.SX.sym("x", nx)
+    V = ca.SX.sym("V")
+    H = ca.DM(np.asarray(ms.sensor_rows, float))
+    names, units, rows = [], [], []
+    sunits = truth.sensor_units()
+    if getattr(truth, "lco_modal_outputs", True):
+        names += list(ms.mode_names)
+        units += [""] * N
+        rows.append(x[:N])
+    if sensor_kind == "acceleration":
+        rows.append(ca.mtimes(H, f(x, V)[N:2 * N]))
+        tu = ms.time_unit if ms.time_unit.isalpha() else f"({ms.time_unit})"
+        units += [f"{u}/{tu}^2" if u else "" for u in sunits]
+    else:
+        rows.append(ca.mtimes(H, x[:N]))
+        units += list(sunits)
+    names += list(ms.sensor_names)
+    if len(set(names)) != len(names):
+        names = [f"{n} [{k}]" for k, n in enumerate(names)]
+    return Outputs(tuple(names), tuple(units),
+                   ca.Function("outputs", [x, V], [ca.vertcat(*rows)]))
+
+
+def speed_convention(truth) -> tuple[float, str]:
+    """``(problem speed per speed index, unit)``: m/s for truths with an airspeed, else the
+    speed index itself."""
+    if hasattr(truth, "airspeed"):
+        return float(truth.airspeed(1.0)), "m/s"
+    return 1.0, truth.modal_structure().speed_index
+
+
+class _OdeDisc:
+    """Adaptor of :class:`Collocation` for the continuation engine."""
+
+    def __init__(self, col: Collocation, outputs: Outputs):
+        self.col = col
+        self.iV = col.iV
+        self.outputs = outputs
+        self._h = outputs.function.map(col.N * 16)
+        self.w2 = np.ones((col.n, 1))      # state weights of size(); set from the mode shape
+
+    def solve(self, X0, ref, c, s):
+        return self.col.solve(X0, ref, c, s)
+
+    def jacobian(self, X, ref):
+        return self.col.jacobian(X, ref)
+
+    def reference(self, X):
+        return self.col.reference(X)
+
+    def size(self, X) -> float:
+        W = self.col.nodes(X)
+        return float(np.sqrt(np.mean(np.sum((W - W.mean(axis=1, keepdims=True)) ** 2 * self.w2,
+                                            axis=0))))
+
+    def evaluate(self, X) -> LCOPoint:
+        col = self.col
+        _, Wf = col.fine(X, 16)
+        V, T = float(X[col.iV]), float(X[col.iT])
+        Y = np.asarray(self._h(Wf, np.full((1, Wf.shape[1]), V)))
+        amp = 0.5 * (Y.max(axis=1) - Y.min(axis=1))
+        mean = Y.mean(axis=1)
+        Mon = col.monodromy(X)
+        mu, vecs = np.linalg.eig(Mon)
+        x0 = col.nodes(X)[:, 0]
+        f0 = np.asarray(col.f(x0, V)).ravel()
+        f0 = f0 / max(np.linalg.norm(f0), 1e-300)
+        align = np.abs(f0 @ vecs) / np.linalg.norm(vecs, axis=0)
+        k = int(np.argmax(align - 1e-3 * np.abs(mu - 1)))
+        others = np.delete(mu, k)
+        mmax = float(np.max(np.abs(others))) if others.size else 0.0
+        names = self.outputs.names
+        return LCOPoint(V=V, period=T, freq_hz=1.0 / T,
+                        amplitude={n: float(a) for n, a in zip(names, amp)},
+                        mean={n: float(a) for n, a in zip(names, mean)},
+                        multipliers=mu, max_multiplier=mmax, stable=bool(mmax < 1.0),
+                        trivial_error=float(abs(mu[k] - 1.0)), state=x0.copy())
+
+
+def continue_lco(f: ca.Function, outputs: Outputs, vrange, settings: LCOSettings | None = None,
+                 *, problem: str = "", speed_scale: float = 1.0, speed_unit: str = "",
+                 time_unit: str = "s", n_modes: int | None = None) -> LCOBranch:
+    """LCO branch of ``x' = f(x, V)`` from its first Hopf point in ``vrange``.
+
+    Parameters
+    ----------
+    f : casadi.Function
+        ``f(x, V)`` with ``f(0, V) = 0``.
+    outputs : Outputs
+        The reported outputs.
+    vrange : (float, float)
+        Speed-index range: the Hopf point is searched and the branch kept in it.
+    settings : LCOSettings, optional
+    problem, speed_scale, speed_unit, time_unit :
+        Labels of the result (see :class:`LCOBranch`).
+    n_modes : int, optional
+        Number of displacement states at the start of ``x`` (the amplitude of the first
+        orbit is set on the largest of them); all states if omitted.
+
+    Returns
+    -------
+    LCOBranch
+
+    Raises
+    ------
+    ConfigError
+        No Hopf point in the range (or unstable at its start), or a degenerate Hopf point
+        (zero first Lyapunov coefficient: the nonlinearity does not act at third order).
+    ConvergenceError
+        The first orbit next to the Hopf point could not be solved.
+    """
+    settings = LCOSettings() if settings is None else settings
+    lo, hi = (float(v) for v in vrange)
+    if not 0 < lo < hi:
+        raise ConfigError(f"vrange = ({lo}, {hi}) must satisfy 0 < lo < hi")
+    t0 = time.perf_counter()
+    forms = MultilinearForms(f)
+    cp = find_hopf(forms, (lo, hi), settings.n_grid, speed_scale=speed_scale,
+                   speed_unit=speed_unit)
+    l1 = lyapunov_flow(forms, cp)
+    omega = cp.eigenvalue.imag
+    t_hopf = time.perf_counter() - t0
+    if not math.isfinite(l1) or abs(l1) < 1e-14 * max(1.0, np.max(np.abs(cp.A))):
+        raise ConfigError(f"the Hopf point at {cp.V * speed_scale:.6g} {speed_unit} is degenerate "
+                          f"(first Lyapunov "
+                          f"coefficient {l1:.3g}): the system has no nonlinearity acting at "
+                          "third order (e.g. a linear truth), so no LCO branch leaves it")
+    nd = int(n_modes) if n_modes else cp.q.size
+    dom = int(np.argmax(np.abs(cp.q[:nd])))
+    qhat = cp.q * np.exp(-1j * np.angle(cp.q[dom])) / abs(cp.q[dom])
+    col = Collocation(f, settings.n_intervals, settings.degree, tol=settings.tol,
+                      max_newton=settings.max_newton)
+    disc = _OdeDisc(col, outputs)
+    T0 = 2.0 * math.pi / omega
+
+    def mode(tau):
+        return np.real(qhat[:, None] * np.exp(2j * math.pi * tau)[None, :])
+
+    phi = col.initial_guess(mode, 0.0, 0.0)
+    phi[col.iT] = phi[col.iV] = 0.0
+    start = BranchStart(
+        cp=cp, lyapunov=l1, radial=omega * l1, omega=omega, freq_hz=omega / (2 * math.pi),
+        discrete=False, qhat=qhat, dominant=dom,
+        guess=lambda eps, V: col.initial_guess(lambda tau: eps * mode(tau), T0, V),
+        phi=phi, n_points=col.npts, period0=T0, hint="try more mesh intervals",
+        ref=col.reference_from(lambda tau: np.real(2j * math.pi * qhat[:, None]
+                                                   * np.exp(2j * math.pi * tau)[None, :])))
+    t1b = time.perf_counter()
+    hopf, run = run_from_hopf(disc, start, settings, (lo, hi), speed_scale=speed_scale,
+                              speed_unit=speed_unit)
+    t_branch = time.perf_counter() - t1b
+    return LCOBranch(problem=problem, system="truth", hopf=hopf, points=tuple(run.points),
+                     folds=tuple(run.folds), outputs=outputs.names, output_units=outputs.units,
+                     speed_unit=speed_unit, speed_scale=speed_scale, time_unit=time_unit,
+                     completed=run.completed, stop_reason=run.stop_reason, vrange=(lo, hi),
+                     timings={"hopf": t_hopf, "branch": t_branch,
+                              "total": time.perf_counter() - t0})
+
+
+def lco_branch(truth, vrange=None, settings: LCOSettings | None = None,
+               problem: str | None = None) -> LCOBranch:
+    """The LCO branch of a truth from its Hopf (flutter) point, continued in the speed.
+
+    Parameters
+    ----------
+    truth : AeroelasticTruth
+        Any truth with :meth:`vector_field` (typical section, rig section, Goland, seed
+        wing).
+    vrange : (float, float), optional
+        Speed-index range (default: the ``[lco] vrange`` of the problem definition when it
+        has one, else ``[rom] V_range``); the rig sections' speed index is the airspeed.
+    settings : LCOSettings, optional
+    problem : str, optional
+        Label (default the truth's name).
+
+    Returns
+    -------
+    LCOBranch
+        Speeds of the branch in the speed index (``branch.speed(V)`` converts); amplitudes
+        per mode and per sensor (the rig sections: ``heave`` [m], ``pitch`` [rad]).
+
+    Raises
+    ------
+    ConfigError
+        No range given and none in the definition, no Hopf point in it, or a linear truth.
+    ConvergenceError
+        The first orbit did not converge.
+    """
+    settings = LCOSettings() if settings is None else settings
+    if vrange is None:
+        vrange = default_vrange(truth)
+    f = truth.vector_field()
+    outputs = truth_outputs(truth, f, settings.sensor_kind)
+    scale, unit = speed_convention(truth)
+    ms = truth.modal_structure()
+    return continue_lco(f, outputs, vrange, settings,
+                        problem=problem or str(getattr(truth, "name", type(truth).__name__)),
+                        speed_scale=scale, speed_unit=unit, time_unit=ms.time_unit,
+                        n_modes=truth.n_modes)
+
+
+def default_vrange(truth) -> tuple[float, float]:
+    """``[lco] vrange`` of the problem's definition (problem speed unit), else its ``[rom]
+    V_range`` (speed index).
+
+    Raises
+    ------
+    ConfigError
+        Neither is available.
+    """
+    definition = getattr(truth, "definition", None)
+    if definition is None:
+        try:
+            definition = problem_definition(getattr(truth, "name", ""))
+        except ConfigError:
+            definition = {}
+    scale, _ = speed_convention(truth)
+    lco = dict(definition.get("lco", {}))
+    if "vrange" in lco:
+        lo, hi = lco["vrange"]
+        return float(lo) / scale, float(hi) / scale
+    rom = dict(definition.get("rom", {}))
+    if "V_range" in rom:
+        lo, hi = rom["V_range"]
+        return float(lo), float(hi)
+    raise ConfigError("no speed range: pass vrange (or --vrange LO HI), or add [lco] vrange to "
+                      "the problem definition")
