@@ -33,7 +33,7 @@ from scipy.optimize import brentq
 
 from ..data import GAFTable
 from ..errors import ConfigError, ConvergenceError, DataError, DimensionError
-from ._structure import ModalStructure
+from ..structure import ModalStructure
 
 __all__ = ["PKResult", "pk_flutter"]
 

@@ -37,7 +37,7 @@ import numpy as np
 
 from ..errors import ConfigError, DimensionError
 from ..realize import RationalApproximation
-from ._structure import ModalStructure
+from ..structure import ModalStructure
 
 __all__ = ["RFASystem"]
 

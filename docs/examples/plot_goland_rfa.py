@@ -17,17 +17,18 @@ import os
 import matplotlib.pyplot as plt
 import numpy as np
 
-from casflutter.aeroelastic import ModalStructure, RFASystem, find_flutter, pk_flutter
+from casflutter.aeroelastic import RFASystem, find_flutter, pk_flutter
 from casflutter.data import GAFTable
 from casflutter.realize import fit_roger
 from casflutter.report import plot_vg_vf
+from casflutter.structure import ModalStructure
 from casflutter.truth import load_problem, problem_definition
 
 QUICK = os.environ.get("CASFLUTTER_DOCS_QUICK") == "1"   # set by `make docs`
 
 wing = load_problem("goland")
 ms = wing.modal_structure()
-structure = ModalStructure(ms.omega, ms.zeta, ms.alpha, Hs=ms.sensor_rows, sensor="displacement")
+structure = ms.with_sensors(kind="displacement")
 ref = problem_definition("goland")["reference"]["flutter"]
 
 # dense near k = 0, where Theodorsen's C(k) has its k log k branch point

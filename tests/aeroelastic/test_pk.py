@@ -10,9 +10,10 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from casflutter.aeroelastic import ModalStructure, PKResult, find_flutter, pk_flutter
+from casflutter.aeroelastic import PKResult, find_flutter, pk_flutter
 from casflutter.data import GAFTable
 from casflutter.errors import ConfigError, ConvergenceError, DataError, DimensionError
+from casflutter.structure import ModalStructure
 from casflutter.truth import GolandParams, GolandWing, problem_definition
 from truth.test_goland import C_theodorsen, Strips
 
@@ -29,7 +30,7 @@ def wing():
 @pytest.fixture(scope="module")
 def structure(wing):
     ms = wing.modal_structure()
-    return ModalStructure(ms.omega, ms.zeta, ms.alpha, Hs=ms.sensor_rows, sensor="displacement")
+    return ms.with_sensors(kind="displacement")
 
 
 @pytest.fixture(scope="module")

@@ -9,11 +9,12 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from casflutter.aeroelastic import (AeroelasticSystem, ModalStructure, RFASystem, build_lft,
-                                    find_flutter, pk_flutter)
+from casflutter.aeroelastic import (AeroelasticSystem, RFASystem, build_lft, find_flutter,
+                                    pk_flutter)
 from casflutter.data import GAFTable
 from casflutter.errors import ConfigError, ConvergenceError, DataError, DimensionError
 from casflutter.realize import RFASettings, fit_minimum_state, fit_rfa, fit_roger
+from casflutter.structure import ModalStructure
 from casflutter.truth import JONES_B, GolandParams, GolandWing, problem_definition
 
 REF = problem_definition("goland")["reference"]["flutter"]
@@ -23,7 +24,7 @@ K_GRID = np.concatenate([np.linspace(0.0, 0.2, 9), np.linspace(0.25, 2.0, 36)])
 
 def _structure(wing, sensor="displacement"):
     ms = wing.modal_structure()
-    return ModalStructure(ms.omega, ms.zeta, ms.alpha, Hs=ms.sensor_rows, sensor=sensor)
+    return ms.with_sensors(kind=sensor)
 
 
 @pytest.fixture(scope="module")
@@ -163,7 +164,7 @@ def test_statespace_frequency_response_is_the_modal_equation(wing, table, roger,
         assert_allclose(Z @ G[:N, 0], q * Q[:, N] * v, rtol=1e-9,
                         atol=1e-12 * np.abs(q * Q[:, N] * v).max())
         factor = 1.0 if sensor == "displacement" else -om ** 2
-        assert_allclose(G[N:], factor * ms.sensor_rows @ G[:N], rtol=1e-9,
+        assert_allclose(G[N:], factor * ms.Hs @ G[:N], rtol=1e-9,
                         atol=1e-12 * np.abs(G[N:]).max())
 
 
