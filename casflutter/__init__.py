@@ -8,6 +8,7 @@ suppression control of an experimental wing", ACC 2016:
 aeroelastic (eq. 6-15) -> design (fixed-order H-infinity) -> verify -> report``
 """
 
+from . import _logging  # noqa: F401 - the package logger's NullHandler
 from .errors import (CasflutterError, ConfigError, ConvergenceError, DataError,  # noqa: F401
                      DimensionError, OrderError, SynthesisError)
 
