@@ -24,7 +24,7 @@ from __future__ import annotations
 import logging
 import sys
 
-__all__ = ["PACKAGE_LOGGER", "PROGRESS", "CliHandler", "configure_cli_logging", "remove_cli_logging",
+__all__ = ["PACKAGE_LOGGER", "PROGRESS", "PROGRESS_END", "CliHandler", "configure_cli_logging", "remove_cli_logging",
            "cli_level"]
 
 #: Name of the package logger; every casflutter logger is a child of it.
@@ -32,6 +32,9 @@ PACKAGE_LOGGER = "casflutter"
 
 #: ``extra=`` of a progress record (redrawn in place by the command line on a terminal).
 PROGRESS = {"casflutter_progress": True}
+
+#: ``extra=`` of the last progress record of a run (the line is then left on the terminal).
+PROGRESS_END = {"casflutter_progress": "end"}
 
 
 def cli_level(*, quiet: bool = False, verbose: bool = False, debug: bool = False) -> int:
@@ -78,9 +81,11 @@ class CliHandler(logging.Handler):
             stream = sys.stderr
             msg = self.format(record)
             tty = bool(getattr(stream, "isatty", lambda: False)())
-            if getattr(record, "casflutter_progress", False) and tty:
-                stream.write("\r" + msg + "\x1b[K")
-                self._line_open = True
+            progress = getattr(record, "casflutter_progress", False)
+            if progress and tty:
+                end = "\n" if progress == "end" else ""
+                stream.write("\r" + msg + "\x1b[K" + end)
+                self._line_open = not end
             else:
                 if self._line_open:
                     stream.write("\n")

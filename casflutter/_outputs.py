@@ -15,7 +15,7 @@ from typing import Iterable, Literal
 
 from .errors import OutputError
 
-__all__ = ["check_output_path"]
+__all__ = ["check_output_path", "check_figure_path"]
 
 
 def _nearest_existing(path: Path) -> Path:
@@ -112,3 +112,20 @@ def check_output_path(path: str | os.PathLike, *, what: str = "output",
                           "created; choose another path")
     _probe(anc, what, p)
     return p
+
+
+def check_figure_path(path: str | os.PathLike, *, what: str = "--figure",
+                      overwrite: bool = True) -> Path:
+    """:func:`check_output_path` for a matplotlib figure: the suffix must be a format
+    matplotlib writes (``.png``, ``.pdf``, ``.svg`` ...).
+
+    Raises
+    ------
+    OutputError
+        As :func:`check_output_path`; the message lists the formats.
+    """
+    from matplotlib.backend_bases import FigureCanvasBase  # noqa: PLC0415 - heavy, optional
+
+    formats = sorted("." + ext for ext in FigureCanvasBase.get_supported_filetypes())
+    return check_output_path(path, what=what, kind="file", suffixes=formats,
+                             overwrite=overwrite)

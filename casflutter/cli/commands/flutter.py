@@ -2,8 +2,8 @@
 
 Runs :func:`casflutter.pipeline.rom_flutter` (the paper's ROM route at one speed with the V²
 scaling, and the parametric ROM interpolated in V) beside the full-order truth, prints the
-flutter and divergence speeds in the problem's own units (or writes JSON to stdout) and
-saves the V–g / V–f figure.
+flutter and divergence speeds in the problem's own units (or writes JSON to stdout) and,
+with ``--figure PATH``, saves the V–g / V–f figure.
 """
 
 from __future__ import annotations
@@ -11,6 +11,9 @@ from __future__ import annotations
 import json
 import math
 import sys
+from pathlib import Path
+
+from ..._outputs import check_figure_path
 
 __all__ = ["register", "run", "summarize"]
 
@@ -34,8 +37,8 @@ def register(subparsers) -> None:
     p.add_argument("--no-parametric", action="store_true",
                    help="skip the parametric ROM (its block is then null)")
     p.add_argument("--figure", default=None, metavar="PATH",
-                   help="where to save the V-g/V-f figure (default PROBLEM_flutter.png; "
-                        "'none' to skip)")
+                   help="save the V-g/V-f figure to PATH (.png, .pdf, .svg ...; checked "
+                        "before the work); default: no figure")
     p.add_argument("--json", action="store_true", help="write the result as JSON to stdout")
     p.set_defaults(func=run)
 
@@ -151,6 +154,9 @@ def run(args) -> int:
     from ...pipeline import rom_flutter, rom_settings
     from ...truth import load_problem, problem_definition, problem_label
 
+    fig_path = None                  # figures only where asked, checked before the work
+    if args.figure is not None and args.figure.lower() != "none":
+        fig_path = str(check_figure_path(args.figure, what="--figure"))
     truth = load_problem(args.problem, args.sets)
     label = problem_label(args.problem)
     # a problem file carries its own [rom] table (a built-in name's is read by rom_settings)
@@ -166,8 +172,8 @@ def run(args) -> int:
     settings = rom_settings(args.problem, **{**rom_table, **over})
     result = rom_flutter(truth, settings, parametric=not args.no_parametric)
     doc = summarize(result, truth, label)
-    fig_path = args.figure if args.figure is not None else f"{label}_flutter.png"
-    if fig_path.lower() != "none":
+    if fig_path is not None:
+        Path(fig_path).parent.mkdir(parents=True, exist_ok=True)
         _figure(result, fig_path, float(truth.modal_structure().omega.max()),
                 "speed index " + truth.modal_structure().speed_index.split(",")[0])
         doc["figure"] = fig_path
