@@ -39,7 +39,7 @@ import numpy as np
 from .._resources import read_toml
 from ..errors import ConfigError
 
-__all__ = ["Parameter", "Study", "load_study", "point_key"]
+__all__ = ["Parameter", "Study", "load_study", "point_key", "check_setting"]
 
 _DESIGNS = ("grid", "lhs")
 
@@ -72,6 +72,43 @@ def _integer(value, what: str, minimum: int | None = None) -> int:
         more = f" >= {minimum}" if minimum is not None else ""
         raise ConfigError(f"{what} = {value!r}: give an integer{more}")
     return int(value)
+
+
+def check_setting(settings: Mapping[str, Any], key: str, default: Any, *,
+                  integer: bool = False, low: float | None = None, high: float | None = None,
+                  positive: bool = False) -> float | int:
+    """A numeric evaluator setting (or swept value) checked before any point runs: the
+    pre-flight checks of the evaluators call it.
+
+    Parameters
+    ----------
+    settings : mapping
+        The point's merged settings and parameters.
+    key : str
+        The setting; ``default`` when absent.
+    integer, low, high, positive
+        The type and range allowed.
+
+    Returns
+    -------
+    float or int
+
+    Raises
+    ------
+    ConfigError
+        Names the key, its value and what is allowed.
+    """
+    value = settings.get(key, default)
+    ok = _is_int(value) if integer else (_is_real(value) and math.isfinite(float(value)))
+    if ok:
+        v = float(value)
+        ok = (low is None or v >= low) and (high is None or v <= high) and (not positive or v > 0)
+    if not ok:
+        rng = "".join([" > 0" if positive else "", f" >= {low:g}" if low is not None else "",
+                       f" <= {high:g}" if high is not None else ""])
+        raise ConfigError(f"{key} = {value!r}: give {'an integer' if integer else 'a finite number'}"
+                          f"{rng}")
+    return int(value) if integer else float(value)
 
 
 def _check_value(value, what: str) -> None:
