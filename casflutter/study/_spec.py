@@ -420,5 +420,8 @@ def load_study(path: str | Path) -> Study:
     """
     path = Path(path)
     data = read_toml(path, "study file")
-    return Study.from_dict(data, name=path.stem, base_dir=path.resolve().parent)
+    try:
+        return Study.from_dict(data, name=path.stem, base_dir=path.resolve().parent)
+    except ConfigError as exc:
+        raise ConfigError(f"study file {path}: {exc}") from None
 

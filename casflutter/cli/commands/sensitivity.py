@@ -160,12 +160,6 @@ def _gamma(cfg: dict, args) -> int:
     if bad or not {"plant", "nmeas", "ncon"} <= set(g):
         raise ConfigError(f"[gamma] needs plant, nmeas, ncon (optional order, starts, seed, "
                           f"rel_step, tol); unknown: {sorted(bad)}")
-    mod, _, attr = str(g["plant"]).partition(":")
-    try:
-        plant_fn = getattr(importlib.import_module(mod), attr)
-    except (ImportError, AttributeError, ValueError) as exc:
-        raise ConfigError(f"[gamma] plant {g['plant']!r} cannot be imported ({exc}); give "
-                          "'package.module:function'") from None
     params = {k: _number("params", k, v) for k, v in cfg.get("params", {}).items()}
     nmeas = _number("gamma", "nmeas", g["nmeas"], low=1, integer=True)
     ncon = _number("gamma", "ncon", g["ncon"], low=1, integer=True)
@@ -174,6 +168,12 @@ def _gamma(cfg: dict, args) -> int:
     seed = _number("gamma", "seed", g.get("seed", 0), low=0, integer=True)
     tol = _number("gamma", "tol", g.get("tol", 1e-6), positive=True)
     rel_step = _number("gamma", "rel_step", g.get("rel_step", 1e-6), positive=True, high=0.1)
+    mod, _, attr = str(g["plant"]).partition(":")
+    try:
+        plant_fn = getattr(importlib.import_module(mod), attr)
+    except (ImportError, AttributeError, ValueError) as exc:
+        raise ConfigError(f"[gamma] plant {g['plant']!r} cannot be imported ({exc}); give "
+                          "'package.module:function'") from None
     res = synthesize(plant_fn(params), nmeas, ncon, order, starts=starts, seed=seed,
                      options={"tol": tol})
     gs = gamma_sensitivity(plant_fn, params, nmeas, ncon, res, rel_step=rel_step)
