@@ -160,3 +160,51 @@ def test_json_of_verify_is_quiet_on_a_closed_pipe(tmp_path):
     finally:
         os.close(w)
     assert proc.stderr == "" and proc.returncode == 141
+
+
+# ----------------------------------------------- property-based: the JSON loaders
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as hst  # noqa: E402
+
+from casflutter.errors import CasflutterError  # noqa: E402
+from casflutter.verify import load_controller  # noqa: E402
+
+_JSON = hst.recursive(
+    hst.none() | hst.booleans() | hst.integers(-3, 3) | hst.floats(allow_nan=True)
+    | hst.text(max_size=3),
+    lambda inner: hst.lists(inner, max_size=3) | hst.dictionaries(hst.text(max_size=2), inner,
+                                                                  max_size=3),
+    max_leaves=12)
+_MATRIX = hst.one_of(_JSON, hst.lists(hst.lists(hst.floats(-2, 2), min_size=0, max_size=3),
+                                      max_size=3))
+_KEYS = ["A", "B", "C", "D", "B1", "C1", "D11", "D12", "D21", "D22", "nmeas", "ncon", "Vf",
+         "n_delta", "name", "shape_A", "shape_B", "shape_D"]
+_PROPS = settings(max_examples=150, deadline=None, derandomize=True, database=None)
+
+
+@_PROPS
+@given(doc=hst.one_of(_JSON, hst.dictionaries(hst.sampled_from(_KEYS), _MATRIX, max_size=9)))
+def test_plant_and_controller_json_give_only_casflutter_errors(doc):
+    for read in (plant_from_json, controller_from_json):
+        try:
+            read(doc)
+        except CasflutterError:
+            pass
+
+
+@_PROPS
+@given(data=hst.binary(max_size=400))
+def test_plant_files_of_random_bytes_give_only_casflutter_errors(tmp_path_factory, data):
+    path = tmp_path_factory.mktemp("p") / "P.json"
+    path.write_bytes(data)
+    for read in (load_plant, load_controller):
+        try:
+            read(path)
+        except CasflutterError:
+            pass
+
+
+def test_plant_file_that_is_a_folder(tmp_path):
+    with pytest.raises(DataError, match="is a folder"):
+        load_plant(tmp_path)
