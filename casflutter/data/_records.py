@@ -303,8 +303,8 @@ class IOData:
             increasing and uniform, or records that :class:`Record` refuses.
         """
         path = _input_file(path, ".csv")
-        y = [str(c) for c in (y or [])]
-        u = [str(c) for c in u] if u else None
+        y = [y] if isinstance(y, str) else [str(c) for c in (y or [])]
+        u = [u] if isinstance(u, str) else ([str(c) for c in u] if u else None)
         if not y:
             raise DataError(f"{path}: no output column given; pass y=[names] (--y on the "
                             "command line)")

@@ -24,7 +24,7 @@ import socket
 from pathlib import Path
 from typing import Any, Iterator, Mapping
 
-from ..errors import StoreLockedError
+from ..errors import OutputError, StoreLockedError
 
 try:  # POSIX
     import fcntl
@@ -62,7 +62,11 @@ class PointStore:
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise OutputError(f"sweep store {self.path}: its folder cannot be created "
+                              f"({exc.strerror or exc}); choose another output folder") from None
         #: Lines skipped by the last full read (torn, not UTF-8, not a JSON record).
         self.skipped_lines = 0
 
