@@ -1,13 +1,19 @@
 """Identification of the Hammerstein--Wiener-like ROM (paper §II, eq. 1--4).
 
 ``identify(data, orders)`` runs stage 1 (over-parameterised least squares and rank-one SVD,
-Bai 1998, extended to MIMO) and stage 2 (an Ipopt NLP through CasADi).
+Bai 1998, extended to MIMO) and stage 2: the mu-step prediction error (Ipopt through CasADi)
+or the free-run simulation error (Levenberg--Marquardt with exact forward sensitivities
+through the recursion of eq. 3, or Ipopt on a multiple-shooting NLP).
+``select_orders(data, grid)`` compares candidate orders by free-run error on held-out data.
 """
 
 from ._identify import (FitReport, IdentificationResult, IdentificationSettings,  # noqa: F401
-                        fit_report, identify)
-from ._model import (HWLModel, HWLStructure, hwl_predict_function,  # noqa: F401
-                     hwl_simulate_function, paper_parameter_count)
+                        IdentificationWarning, fit_report, identify)
+from ._model import (HWLModel, HWLStructure, UnstableModelWarning,  # noqa: F401
+                     paper_parameter_count)
 from ._orders import HWLOrders  # noqa: F401
 from ._regression import Stage1Result, stage1  # noqa: F401
-from ._synthetic import random_hwl_model, synthetic_data  # noqa: F401
+from ._select import (OrderCandidate, OrderSelection, order_grid, parse_grid,  # noqa: F401
+                      select_orders)
+from ._synthetic import duffing_data, random_hwl_model, synthetic_data  # noqa: F401
+from ._twins import hwl_predict_function, hwl_simulate_function  # noqa: F401

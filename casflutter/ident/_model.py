@@ -28,23 +28,33 @@ Then the linearisation about zero keeps exactly the mu-Markov system ``{A, H, h,
 (paper §III.A.1) and the higher polynomial coefficients measure the nonlinearity directly.
 The normalisation needs a non-zero linear part; a purely nonlinear path cannot be represented.
 
-The same formulas are evaluated by numpy and by CasADi (:func:`hwl_predict_function`,
-:func:`hwl_simulate_function`): one code path, so the twins agree to rounding.
+The same formulas are evaluated by numpy and by CasADi (the twins in :mod:`._twins`): one
+code path, so they agree to rounding.
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field, replace
+from math import comb
 from typing import Any
 
 import casadi as ca
 import numpy as np
 
 from ..errors import DataError, DimensionError, OrderError
+from ._kernels import free_run
 from ._orders import HWLOrders
 
-__all__ = ["HWLStructure", "HWLModel", "hwl_predict_function", "hwl_simulate_function",
-           "paper_parameter_count"]
+__all__ = ["HWLStructure", "HWLModel", "paper_parameter_count", "UnstableModelWarning"]
+
+
+#: |y| above which a free run counts as diverged (its square still fits in a double)
+_DIVERGED = 1e100
+
+
+class UnstableModelWarning(UserWarning):
+    """A free-run simulation of an HWL model diverged (the model is unstable for that input)."""
 
 
 def paper_parameter_count(n_modes: int, orders: HWLOrders) -> int:
@@ -73,12 +83,16 @@ class HWLStructure:
         ``N``: number of outputs y (generalised forces) and, when present, of inputs u.
     has_u, has_v : bool
         Whether the modal-displacement input u and the flap input v exist.
+    constant : bool
+        Whether eq. 3 carries a constant term ``c`` (N values added to ``y(k)``); the
+        paper's model has none.  Used for data with offsets (``identify(..., offset=True)``).
     """
 
     orders: HWLOrders
     n_modes: int
     has_u: bool = True
     has_v: bool = True
+    constant: bool = False
 
     def __post_init__(self):
         object.__setattr__(self, "orders", HWLOrders.from_tuple(self.orders))
@@ -102,6 +116,23 @@ class HWLStructure:
             out.append(("gamma", (o.p - 1, N, N)))
         if self.has_v:
             out.append(("beta", (o.p - 1, N)))
+        if self.constant:
+            out.append(("c", (1, N)))
+        return out
+
+    def index_map(self) -> dict[str, np.ndarray]:
+        """Position in theta of every free coefficient, shaped like its block
+        (``A[m, i, j]``, ``h[d, i]``, ``alpha[l-2, i, j]``, ``c[0, i]``, ...)."""
+        out, pos = {}, 0
+        for name, shape in self.blocks():
+            size = int(np.prod(shape))
+            if len(shape) == 3:
+                # column-major within each (i, j) matrix, as in pack()
+                idx = np.arange(size).reshape(shape[0], shape[2], shape[1]).transpose(0, 2, 1)
+            else:
+                idx = np.arange(size).reshape(shape)
+            out[name] = idx + pos
+            pos += size
         return out
 
     @property
@@ -118,7 +149,7 @@ class HWLStructure:
             n += N * N * (o.mu + o.nb + 1 + o.p)
         if self.has_v:
             n += N * (o.mu + o.nb + 1 + o.p)
-        return n
+        return n + (N if self.constant else 0)
 
     @property
     def max_lag(self) -> int:
@@ -133,6 +164,8 @@ class HWLStructure:
             arr = np.asarray(coefficients[name], dtype=float)
             if name in ("alpha", "gamma", "beta"):
                 arr = arr[1:]
+            if name == "c":
+                arr = arr.reshape(1, -1)
             if arr.shape != shape:
                 raise DimensionError(f"coefficient {name} has shape {arr.shape}, expected {shape}")
             # column-major within each (i, j) matrix so that numpy and CasADi agree
@@ -184,6 +217,8 @@ class HWLStructure:
             W["u"] = [[hb * g for g in c["gamma"]] for hb in c["H"] + c["B"]]
         if self.has_v:
             W["v"] = [[hb * be for be in c["beta"]] for hb in c["h"] + c["b"]]
+        if self.constant:
+            W["c"] = c["c"][0]
         return W
 
 
@@ -203,7 +238,24 @@ def _input_part(structure: HWLStructure, W, u, v, n_samples: int):
             block = v[L - lag:K - lag, :]
             for l, w in enumerate(W["v"][d], start=1):
                 total = total + (block ** l) @ w
+    if structure.constant:
+        c = W["c"]
+        if isinstance(c, (ca.MX, ca.SX, ca.DM)):
+            total = total + ca.repmat(c, K - L, 1)
+        else:
+            total = total + np.broadcast_to(c, (K - L, structure.n_modes))
     return total
+
+
+def ar_weight_array(structure: HWLStructure, W) -> np.ndarray:
+    """The autoregressive weights ``A^(m) ∘ alpha^[l]`` as one array ``(na, q, N, N)``
+    (numpy weights only), the form the compiled recursion takes."""
+    o, N = structure.orders, structure.n_modes
+    out = np.zeros((o.na, o.q, N, N))
+    for m in range(o.na):
+        for l in range(o.q):
+            out[m, l] = W["ar"][m][l]
+    return out
 
 
 def _ar_part(structure: HWLStructure, W, y, n_samples: int):
@@ -216,42 +268,6 @@ def _ar_part(structure: HWLStructure, W, y, n_samples: int):
         for l, w in enumerate(W["ar"][m], start=1):
             total = total + (block ** l) @ w.T
     return total
-
-
-def ar_weights(structure: HWLStructure, W) -> "ca.MX | np.ndarray":
-    """The autoregressive weights ``A^(m) ∘ alpha^[l]`` stacked in one column (the only
-    parameters the free-run recursion needs)."""
-    o = structure.orders
-    mats = [W["ar"][m][l] for m in range(o.na) for l in range(o.q)]
-    if mats and isinstance(mats[0], (ca.MX, ca.SX, ca.DM)):
-        return ca.vertcat(*[ca.vec(w) for w in mats])
-    return np.concatenate([np.ravel(w, order="F") for w in mats])
-
-
-def recursion_step(structure: HWLStructure) -> ca.Function:
-    """One step of the free-run recursion: ``(hist, xin_k, w_ar) -> hist_next``.
-
-    ``hist = [y(k-1); ...; y(k-H)]`` (each block N long, ``H`` the largest output lag);
-    ``xin_k`` the input part of eq. 3 at time k; ``w_ar`` from :func:`ar_weights`.  The first
-    N entries of ``hist_next`` are ``y(k)``.  Built from SX so that ``mapaccum`` over long
-    records runs at compiled-expression speed.
-    """
-    o, N = structure.orders, structure.n_modes
-    lags = o.ar_lags()
-    H = max(lags)
-    hist = ca.SX.sym("hist", H * N)
-    xk = ca.SX.sym("xin", N)
-    w_ar = ca.SX.sym("w_ar", o.na * o.q * N * N)
-    yk = xk
-    pos = 0
-    for lag in lags:
-        past = hist[(lag - 1) * N:lag * N]
-        for l in range(1, o.q + 1):
-            w = ca.reshape(w_ar[pos:pos + N * N], N, N)
-            pos += N * N
-            yk = yk - ca.mtimes(w, past ** l)
-    new = ca.vertcat(yk, hist[:(H - 1) * N]) if H > 1 else yk
-    return ca.Function("hwl_step", [hist, xk, w_ar], [new])
 
 
 @dataclass(frozen=True)
@@ -299,21 +315,24 @@ class HWLModel:
     # -- construction ---------------------------------------------------------------
     @classmethod
     def from_coefficients(cls, orders, *, A, alpha, H=None, B=None, gamma=None, h=None, b=None,
-                          beta=None, dt: float = 1.0, **names) -> "HWLModel":
+                          beta=None, c=None, dt: float = 1.0, **names) -> "HWLModel":
         """Build from coefficient arrays with the paper's names (shapes in the module doc).
 
         The polynomial arrays ``alpha``, ``gamma``, ``beta`` include their leading
-        coefficient, which must be 1 (the normalisation).
+        coefficient, which must be 1 (the normalisation).  ``c`` (N,) is the optional
+        constant term.
         """
         A = np.asarray(A, dtype=float)
         N = A.shape[-1] if A.ndim == 3 and A.shape[0] else np.asarray(alpha).shape[-1]
         has_u, has_v = H is not None, h is not None
-        structure = HWLStructure(HWLOrders.from_tuple(orders), N, has_u, has_v)
+        structure = HWLStructure(HWLOrders.from_tuple(orders), N, has_u, has_v, c is not None)
         coeffs = {"A": A.reshape(structure.orders.na, N, N), "alpha": alpha}
         if has_u:
             coeffs.update(H=H, B=B, gamma=gamma)
         if has_v:
             coeffs.update(h=h, b=b, beta=beta)
+        if c is not None:
+            coeffs["c"] = np.asarray(c, dtype=float).reshape(N)
         for name in ("alpha", "gamma", "beta"):
             if name in coeffs and not np.allclose(np.asarray(coeffs[name])[0], 1.0):
                 raise DataError(f"{name}[0] (the linear coefficient {name}^[1]) must be 1: "
@@ -324,7 +343,8 @@ class HWLModel:
     def coefficients(self) -> dict[str, np.ndarray]:
         """Coefficient arrays with the paper's names: ``A (na,N,N)``, ``H (mu,N,N)``,
         ``B (nb+1,N,N)``, ``h (mu,N)``, ``b (nb+1,N)``, ``alpha (q,N,N)``, ``gamma (p,N,N)``,
-        ``beta (p,N)`` (the polynomial arrays include the leading 1)."""
+        ``beta (p,N)`` (the polynomial arrays include the leading 1), and ``c (N,)`` when
+        the model has a constant term."""
         c = self.structure.unpack(self.theta)
         out = {}
         for name, mats in c.items():
@@ -334,6 +354,8 @@ class HWLModel:
             out[name] = arr
         N = self.n_modes
         out["A"] = out["A"].reshape(self.orders.na, N, N)
+        if "c" in out:
+            out["c"] = out["c"].reshape(N)
         return out
 
     def with_theta(self, theta) -> "HWLModel":
@@ -368,6 +390,8 @@ class HWLModel:
     # -- evaluation -------------------------------------------------------------------
     def _arrays(self, u, v, y, n_samples=None):
         N = self.n_modes
+        if u is not None and v is None and self.has_v and not self.has_u:
+            u, v = None, u   # a flap-only model: the one input given is v
         K = None
         for arr in (y, u, v):
             if arr is not None:
@@ -421,13 +445,20 @@ class HWLModel:
         Parameters
         ----------
         u : array (K, N), optional
+            Modal displacements.  For a model whose only input is the flap, the first
+            positional argument is taken as ``v`` (``model.simulate(v)``).
         v : array (K,), optional
         y0 : array (K0 >= max_lag, N), optional
             Initial outputs for the first ``max_lag`` samples (zeros when omitted).
+        n_samples : int, optional
+            Length when the model is driven by no signal at all (not needed otherwise).
 
         Returns
         -------
         ndarray, shape (K, N)
+            When the model diverges (unstable free run: an output above ``1e100`` in magnitude
+            or not finite) the samples from the divergence on are NaN and one
+            :class:`UnstableModelWarning` names the sample.
         """
         u, v, _, K = self._arrays(u, v, None, n_samples)
         N, L = self.n_modes, self.max_lag
@@ -437,22 +468,23 @@ class HWLModel:
             if y0.shape[0] < L:
                 raise DataError(f"y0 needs at least max_lag={L} rows, got {y0.shape[0]}")
             y[:L] = y0[:L]
-        xin = _input_part(self.structure, self._weights, u, v, K)
+        xin = np.ascontiguousarray(_input_part(self.structure, self._weights, u, v, K),
+                                   dtype=float)
         lags = self.orders.ar_lags()
         if not lags:
             y[L:] = xin
             return y
-        Wt = [[w.T for w in row] for row in self._weights["ar"]]
-        mu = self.orders.mu
-        # y(k) depends on outputs at lags >= mu only: advance mu samples per step
-        for k0 in range(L, K, mu):
-            k1 = min(k0 + mu, K)
-            acc = np.array(xin[k0 - L:k1 - L])
-            for m, lag in enumerate(lags):
-                block = y[k0 - lag:k1 - lag]
-                for l, wt in enumerate(Wt[m], start=1):
-                    acc -= (block ** l) @ wt
-            y[k0:k1] = acc
+        H = max(lags)
+        ybuf, _, diverged = free_run(xin, ar_weight_array(self.structure, self._weights),
+                                     np.asarray(lags, dtype=np.int64),
+                                     np.ascontiguousarray(y[L - H:L]), np.zeros((1, N)), 0,
+                                     _DIVERGED)
+        y[L:] = ybuf[H:]
+        if diverged >= 0:
+            warnings.warn(f"the HWL model is unstable in free run: its output diverges at sample "
+                          f"{L + diverged} of {K} (the rest is NaN); check its orders or "
+                          "identify it with criterion='simulation'", UnstableModelWarning,
+                          stacklevel=2)
         return y
 
     def step(self, y_hist, u_hist=None, v_hist=None) -> np.ndarray:
@@ -513,6 +545,8 @@ class HWLModel:
             kw.update(H=c["H"], B=c["B"], gamma=c["gamma"][:1])
         if self.has_v:
             kw.update(h=c["h"], b=c["b"], beta=c["beta"][:1])
+        if "c" in c:
+            kw["c"] = c["c"]
         return HWLModel.from_coefficients(lin, dt=self.dt, output_names=self.output_names,
                                           u_names=self.u_names, v_name=self.v_name, **kw)
 
@@ -542,7 +576,57 @@ class HWLModel:
             new["h"] = c["h"] * sv / sy[None, :]
             new["b"] = c["b"] * sv / sy[None, :]
             new["beta"] = c["beta"] * np.array([[sv ** l] * N for l in range(self.orders.p)])
+        if self.structure.constant:
+            new["c"] = c["c"] / sy
         return replace(self, theta=self.structure.pack(new), _weights=None)
+
+    def shifted(self, y_shift, u_shift=None, v_shift=None) -> "HWLModel":
+        """The same input--output map expressed in shifted signals ``y' = y - y_shift``,
+        ``u' = u - u_shift``, ``v' = v - v_shift``.
+
+        Each polynomial of eq. 3 is re-expanded about the shift (binomial theorem) and
+        renormalised so that its linear coefficient stays 1; the constants collect in the
+        constant term ``c``, which the result always has.  A model identified on centred
+        data is returned to raw units by ``shifted(-mean_y, -mean_u, -mean_v)``.
+
+        Raises
+        ------
+        DataError
+            When a polynomial's slope vanishes at the shift (the normalisation cannot hold).
+        """
+        N = self.n_modes
+        sy = np.broadcast_to(np.asarray(y_shift, float), (N,))
+        su = np.broadcast_to(np.asarray(0.0 if u_shift is None else u_shift, float), (N,))
+        sv = float(0.0 if v_shift is None else v_shift)
+        c = self.coefficients()
+
+        def expand(coef, shift, what):
+            # coef (deg, ...) for powers 1..deg; returns e0 and the renormalised polynomial
+            deg = coef.shape[0]
+            e = np.zeros((deg + 1,) + coef.shape[1:])
+            for lp in range(1, deg + 1):
+                for l in range(0, lp + 1):
+                    e[l] = e[l] + coef[lp - 1] * comb(lp, l) * shift ** (lp - l)
+            if np.any(e[1] == 0):
+                raise DataError(f"the {what} polynomial has zero slope at the shift: the model "
+                                "cannot be normalised (alpha^[1] = 1) in the shifted signals")
+            return e[0], e[1], e[1:] / e[1]
+
+        const = -sy + (c["c"] if "c" in c else 0.0)
+        e0, e1, alpha = expand(c["alpha"], sy[None, :], "alpha")
+        new = {"A": c["A"] * e1, "alpha": alpha}
+        const = const - np.einsum("mij,ij->i", c["A"], e0)
+        if self.has_u:
+            e0, e1, gamma = expand(c["gamma"], su[None, :], "gamma")
+            new.update(H=c["H"] * e1, B=c["B"] * e1, gamma=gamma)
+            const = const + np.einsum("dij,ij->i", np.concatenate([c["H"], c["B"]]), e0)
+        if self.has_v:
+            e0, e1, beta = expand(c["beta"], sv, "beta")
+            new.update(h=c["h"] * e1, b=c["b"] * e1, beta=beta)
+            const = const + np.concatenate([c["h"], c["b"]]).sum(axis=0) * e0
+        new["c"] = const
+        structure = replace(self.structure, constant=True)
+        return replace(self, structure=structure, theta=structure.pack(new), _weights=None)
 
     # -- persistence ------------------------------------------------------------------
     def save(self, path) -> None:
@@ -550,7 +634,8 @@ class HWLModel:
         s = self.structure
         np.savez(path, format=np.array("casflutter.HWLModel/1"),
                  orders=np.array(s.orders.as_tuple()), n_modes=np.array(s.n_modes),
-                 has_u=np.array(s.has_u), has_v=np.array(s.has_v), theta=self.theta,
+                 has_u=np.array(s.has_u), has_v=np.array(s.has_v),
+                 constant=np.array(s.constant), theta=self.theta,
                  dt=np.array(self.dt), output_names=np.array(self.output_names),
                  u_names=np.array(self.u_names), v_name=np.array(self.v_name))
 
@@ -561,7 +646,8 @@ class HWLModel:
             if "format" not in z.files or not str(z["format"]).startswith("casflutter.HWLModel"):
                 raise DataError(f"{path} is not a casflutter HWL model file")
             structure = HWLStructure(HWLOrders.from_tuple(tuple(int(x) for x in z["orders"])),
-                                     int(z["n_modes"]), bool(z["has_u"]), bool(z["has_v"]))
+                                     int(z["n_modes"]), bool(z["has_u"]), bool(z["has_v"]),
+                                     bool(z["constant"]) if "constant" in z.files else False)
             return cls(structure, z["theta"], float(z["dt"]),
                        tuple(str(x) for x in z["output_names"]),
                        tuple(str(x) for x in z["u_names"]), str(z["v_name"]))
@@ -569,60 +655,6 @@ class HWLModel:
     def __str__(self) -> str:
         s = self.structure
         ins = [n for n, ok in (("u", s.has_u), ("v", s.has_v)) if ok]
-        return (f"HWLModel(N={s.n_modes}, {s.orders}, inputs {'+'.join(ins)}, "
+        const = ", constant term" if s.constant else ""
+        return (f"HWLModel(N={s.n_modes}, {s.orders}, inputs {'+'.join(ins)}{const}, "
                 f"{s.n_params} parameters, dt={self.dt:g} s)")
-
-
-def _sym_signals(structure: HWLStructure, n_samples: int):
-    N = structure.n_modes
-    theta = ca.MX.sym("theta", structure.n_params)
-    u = ca.MX.sym("u", n_samples, N) if structure.has_u else None
-    v = ca.MX.sym("v", n_samples, 1) if structure.has_v else None
-    return theta, u, v
-
-
-def hwl_predict_function(structure: HWLStructure, n_samples: int) -> ca.Function:
-    """CasADi twin of :meth:`HWLModel.predict`.
-
-    ``f(theta, y, [u], [v]) -> yhat`` with ``yhat`` of shape ``(K - max_lag, N)`` (the rows
-    where a prediction exists).  Inputs u, v appear only when the structure has them.
-    """
-    theta, u, v = _sym_signals(structure, n_samples)
-    y = ca.MX.sym("y", n_samples, structure.n_modes)
-    W = structure.weights(theta)
-    yhat = _input_part(structure, W, u, v, n_samples)
-    if structure.orders.na:
-        yhat = yhat - _ar_part(structure, W, y, n_samples)
-    args = [theta, y] + [s for s in (u, v) if s is not None]
-    names = ["theta", "y"] + [n for n, s in (("u", u), ("v", v)) if s is not None]
-    return ca.Function("hwl_predict", args, [yhat], names, ["yhat"])
-
-
-def hwl_simulate_function(structure: HWLStructure, n_samples: int) -> ca.Function:
-    """CasADi twin of :meth:`HWLModel.simulate`, built with ``mapaccum``.
-
-    ``f(theta, y0, [u], [v]) -> ysim`` with ``y0`` the first ``max_lag`` outputs
-    (``max_lag x N``) and ``ysim`` of shape ``(K - max_lag, N)``.
-    """
-    o = structure.orders
-    N, L = structure.n_modes, structure.max_lag
-    theta, u, v = _sym_signals(structure, n_samples)
-    y0 = ca.MX.sym("y0", L, N)
-    W = structure.weights(theta)
-    xin = _input_part(structure, W, u, v, n_samples)  # (K-L, N)
-    n_steps = n_samples - L
-    lags = o.ar_lags()
-    if lags:
-        H = max(lags)  # history length carried by the recursion
-        step = recursion_step(structure)
-        acc = step.mapaccum("hwl_recursion", n_steps)
-        # initial history from y0: rows L-1, L-2, ..., L-H
-        rows = [y0[L - 1 - d, :].T for d in range(H)]
-        hist0 = ca.vertcat(*rows)
-        traj = acc(hist0, xin.T, ca.repmat(ar_weights(structure, W), 1, n_steps))  # (H*N, n_steps)
-        ysim = traj[:N, :].T
-    else:
-        ysim = xin
-    args = [theta, y0] + [s for s in (u, v) if s is not None]
-    names = ["theta", "y0"] + [n for n, s in (("u", u), ("v", v)) if s is not None]
-    return ca.Function("hwl_simulate", args, [ysim], names, ["ysim"])

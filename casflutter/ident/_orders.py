@@ -4,9 +4,32 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..errors import OrderError
 
 __all__ = ["HWLOrders"]
+
+_NAMES = ("mu", "na", "nb", "r", "p", "q")
+
+
+def _as_int(name: str, value):
+    """An order value as int; integer-valued floats and numeric strings are accepted."""
+    if isinstance(value, (bool, np.bool_)):
+        raise OrderError(f"order {name}={value!r} must be an integer, not a boolean")
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, str):
+        try:
+            value = float(value)
+        except ValueError:
+            raise OrderError(f"order {name}={value!r} is not a number: give an integer") from None
+    if isinstance(value, (float, np.floating)):
+        if not np.isfinite(value) or value != int(value):
+            raise OrderError(f"order {name}={value!r} must be an integer (got a non-integer "
+                             "or non-finite value)")
+        return int(value)
+    raise OrderError(f"order {name}={value!r} ({type(value).__name__}) must be an integer")
 
 
 @dataclass(frozen=True)
@@ -50,15 +73,36 @@ class HWLOrders:
 
     @classmethod
     def from_tuple(cls, orders) -> "HWLOrders":
-        """Build from ``(mu, na, nb, r, p, q)`` in the paper's order (Table I)."""
+        """Build from ``(mu, na, nb, r, p, q)`` in the paper's order (Table I).
+
+        Also accepts a mapping with those keys, a string ``"3,1,1,1,2,2"`` or an
+        :class:`HWLOrders`.  Integer-valued floats are taken as integers.
+
+        Raises
+        ------
+        OrderError
+            ``None``, the wrong number of values, or a value that is not an integer in range.
+        """
         if isinstance(orders, HWLOrders):
             return orders
+        hint = "give six integers (mu, na, nb, r, p, q), e.g. (3, 1, 1, 1, 2, 2) as in the paper"
+        if orders is None:
+            raise OrderError(f"orders=None: {hint}")
         if isinstance(orders, dict):
-            return cls(**orders)
-        orders = tuple(orders)
-        if len(orders) != 6:
-            raise OrderError(f"orders must be (mu, na, nb, r, p, q): got {len(orders)} values {orders}")
-        return cls(*[int(o) if float(o) == int(o) else o for o in orders])
+            unknown = sorted(set(map(str, orders)) - set(_NAMES))
+            if unknown:
+                raise OrderError(f"orders has unknown key(s) {unknown}: the keys are {_NAMES}")
+            return cls(**{k: _as_int(k, v) for k, v in orders.items()})
+        if isinstance(orders, str):
+            orders = [x for x in orders.replace(" ", "").split(",") if x != ""]
+        try:
+            values = tuple(orders)
+        except TypeError:
+            raise OrderError(f"orders={orders!r} is not a sequence: {hint}") from None
+        if len(values) != 6:
+            raise OrderError(f"orders must be (mu, na, nb, r, p, q): got {len(values)} values "
+                             f"{values!r}; {hint}")
+        return cls(*[_as_int(n, v) for n, v in zip(_NAMES, values)])
 
     def as_tuple(self) -> tuple[int, int, int, int, int, int]:
         """``(mu, na, nb, r, p, q)``."""

@@ -22,10 +22,13 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-from .._nlp import NLPResult, make_solver
+from .._nlp import make_solver
 from ..data import IOData
-from ._model import HWLStructure, _input_part, ar_weights, recursion_step
+from ..errors import ConfigError
+from ._model import HWLStructure, _input_part
+from ._twins import ar_weights, recursion_step
 from ._regression import regressor_matrix, weights_matrix
+from ._simfit import FreeRunProblem
 
 __all__ = ["prediction_problem", "simulation_problem", "refine"]
 
@@ -63,7 +66,8 @@ def simulation_problem(structure: HWLStructure, data: IOData, shooting_interval:
 
     Returns ``(nlp, residual, x0_nodes, unpack)``: the NLP dict, the residual vector (for a
     Gauss--Newton Hessian), the initial values of the shooting nodes (measured output
-    histories) and a function splitting the solution vector into ``(theta, nodes)``.
+    histories) and a function splitting the solution vector into ``(theta, nodes)``.  Each
+    record starts from its measured outputs.
     """
     N, L = structure.n_modes, structure.max_lag
     lags = structure.orders.ar_lags()
@@ -85,6 +89,7 @@ def simulation_problem(structure: HWLStructure, data: IOData, shooting_interval:
         if not lags:
             residuals.append(ca.vec(xin - ca.DM(target)))
             continue
+        # the measured initial output history (the Gauss--Newton solver estimates it)
         hist = ca.DM(np.concatenate([rec.y[L - 1 - d] for d in range(H)]))
         for start in range(0, K - L, shooting_interval):
             stop = min(start + shooting_interval, K - L)
@@ -135,9 +140,10 @@ def _gauss_newton_hessian(nlp, residual, structure, data, regularization) -> ca.
 
 def refine(structure: HWLStructure, data: IOData, theta0, *, criterion: str = "prediction",
            shooting_interval: int = 50, regularization: float = 0.0,
-           options: dict | None = None, accept_acceptable: bool = False,
-           hessian: str = "gauss-newton") -> tuple[np.ndarray, NLPResult, float]:
-    """Solve the stage-2 NLP from ``theta0``.
+           options: dict | None = None, hessian: str = "gauss-newton"):
+    """Solve the stage-2 NLP from ``theta0`` with Ipopt.
+
+    Options not given take the package defaults (``casflutter._nlp.DEFAULT_IPOPT_OPTIONS``).
 
     Returns
     -------
@@ -145,30 +151,34 @@ def refine(structure: HWLStructure, data: IOData, theta0, *, criterion: str = "p
         Refined parameters (the last iterate when the solve failed: check ``result.success``).
     result : NLPResult
         Solver outcome (status, iterations, time).
-    cost0 : float
-        Objective at ``theta0`` (same scaling as ``result.f``).
+    cost0, cost : float
+        Criterion at ``theta0`` and at ``theta``.  For the simulation criterion both are free
+        runs evaluated outside the NLP (``cost0`` from the measured initial outputs), so they
+        compare like with like.
+    initial_outputs : list
+        Empty: the Ipopt NLP starts every record from its measured outputs.
     """
     theta0 = np.asarray(theta0, dtype=float)
-    opts = {"ipopt.max_iter": 300}
-    opts.update(options or {})
+    opts = dict(options or {})
     if criterion == "prediction":
         nlp, cost = prediction_problem(structure, data, regularization, theta0)
         solver = make_solver(nlp, opts, name="hwl_prediction")
         cost0 = cost(theta0)
-        res = solver(theta0, accept_acceptable=accept_acceptable)
-        return res.x, res, cost0
+        res = solver(theta0)
+        return res.x, res, cost0, res.f, []
     if criterion == "simulation":
         nlp, residual, nodes0, split = simulation_problem(structure, data, shooting_interval,
                                                           regularization, theta0)
         x0 = np.concatenate([theta0, nodes0])
-        f0 = ca.Function("f0", [nlp["x"]], [nlp["f"]])
-        cost0 = float(f0(x0))
-        if not np.isfinite(cost0):
-            cost0 = np.inf
+        free = FreeRunProblem(structure, data, regularization, theta0)
+        cost0 = free.cost(free.x0(theta0))
         if hessian == "gauss-newton":
             opts.setdefault("hess_lag", _gauss_newton_hessian(nlp, residual, structure,
                                                               data, regularization))
+        opts.setdefault("show_eval_warnings", False)
         solver = make_solver(nlp, opts, name="hwl_simulation")
-        res = solver(x0, lbg=0.0, ubg=0.0, accept_acceptable=accept_acceptable)
-        return split(res.x)[0], res, cost0
-    raise ValueError(f"criterion={criterion!r} is not known: use 'prediction' or 'simulation'")
+        res = solver(x0, lbg=0.0, ubg=0.0)
+        theta = split(res.x)[0]
+        cost = free.cost(free.x0(theta)) if np.all(np.isfinite(theta)) else float("nan")
+        return theta, res, cost0, cost, []
+    raise ConfigError(f"criterion={criterion!r} is not known: use 'prediction' or 'simulation'")

@@ -30,8 +30,8 @@ __all__ = ["regressor_matrix", "regression_layout", "stage1", "Stage1Result"]
 def regression_layout(structure: HWLStructure) -> list[tuple[str, int, int, int]]:
     """Column meaning of the regressor matrix: ``(kind, lag_index, power, channel)``.
 
-    ``kind`` is ``"ar"`` (column holds ``-y_j(k-lag)^l``), ``"u"`` (``u_j(k-lag)^l``)
-    or ``"v"`` (``v(k-lag)^l``, channel 0).
+    ``kind`` is ``"ar"`` (column holds ``-y_j(k-lag)^l``), ``"u"`` (``u_j(k-lag)^l``),
+    ``"v"`` (``v(k-lag)^l``, channel 0) or ``"c"`` (ones: the constant term).
     """
     o, N = structure.orders, structure.n_modes
     cols = [("ar", m, l, j) for m in range(o.na) for l in range(1, o.q + 1) for j in range(N)]
@@ -40,6 +40,8 @@ def regression_layout(structure: HWLStructure) -> list[tuple[str, int, int, int]
         cols += [("u", d, l, j) for d in range(n_in) for l in range(1, o.p + 1) for j in range(N)]
     if structure.has_v:
         cols += [("v", d, l, 0) for d in range(n_in) for l in range(1, o.p + 1)]
+    if structure.constant:
+        cols.append(("c", 0, 0, 0))
     return cols
 
 
@@ -66,6 +68,8 @@ def regressor_matrix(structure: HWLStructure, data: IOData) -> tuple[np.ndarray,
             elif kind == "u":
                 lag = in_lags[d]
                 cols.append(rec.u[L - lag:K - lag, j] ** l)
+            elif kind == "c":
+                cols.append(np.ones(K - L))
             else:
                 lag = in_lags[d]
                 cols.append(rec.v[L - lag:K - lag] ** l)
@@ -91,6 +95,8 @@ def weights_matrix(structure: HWLStructure, W) -> list:
         for d in range(n_in):
             for l in range(o.p):
                 rows.append(W["v"][d][l])
+    if structure.constant:
+        rows.append(W["c"])
     return rows
 
 
@@ -154,8 +160,14 @@ def stage1(structure: HWLStructure, data: IOData, *, max_condition: float = 1e10
                         f"{structure.max_lag}) for {len(layout)} regression unknowns per output "
                         f"({structure.n_params} model parameters); record more data or lower "
                         "the orders")
-    Phi, Y = regressor_matrix(structure, data)
-    col_norm = np.linalg.norm(Phi, axis=0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        Phi, Y = regressor_matrix(structure, data)
+        col_norm = np.linalg.norm(Phi, axis=0)
+    if not (np.all(np.isfinite(Phi)) and np.all(np.isfinite(col_norm))):
+        raise DataError(f"the regression overflows: the powers up to "
+                        f"{max(structure.orders.p, structure.orders.q)} of the signals are not "
+                        "finite in double precision; scale the data (scale_data=True) or lower "
+                        "the polynomial degrees p, q")
     dead = [layout[c] for c in np.flatnonzero(col_norm == 0)]
     if dead:
         raise DataError(f"non-exciting input: regressor column(s) {dead[:4]} are identically "
@@ -205,5 +217,7 @@ def stage1(structure: HWLStructure, data: IOData, *, max_condition: float = 1e10
             hb[:, i], beta[:, i] = a, c
             worst = max(worst, res)
         coeffs.update(h=hb[:o.mu], b=hb[o.mu:], beta=beta)
+    if structure.constant:
+        coeffs["c"] = theta_over[index["c", 0, 0, 0], :]
     model = HWLModel(structure, structure.pack(coeffs), data.dt)
     return Stage1Result(model, theta_over, cond, worst, n_rows)

@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from scipy.signal import butter, sosfiltfilt
+
 from ..data import IOData, Record, chirp_excitation
+from ..errors import ConfigError
+from ._kernels import duffing_rk4
 from ._model import HWLModel, HWLStructure
 from ._orders import HWLOrders
 
-__all__ = ["random_hwl_model", "synthetic_data"]
+__all__ = ["random_hwl_model", "synthetic_data", "duffing_data"]
 
 
 def random_hwl_model(n_modes: int = 5, orders=(3, 1, 1, 1, 2, 2), *, has_u: bool = True,
@@ -70,3 +74,40 @@ def synthetic_data(model: HWLModel, n_samples: int = 4000, *, n_records: int = 1
             y = y + noise * np.sqrt(np.mean(y ** 2, axis=0)) * rng.normal(size=y.shape)
         recs.append(Record(y, u, v, f"synthetic[{rec}]"))
     return IOData(tuple(recs), dt, output_names=model.output_names, u_names=model.u_names)
+
+
+def duffing_data(n_samples: int = 65000, *, f0: float = 1.0, oversampling: float = 10.0,
+                 zeta: float = 0.1, cubic: float = 0.05, band: float = 3.0,
+                 amplitude: float = 1.0, noise: float = 0.01, offset: float = 0.0,
+                 seed: int = 0) -> IOData:
+    """A single-input single-output record of a Duffing-type oscillator (cubic stiffness in
+    the feedback), a stand-in for measured nonlinear benchmark records such as Silverbox.
+
+    The system ``y'' + 2 zeta w0 y' + w0^2 (y + cubic y^3) = w0^2 u(t)`` (``w0 = 2 pi f0``,
+    unit static gain of the linear part) is driven by Gaussian noise low-pass filtered to
+    ``band * f0`` (zero phase, RMS ``amplitude``), integrated by Runge--Kutta with 20 steps
+    per sample and the input held between samples, and sampled at ``oversampling * f0``.
+    White noise of ``noise`` times the output RMS is added to the output, and ``offset`` to
+    both signals (a sensor bias).
+
+    Returns
+    -------
+    IOData
+        One record, ``u`` the input and ``y`` the output (``N = 1``).
+    """
+    for name, value, ok in (("n_samples", n_samples, isinstance(n_samples, int) and n_samples > 10),
+                            ("oversampling", oversampling, oversampling > 2 * band),
+                            ("zeta", zeta, zeta > 0), ("f0", f0, f0 > 0)):
+        if not ok:
+            raise ConfigError(f"duffing_data {name}={value!r} is not allowed (n_samples > 10, "
+                              "f0 > 0, zeta > 0, oversampling > 2 band)")
+    rng = np.random.default_rng(seed)
+    dt = 1.0 / (oversampling * f0)
+    w0 = 2 * np.pi * f0
+    sos = butter(6, band / (oversampling / 2), output="sos")
+    u = sosfiltfilt(sos, rng.normal(size=n_samples + 400))[200:-200]
+    u *= amplitude / np.sqrt(np.mean(u ** 2))
+    y = duffing_rk4(w0 ** 2 * u, dt, w0, zeta, w0 ** 2 * cubic, 20)
+    y = y + noise * np.sqrt(np.mean(y ** 2)) * rng.normal(size=n_samples)
+    return IOData.from_arrays(y=y[:, None] + offset, u=u[:, None] + offset, dt=dt,
+                              name="duffing", output_names=("y",), u_names=("u",))

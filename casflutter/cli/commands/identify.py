@@ -1,19 +1,73 @@
-"""``casflutter identify``: identify an HWL ROM from a data file and print the fit table."""
+"""``casflutter identify``: identify an HWL ROM from a data file and print the fit table.
+
+With ``--search [GRID]`` the orders are first chosen by free-run error on the held-out last
+part of the records (``--validation``, default 30 %): every candidate of the grid
+(default ``na=1:4 p=1:3 q=1:3`` around ``--orders``) is identified and scored, the table of
+candidates is printed, and the chosen orders are then identified on all the data.
+
+Exit status: 0 for a converged fit (also one stopped at the acceptable level, with a warning
+line), 1 for an error, a fit that did not converge or diverges in free run, or a fit stopped
+by ``--max-time`` (its best iterate is still reported and written).
+"""
 
 from __future__ import annotations
 
 import json
+import math
+import os
+import sys
+import warnings
 from pathlib import Path
+
+import numpy as np
 
 from ...errors import ConfigError
 
 
+def check_writable(path, flag: str) -> None:
+    """Refuse an output path that cannot be written, before any work.
+
+    Raises
+    ------
+    ConfigError
+        The path is a directory, its folder does not exist or is not a folder, or it is not
+        writable.
+    """
+    p = Path(path)
+    if p.is_dir():
+        raise ConfigError(f"{flag} {path}: is a directory; give a file name")
+    parent = p.parent if str(p.parent) else Path(".")
+    if not parent.exists():
+        raise ConfigError(f"{flag} {path}: the folder {parent} does not exist; create it first")
+    if not parent.is_dir():
+        raise ConfigError(f"{flag} {path}: {parent} is not a folder")
+    if (p.exists() and not os.access(p, os.W_OK)) or not os.access(parent, os.W_OK):
+        raise ConfigError(f"{flag} {path}: not writable")
+
+
 def _orders(text: str):
+    from ...ident import HWLOrders
+
+    return HWLOrders.from_tuple(text)
+
+
+def _finite(x):
+    """JSON-safe number: None for NaN/inf (valid JSON, never a bare NaN)."""
+    if isinstance(x, (list, tuple, np.ndarray)):
+        return [_finite(v) for v in np.asarray(x, dtype=float).ravel()]
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _regularization(text: str) -> float:
     try:
-        vals = tuple(int(x) for x in text.replace(" ", "").split(","))
+        value = float(text)
     except ValueError:
-        raise ConfigError(f"--orders {text!r}: give six integers mu,na,nb,r,p,q") from None
-    return vals
+        raise ConfigError(f"--regularization {text!r}: give a finite number >= 0") from None
+    if not (math.isfinite(value) and value >= 0):
+        raise ConfigError(f"--regularization {text!r}: give a finite number >= 0 "
+                          "(0: no regularisation)")
+    return value
 
 
 def _load(args):
@@ -39,29 +93,65 @@ def _load(args):
 
 
 def _main(args) -> int:
-    from ...ident import identify
+    from ...ident import IdentificationWarning, identify, parse_grid, select_orders
     from ...realize import realize
 
+    # every argument checked before any work
+    orders = _orders(args.orders)
+    reg = _regularization(args.regularization)
+    if args.out:
+        check_writable(args.out, "--out")
+    if args.max_time is not None and not (math.isfinite(args.max_time) and args.max_time > 0):
+        raise ConfigError(f"--max-time {args.max_time}: give a positive number of seconds")
+    grid = None if args.search in (None, "default") else parse_grid(args.search)
+    if not 0 < args.validation < 1:
+        raise ConfigError(f"--validation {args.validation}: give a fraction in (0, 1)")
+    settings = dict(criterion=args.criterion, regularization=reg, offset=args.offset,
+                    max_time=args.max_time)
     data = _load(args)
-    res = identify(data, _orders(args.orders), criterion=args.criterion,
-                   regularization=args.regularization)
+    selection = None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", IdentificationWarning)
+        if args.search is not None:
+            selection = select_orders(data, grid, base=orders, validation=args.validation,
+                                      **settings)
+            orders = selection.best.orders
+            if not args.json:
+                print(selection.table())
+                print(f"identifying {orders} on all the data")
+        res = identify(data, orders, **settings)
+    for w in caught:   # one line each on stderr
+        print(f"casflutter: warning: {w.message}", file=sys.stderr)
     real = realize(res.model, args.nf if args.nf else "auto")
     if args.out:
         res.model.save(args.out)
     if args.json:
-        print(json.dumps({
+        out = {
             "orders": list(res.model.orders.as_tuple()), "n_params": res.n_params,
-            "fit_error_percent": res.fit.error_percent.tolist(),
-            "nrmse": res.fit.nrmse.tolist(), "status": res.return_status,
-            "iterations": res.iterations, "wall_time_s": res.wall_time, "nf": real.order,
-            "hankel_singular_values": real.hankel_singular_values[:3 * real.order].tolist(),
-        }, indent=2))
+            "criterion": res.settings.criterion, "solver": res.solver,
+            "fit_error_percent": _finite(res.fit.error_percent),
+            "nrmse": _finite(res.fit.nrmse), "status": res.return_status,
+            "success": bool(res.success), "iterations": res.iterations,
+            "cost": _finite(res.cost), "cost_initial": _finite(res.cost_initial),
+            "wall_time_s": res.wall_time, "nf": real.order,
+            "hankel_singular_values": _finite(real.hankel_singular_values[:3 * real.order]),
+        }
+        if selection is not None:
+            out["search"] = [{"orders": list(c.orders.as_tuple()), "n_params": c.n_params,
+                              "held_out_error_percent": _finite(c.score),
+                              "time_s": c.wall_time, "status": c.status,
+                              "chosen": c is selection.best} for c in selection.candidates]
+        print(json.dumps(out, indent=2, allow_nan=False))
     else:
         print(res.summary())
         print(f"linear part realised by ERA + Tustin: nf = {real.order} "
               f"(exact-order bound {real.exact_order_bound})")
         if args.out:
             print(f"model written to {args.out}")
+    if res.return_status in ("Maximum_WallTime_Exceeded",):
+        print(f"casflutter: identification stopped at --max-time ({res.return_status}); the "
+              "best iterate is reported", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -71,7 +161,17 @@ def register(subparsers) -> None:
     p.add_argument("data", help="records: .npz (arrays y,u,v,dt), .csv or .mat")
     p.add_argument("--orders", default="3,1,1,1,2,2", help="mu,na,nb,r,p,q (default: paper)")
     p.add_argument("--criterion", default="prediction", choices=["prediction", "simulation"])
-    p.add_argument("--regularization", type=float, default=0.0)
+    p.add_argument("--regularization", default="0", help="finite number >= 0 (default 0)")
+    p.add_argument("--offset", action="store_true",
+                   help="fit a constant term (identify on centred data, exact back-transform)")
+    p.add_argument("--max-time", type=float, default=None,
+                   help="wall-time budget of stage 2 [s]: the best iterate is returned")
+    p.add_argument("--search", nargs="?", const="default", default=None, metavar="GRID",
+                   help="choose the orders by held-out free-run error over GRID, e.g. "
+                        "'na=1:4 p=1,2 q=1:3' (default grid: na=1:4 p=1:3 q=1:3 around "
+                        "--orders)")
+    p.add_argument("--validation", type=float, default=0.3,
+                   help="held-out fraction of each record for --search (default 0.3)")
     p.add_argument("--y", help="output columns/variable"), p.add_argument("--u"), p.add_argument("--v")
     p.add_argument("--time", default="t", help="CSV time column")
     p.add_argument("--dt", type=float, help="sampling time [s]")
