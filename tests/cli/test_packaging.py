@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import importlib.metadata
 import re
+import shutil
 import subprocess
 import sys
 import tomllib
@@ -65,8 +66,12 @@ def test_docs_dependencies_are_lower_bounded():
 
 @pytest.mark.slow
 def test_the_wheel_holds_license_py_typed_and_the_problems(tmp_path):
+    # build from a copy: an in-tree build would leave build/ and *.egg-info in the checkout
+    src = tmp_path / "src"
+    shutil.copytree(ROOT, src, symlinks=True, ignore=shutil.ignore_patterns(
+        ".venv", ".git", "build", "dist", "docs", "tests", "*.egg-info", "__pycache__"))
     proc = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w",
-                           str(tmp_path), str(ROOT)], capture_output=True, text=True,
+                           str(tmp_path), str(src)], capture_output=True, text=True,
                           timeout=600)
     if proc.returncode != 0 and "Could not find a version" in proc.stderr:
         pytest.skip("no build backend reachable (offline)")
