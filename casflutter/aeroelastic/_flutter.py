@@ -198,8 +198,8 @@ def find_flutter(system, V_range=None, *, V_grid=None, n_grid: int = 101, mode_s
     Parameters
     ----------
     system : callable or object with ``state_matrix(V)``
-        ``V -> A(V)``; an :class:`AeroelasticSystem` also supplies ``mode_states`` and the
-        structural ``omega`` for the origin-mode attribution.
+        ``V -> A(V)``; an :class:`AeroelasticSystem` or a truth simulator also supplies
+        ``mode_states`` and the structural ``omega`` for the origin-mode attribution.
     V_range : (float, float), optional
         Lowest and highest speed index; a uniform grid of ``n_grid`` points is used.
     V_grid : array_like, optional
@@ -208,7 +208,8 @@ def find_flutter(system, V_range=None, *, V_grid=None, n_grid: int = 101, mode_s
         Points of the uniform grid.
     mode_states, omega :
         Origin-mode information, see :func:`origin_modes` (taken from ``system`` if it has
-        ``mode_states`` / ``structure.omega`` and these are not given).
+        ``mode_states`` / ``structure.omega`` / ``modal_structure().omega`` and these are
+        not given).
     xtol_rel : float
         Relative tolerance of the Brent refinement on V (default 1e-10, i.e. well inside
         the 1e-8 target).
@@ -237,6 +238,8 @@ def find_flutter(system, V_range=None, *, V_grid=None, n_grid: int = 101, mode_s
         mode_states = getattr(system, "mode_states", None)
     if omega is None and hasattr(system, "structure"):
         omega = system.structure.omega
+    elif omega is None and hasattr(system, "modal_structure"):  # a truth simulator
+        omega = system.modal_structure().omega
     tr = track_eigenvalues(fn, V_grid, min_score=min_score, max_refine=max_refine)
     origin = origin_modes(tr, mode_states=mode_states, omega=omega)
     lam = tr.eigenvalues

@@ -55,7 +55,7 @@ class AeroelasticLFT:
     ncon : int
         1 (the flap v).
     sensor : str
-        Sensor kind of Σs (see :mod:`._structure`).
+        Sensor kind of Σs (see :mod:`casflutter.structure`).
     """
 
     Vf: float
@@ -153,7 +153,7 @@ def build_lft(system: AeroelasticSystem, Vf: float) -> AeroelasticLFT:
     C1 = Nx
     D11 = np.hstack([np.zeros((N, N)), Nw])
     D12 = Nv
-    Hx, Hf = s.sensor_rows()
+    Hx, Hf = s.sensor_matrices()
     C2 = np.hstack([Hx, np.zeros((s.n_sensors, nf))]) + Vf2 * Hf @ Nx
     D21 = np.hstack([-Hf, Hf])
     D22 = Vf2 * Hf @ Nv

@@ -13,7 +13,7 @@ given as a continuous ``control.StateSpace`` with N outputs ``y`` and inputs
 
 where for state sensors ``C2 = [Hs 0]`` and ``D21 = D22 = 0`` exactly as in the paper;
 for accelerometers the zm rows carry the aerodynamic and disturbance feed-through
-(see :mod:`._structure`).
+(see :mod:`casflutter.structure`).
 """
 
 from __future__ import annotations
@@ -24,10 +24,12 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
+from .._linalg import spectral_abscissa
 from ..errors import DimensionError
-from ._structure import ModalStructure
+from ..structure import ModalStructure
 
-__all__ = ["AeroelasticSystem", "AeroelasticLoop", "aeroelastic_loop", "split_sigma_f"]
+__all__ = ["AeroelasticSystem", "AeroelasticLoop", "ParametricSystem", "aeroelastic_loop",
+           "split_sigma_f"]
 
 
 def split_sigma_f(sigma_f, n_modes: int | None = None):
@@ -102,8 +104,17 @@ class AeroelasticLoop:
     n_f: int
 
     def statespace(self, include_modal: bool = False) -> control.StateSpace:
-        """ΣAE as ``control.StateSpace`` with inputs ``[w_1..w_N, v]`` and outputs ``zm``
-        (followed by the modal displacements ``u`` when ``include_modal``)."""
+        """ΣAE as ``control.StateSpace`` with inputs ``[w_1..w_N, v]`` and outputs ``zm``.
+
+        Parameters
+        ----------
+        include_modal : bool
+            Also the modal displacements ``u`` as outputs (after ``zm``).
+
+        Returns
+        -------
+        control.StateSpace
+        """
         C, D = self.C2, np.hstack([self.D21, self.D22[:, None]])
         outs = [f"zm[{j}]" for j in range(C.shape[0])]
         if include_modal:
@@ -115,7 +126,12 @@ class AeroelasticLoop:
                           outputs=outs, name="Sigma_AE")
 
     def poles(self) -> np.ndarray:
-        """Eigenvalues of Â(V)."""
+        """Eigenvalues of Â(V).
+
+        Returns
+        -------
+        ndarray, complex
+        """
         return np.linalg.eigvals(self.A)
 
 
@@ -147,16 +163,33 @@ class AeroelasticSystem:
                    ) -> "AeroelasticSystem":
         """Build from Σf (continuous ``control.StateSpace``) and Σs.
 
+        Parameters
+        ----------
+        sigma_f : control.StateSpace
+            Continuous Σf with N outputs and inputs ``[u_1..u_N(, v)]``.
+        structure : ModalStructure
+            Σs (a truth's :meth:`modal_structure` goes in as it is).
+        warn_unstable : bool
+            Warn when Σf is unstable on its own.
+
+        Returns
+        -------
+        AeroelasticSystem
+
         Raises
         ------
         DimensionError
-            When Σf's outputs do not match Σs's modes (both named) or Σf is discrete.
+            When Σf's outputs do not match Σs's modes (both named), Σf is discrete, or
+            ``structure`` is not a :class:`ModalStructure`.
 
         Warns
         -----
         RuntimeWarning
             When Σf (the ROM) is unstable on its own, i.e. ΣAE is unstable at V = 0.
         """
+        if not isinstance(structure, ModalStructure):
+            raise DimensionError(f"structure must be a casflutter.structure.ModalStructure "
+                                 f"(Σs), got {type(structure).__name__}")
         parts = split_sigma_f(sigma_f, structure.n_modes)
         sys = cls(structure, *parts)
         if warn_unstable and not sys.rom_stable:
@@ -184,7 +217,7 @@ class AeroelasticSystem:
     @property
     def rom_spectral_abscissa(self) -> float:
         """max Re λ(Af) (−inf for a static Σf)."""
-        return float(np.max(np.linalg.eigvals(self.Af).real)) if self.n_f else -np.inf
+        return spectral_abscissa(self.Af)
 
     @property
     def rom_stable(self) -> bool:
@@ -193,11 +226,22 @@ class AeroelasticSystem:
 
     @property
     def mode_states(self) -> list[np.ndarray]:
-        """State indices ``[u_i, u̇_i]`` of each structural mode (for eigenvector participation)."""
-        return [np.array([2 * i, 2 * i + 1]) for i in range(self.n_modes)]
+        """State indices ``[u_i, u̇_i]`` of each structural mode in ΣAE's state ``(x_s, x_f)``
+        (for eigenvector participation)."""
+        return self.structure.mode_states
 
     def state_matrix(self, V: float) -> np.ndarray:
-        """Â(V) of eq. 8a."""
+        """Â(V) of eq. 8a.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        ndarray, shape (2N + nf, 2N + nf)
+        """
         s = self.structure
         V2 = float(V) ** 2
         As, Bs, Cs = s.As, s.Bs, s.Cs
@@ -208,9 +252,20 @@ class AeroelasticSystem:
     def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
         """State matrix of ΣAE(V) closed with ``v = K zm`` (positive feedback, paper Fig. 3).
 
-        ``controller`` is a continuous ``control.StateSpace`` K with ``n_sensors`` inputs and
-        one output; the closed-loop state is ``(x, x_K)``.  An algebraic loop through
-        ``D22 Dk`` (accelerometers with a direct flap feed-through) is solved exactly.
+        An algebraic loop through ``D22 Dk`` (accelerometers with a direct flap feed-through)
+        is solved exactly.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+        controller : control.StateSpace
+            Continuous K with ``n_sensors`` inputs and one output.
+
+        Returns
+        -------
+        ndarray
+            The state matrix of ``(x, x_K)``.
         """
         lp = self.loop(V)
         Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in
@@ -233,7 +288,17 @@ class AeroelasticSystem:
         return np.block([[lp.A + B2 @ vx, B2 @ vk], [Bk @ zx, Ak + Bk @ zk]])
 
     def loop(self, V: float) -> AeroelasticLoop:
-        """ΣAE at speed index V (eq. 8-9), with flap input v and disturbance w."""
+        """ΣAE at speed index V (eq. 8-9), with flap input v and disturbance w.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        AeroelasticLoop
+        """
         s = self.structure
         V2 = float(V) ** 2
         nf = self.n_f
@@ -241,7 +306,7 @@ class AeroelasticSystem:
         A = self.state_matrix(V)
         B1 = np.vstack([Bs, np.zeros((nf, s.n_modes))])
         B2 = np.concatenate([V2 * Bs @ self.df, self.bf])
-        Hx, Hf = s.sensor_rows()
+        Hx, Hf = s.sensor_matrices()
         C2 = np.hstack([Hx + V2 * Hf @ self.Df @ Cs, V2 * Hf @ self.Cf])
         D21 = Hf.copy()
         D22 = V2 * Hf @ self.df
@@ -250,5 +315,80 @@ class AeroelasticSystem:
 
 
 def aeroelastic_loop(sigma_f, structure: ModalStructure, V: float) -> AeroelasticLoop:
-    """ΣAE(V) (eq. 8-9) from Σf and Σs; see :class:`AeroelasticSystem`."""
+    """ΣAE(V) (eq. 8-9) from Σf and Σs; see :class:`AeroelasticSystem`.
+
+    Parameters
+    ----------
+    sigma_f : control.StateSpace
+        Continuous Σf.
+    structure : ModalStructure
+        Σs.
+    V : float
+        Speed index.
+
+    Returns
+    -------
+    AeroelasticLoop
+    """
     return AeroelasticSystem.from_parts(sigma_f, structure).loop(V)
+
+
+@dataclass(frozen=True)
+class ParametricSystem:
+    """ΣAE(V) of a parametric ROM: Σf interpolated at the same V as the loop is closed.
+
+    Attributes
+    ----------
+    rom : casflutter.realize.ParametricROM
+        ROMs identified at several speeds, interpolated in V.
+    structure : ModalStructure
+        Σs.
+
+    Raises
+    ------
+    DimensionError
+        The ROMs' outputs do not match Σs's modes (both named).
+    """
+
+    rom: object
+    structure: ModalStructure
+
+    def __post_init__(self):
+        N = self.rom.n_modes
+        if N != self.structure.n_modes:
+            raise DimensionError(f"the ROMs have {N} outputs but Σs has "
+                                 f"{self.structure.n_modes} modes; they must be equal")
+
+    def system_at(self, V: float) -> AeroelasticSystem:
+        """ΣAE with Σf of the interpolated ROM at V (control.StateSpace route).
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        AeroelasticSystem
+        """
+        return AeroelasticSystem.from_parts(self.rom.sigma_f(V), self.structure,
+                                            warn_unstable=False)
+
+    def state_matrix(self, V: float) -> np.ndarray:
+        """Â(V) of eq. 8a with Σf interpolated at the same V.
+
+        The origin mode of a branch is judged by the nearest natural frequency
+        (``structure.omega``; the class has no ``mode_states``): the canonical realisation's
+        states are not balanced, so eigenvector energy fractions would be dominated by the
+        aerodynamic states.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        ndarray
+        """
+        return AeroelasticSystem(self.structure, *self.rom.sigma_f_matrices(V)).state_matrix(V)

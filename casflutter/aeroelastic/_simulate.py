@@ -19,16 +19,8 @@ The controller ``K`` (continuous ``control.StateSpace``, inputs zm, output v) is
 discretised with ZOH at the same ``dt``, consistent with the held flap command; its
 state evolves whatever the gain ``g(t)`` (paper Fig. 11 ramps g from 0 to 1).
 
-Classification
---------------
-From the envelope (half swings maximum → minimum, see :func:`envelope_growth_rate`) of
-the last ``window`` fraction of the record:
-the growth rate σ is the slope of log-envelope against time; with ``r = σ T_window``,
-``r < −tol`` is a decay, ``r > tol`` a divergence, otherwise a limit-cycle oscillation
-(LCO).  A non-finite or blown-up record is a divergence; a record that has fallen
-below ``floor`` is a decay.  LCO amplitudes are half the peak-to-peak value over the
-window, per mode and per sensor; the fundamental frequency is the FFT peak (Hann
-window) refined by parabolic interpolation of the log magnitude (paper Fig. 9).
+The records are classified (decay, LCO, divergence) and the LCO measured by
+:func:`casflutter.data.analyze_response`.
 """
 
 from __future__ import annotations
@@ -39,49 +31,12 @@ from typing import Callable
 import control
 import numpy as np
 from scipy.linalg import expm
-from scipy.signal import find_peaks
 
+from ..data import ResponseAnalysis, analyze_response
 from ..errors import ConfigError, DimensionError
-from ._structure import ModalStructure
+from ..structure import ModalStructure
 
-__all__ = ["ResponseAnalysis", "LoopSimulation", "simulate_loop", "analyze_response",
-           "envelope_growth_rate", "dominant_frequency"]
-
-
-@dataclass(frozen=True)
-class ResponseAnalysis:
-    """Decay / LCO / divergence classification of a record (see module docstring).
-
-    Attributes
-    ----------
-    kind : str
-        ``"decay"``, ``"lco"`` or ``"divergence"``.
-    growth_rate : float
-        Envelope growth rate σ [1/s] of the dominant channel over the window.
-    amplitude : ndarray
-        Half peak-to-peak amplitude per channel over the window.
-    frequency_hz : float
-        Fundamental frequency [Hz] of the dominant channel (FFT peak, parabolic
-        interpolation); ``nan`` when the window holds too few samples.
-    omega : float
-        ``2π frequency_hz`` [rad/s].
-    dominant : int
-        Channel with the largest window amplitude.
-    spectrum_freq_hz, spectrum : ndarray
-        One-sided amplitude spectrum of the dominant channel over the window.
-    window : tuple of float
-        Start and end time of the analysed window.
-    """
-
-    kind: str
-    growth_rate: float
-    amplitude: np.ndarray
-    frequency_hz: float
-    omega: float
-    dominant: int
-    spectrum_freq_hz: np.ndarray
-    spectrum: np.ndarray
-    window: tuple
+__all__ = ["LoopSimulation", "simulate_loop"]
 
 
 @dataclass(frozen=True)
@@ -147,102 +102,6 @@ def _signal(sig, n: int, dt: float, width: int | None, name: str) -> np.ndarray:
     return out
 
 
-def envelope_growth_rate(timepts, x) -> float:
-    """Growth rate σ [1/s] of the envelope of a scalar record.
-
-    The envelope is half the swing from each local maximum to the next local minimum
-    (insensitive to a static offset), placed at the mid time; σ is the slope of its
-    logarithm.  Falls back on a fit of log|x| when fewer than three swings exist
-    (non-oscillatory records).
-    """
-    t, x = np.asarray(timepts, dtype=float), np.asarray(x, dtype=float)
-    mx, _ = find_peaks(x)
-    mn, _ = find_peaks(-x)
-    if mx.size >= 3 and mn.size >= 3:
-        j = np.searchsorted(mn, mx)
-        ok = j < mn.size
-        i_max, i_min = mx[ok], mn[j[ok]]
-        half = 0.5 * (x[i_max] - x[i_min])
-        keep = half > 0
-        if keep.sum() >= 3:
-            tt = 0.5 * (t[i_max] + t[i_min])[keep]
-            return float(np.polyfit(tt, np.log(half[keep]), 1)[0])
-    a = np.abs(x)
-    keep = a > 0
-    if keep.sum() < 2:
-        return -np.inf
-    return float(np.polyfit(t[keep], np.log(a[keep]), 1)[0])
-
-
-def dominant_frequency(timepts, x) -> tuple[float, np.ndarray, np.ndarray]:
-    """Fundamental frequency [Hz] of a uniformly sampled record by FFT peak.
-
-    The record is de-meaned and Hann-windowed; the peak bin is refined by parabolic
-    interpolation of the log magnitude.  Returns ``(f_hz, freq_hz, amplitude_spectrum)``.
-    """
-    t, x = np.asarray(timepts, dtype=float), np.asarray(x, dtype=float)
-    n = x.size
-    if n < 8:
-        return float("nan"), np.zeros(0), np.zeros(0)
-    dt = (t[-1] - t[0]) / (n - 1)
-    win = np.hanning(n)
-    X = np.abs(np.fft.rfft((x - x.mean()) * win)) * 2.0 / win.sum()
-    f = np.fft.rfftfreq(n, dt)
-    k = int(np.argmax(X[1:]) + 1)
-    if 1 <= k < X.size - 1 and np.all(X[k - 1:k + 2] > 0):
-        a, b, c = np.log(X[k - 1:k + 2])
-        den = a - 2 * b + c
-        p = 0.5 * (a - c) / den if den != 0 else 0.0
-    else:
-        p = 0.0
-    return float((k + p) * f[1]), f, X
-
-
-def analyze_response(timepts, X, *, window: float = 0.3, tol: float = 0.05,
-                     floor: float = 1e-12, blowup: float = np.inf) -> ResponseAnalysis:
-    """Classify a record as decay / LCO / divergence and measure its LCO (module docstring).
-
-    Parameters
-    ----------
-    timepts : array_like (n,)
-    X : array_like (n,) or (n, channels)
-    window : float
-        Fraction (0, 1] of the record, at its end, that is analysed.
-    tol : float
-        Allowed relative envelope change ``|σ T_window|`` of an LCO.
-    floor : float
-        A window amplitude below this is a decay.
-    blowup : float
-        An amplitude above this (or non-finite) is a divergence.
-    """
-    t = np.asarray(timepts, dtype=float)
-    X = np.asarray(X, dtype=float)
-    X = X[:, None] if X.ndim == 1 else X
-    if not 0 < window <= 1:
-        raise ConfigError(f"window must be a fraction in (0, 1], got {window}")
-    finite = np.all(np.isfinite(X), axis=1)
-    n_ok = int(np.argmin(finite)) if not finite.all() else t.size
-    t, X = t[:n_ok], X[:n_ok]
-    i0 = int(np.floor((1 - window) * t.size))
-    tw, Xw = t[i0:], X[i0:]
-    amp = 0.5 * (Xw.max(axis=0) - Xw.min(axis=0)) if tw.size else np.full(X.shape[1], np.nan)
-    dom = int(np.argmax(amp)) if tw.size else 0
-    blown = n_ok < finite.size or (tw.size and np.max(np.abs(Xw)) > blowup)
-    sigma = envelope_growth_rate(tw, Xw[:, dom]) if tw.size >= 2 else np.nan
-    fhz, ff, XX = dominant_frequency(tw, Xw[:, dom]) if tw.size else (np.nan, np.zeros(0), np.zeros(0))
-    T = tw[-1] - tw[0] if tw.size >= 2 else 0.0
-    if blown:
-        kind = "divergence"
-    elif not np.isfinite(sigma) or np.max(amp) < floor or sigma * T < -tol:
-        kind = "decay"
-    elif sigma * T > tol:
-        kind = "divergence"
-    else:
-        kind = "lco"
-    return ResponseAnalysis(kind, float(sigma), amp, fhz, 2 * np.pi * fhz, dom, ff, XX,
-                            (float(tw[0]) if tw.size else np.nan, float(tw[-1]) if tw.size else np.nan))
-
-
 def _check_rom(rom, n_modes: int) -> None:
     for attr in ("step", "n_modes", "max_lag", "dt"):
         if not hasattr(rom, attr):
@@ -303,7 +162,7 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
     nx = s.n_states
     E = expm(np.block([[s.As, s.Bs], [np.zeros((N, nx + N))]]) * dt)
     Ad, Bd = E[:nx, :nx], E[:nx, nx:]
-    Hx, Hf = s.sensor_rows()
+    Hx, Hf = s.sensor_matrices()
     Cs = s.Cs
     W = _signal(w, n_steps, dt, N, "w")
     Vext = _signal(v, n_steps, dt, None, "v")

@@ -1,4 +1,10 @@
-"""Input--output records, their loaders (CSV, NPZ, MATLAB) and excitation signals."""
+"""Input--output records, their loaders (CSV, NPZ, MATLAB), excitation signals and the
+analysis of response records (decay, LCO, divergence)."""
 
-from ._records import IOData, Record  # noqa: F401
-from ._signals import chirp_excitation  # noqa: F401
+from ._records import IOData, Record
+from ._response import ResponseAnalysis, analyze_response, dominant_frequency, envelope_growth_rate
+from ._signals import backward_derivatives, check_band, chirp_excitation, chirp_motion
+
+__all__ = ["IOData", "Record", "chirp_excitation", "chirp_motion", "backward_derivatives",
+           "check_band", "ResponseAnalysis", "analyze_response", "envelope_growth_rate",
+           "dominant_frequency"]

@@ -1,12 +1,56 @@
-"""Excitation signals: band-limited chirps as used for the CFD runs of paper §IV.A."""
+"""Excitation signals (band-limited chirps, paper §IV.A) and backward-difference derivatives.
+
+Two chirp shapes serve two kinds of experiment, with one check of their band:
+
+- :func:`chirp_excitation` — several mutually decorrelated channels at once (triangle sweeps at
+  seeded rates and phases), for records in which every input moves together;
+- :func:`chirp_motion` — one tapered linear sweep with its exact first and second
+  derivatives, for a prescribed motion that starts and ends at rest (one channel per record).
+
+:func:`backward_derivatives` gives the grid velocity and acceleration a second-order implicit
+CFD time step computes from the displacement samples (BDF2): a causal function of the samples.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..errors import DataError
+from ..errors import ConfigError, DataError
 
-__all__ = ["chirp_excitation"]
+__all__ = ["chirp_excitation", "chirp_motion", "backward_derivatives", "check_band"]
+
+
+def check_band(band, dt: float | None = None) -> tuple[float, float]:
+    """The chirp band ``(f_low, f_high)`` [Hz] checked against ``0 <= f_low < f_high`` and,
+    with a sampling time, against the Nyquist frequency ``1 / (2 dt)``.
+
+    Parameters
+    ----------
+    band : (float, float)
+        Lowest and highest frequency [cycles per time unit of the problem].
+    dt : float, optional
+        Sampling time.
+
+    Returns
+    -------
+    (float, float)
+
+    Raises
+    ------
+    ConfigError
+        A band that is not two increasing non-negative numbers, or whose top is not below the
+        Nyquist frequency of ``dt``.
+    """
+    try:
+        f0, f1 = (float(x) for x in band)
+    except (TypeError, ValueError):
+        raise ConfigError(f"band = {band!r}: give [f_low, f_high] in Hz") from None
+    if not 0.0 <= f0 < f1:
+        raise ConfigError(f"band = {band!r}: must satisfy 0 <= f_low < f_high [Hz]")
+    if dt is not None and f1 >= 0.5 / dt:
+        raise ConfigError(f"band upper edge {f1:g} Hz is above the Nyquist frequency "
+                          f"{0.5 / dt:g} Hz of dt = {dt:g}; lower it or sample faster")
+    return f0, f1
 
 
 def chirp_excitation(n_samples: int, dt: float, n_channels: int = 1, *,
@@ -16,15 +60,17 @@ def chirp_excitation(n_samples: int, dt: float, n_channels: int = 1, *,
 
     Each channel sweeps ``band`` (Hz) up and down with a continuous instantaneous frequency
     (no phase jumps), at a channel-specific, seeded rate and phase, alternately starting at
-    the low and the high edge, so that the channels are not collinear; a cosine taper of relative length ``taper`` at both ends keeps the
-    spectrum inside the band.
+    the low and the high edge, so that the channels are not collinear; a cosine taper of
+    relative length ``taper`` at both ends keeps the spectrum inside the band.
 
     Parameters
     ----------
     n_samples : int
+        Samples per channel (at least 4).
     dt : float
         Sampling time [s]; ``band[1]`` must lie below the Nyquist frequency ``1/(2 dt)``.
     n_channels : int
+        Number of channels.
     band : (float, float)
         Lowest and highest frequency [Hz].
     amplitude : float or array of length n_channels
@@ -37,13 +83,15 @@ def chirp_excitation(n_samples: int, dt: float, n_channels: int = 1, *,
     Returns
     -------
     ndarray, shape (n_samples, n_channels)
+
+    Raises
+    ------
+    ConfigError
+        A band that is not increasing or reaches the Nyquist frequency (:func:`check_band`).
+    DataError
+        Fewer than 4 samples.
     """
-    f0, f1 = map(float, band)
-    if not (0 <= f0 < f1):
-        raise DataError(f"chirp band {band} must satisfy 0 <= f_low < f_high")
-    if f1 >= 0.5 / dt:
-        raise DataError(f"chirp band upper edge {f1} Hz is above the Nyquist frequency "
-                        f"{0.5 / dt:g} Hz for dt={dt}; lower it or sample faster")
+    f0, f1 = check_band(band, dt)
     if n_samples < 4:
         raise DataError("a chirp needs at least 4 samples")
     rng = np.random.default_rng(seed)
@@ -69,3 +117,88 @@ def chirp_excitation(n_samples: int, dt: float, n_channels: int = 1, *,
         out[:n_tap] *= w[:, None]
         out[n_samples - n_tap:] *= w[::-1, None]
     return out
+
+
+def chirp_motion(timepts, band: tuple[float, float], amplitude: float = 1.0,
+                 taper: float = 0.1, phase: float = 0.0
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A tapered linear chirp and its exact first and second derivatives.
+
+    ``s(t) = amplitude w(t) sin(2 pi (f0 t + (f1 - f0) t^2 / (2 T)) + phase)`` with a
+    raised-cosine taper ``w`` over the first and last ``taper`` fraction of the record
+    (so the motion starts and ends at rest, smoothly).
+
+    Parameters
+    ----------
+    timepts : array_like, shape (K,)
+        Increasing, uniformly spaced sample times (the record starts at ``timepts[0]``).
+    band : (float, float)
+        Start and end frequency [Hz, i.e. cycles per time unit of the problem].
+    amplitude : float
+        Peak amplitude.
+    taper : float
+        Fraction of the record tapered at each end, in (0, 0.5].
+    phase : float
+        Phase offset [rad].
+
+    Returns
+    -------
+    s, sdot, sddot : ndarray, shape (K,)
+
+    Raises
+    ------
+    DataError
+        Fewer than 4 samples or times that do not increase.
+    ConfigError
+        A taper outside (0, 0.5] or a band that is not increasing or reaches the Nyquist
+        frequency of the sampling (:func:`check_band`).
+    """
+    t = np.asarray(timepts, dtype=float).ravel()
+    if t.size < 4 or np.any(np.diff(t) <= 0):
+        raise DataError("timepts must hold at least 4 increasing samples")
+    if not 0.0 < taper <= 0.5:
+        raise ConfigError(f"taper = {taper}: must lie in (0, 0.5]")
+    f0, f1 = check_band(band, (t[-1] - t[0]) / (t.size - 1))
+    t = t - t[0]
+    Tr = t[-1]
+    k = (f1 - f0) / Tr
+    ph = 2 * np.pi * (f0 * t + 0.5 * k * t * t) + phase
+    d1 = 2 * np.pi * (f0 + k * t)
+    d2 = 2 * np.pi * k
+    Tt = taper * Tr
+    w, w1, w2 = np.ones_like(t), np.zeros_like(t), np.zeros_like(t)
+    for mask, x, sgn in ((t < Tt, t, 1.0), (t > Tr - Tt, Tr - t, -1.0)):
+        xx = np.pi * x[mask] / Tt
+        w[mask] = 0.5 * (1.0 - np.cos(xx))
+        w1[mask] = sgn * 0.5 * np.pi / Tt * np.sin(xx)
+        w2[mask] = 0.5 * (np.pi / Tt) ** 2 * np.cos(xx)
+    s, c = np.sin(ph), np.cos(ph)
+    u = w * s
+    ud = w1 * s + w * d1 * c
+    udd = w2 * s + 2 * w1 * d1 * c + w * d2 * c - w * d1 * d1 * s
+    return amplitude * u, amplitude * ud, amplitude * udd
+
+
+def backward_derivatives(x, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """Second-order backward differences (BDF2) of samples, at rest before the record.
+
+    ``xdot(k) = (3 x_k - 4 x_{k-1} + x_{k-2}) / (2 dt)``,
+    ``xddot(k) = (2 x_k - 5 x_{k-1} + 4 x_{k-2} - x_{k-3}) / dt^2``, with ``x_{k<0} = 0``:
+    the grid velocity and acceleration of a second-order implicit CFD time step.
+
+    Parameters
+    ----------
+    x : array_like, shape (K, ...)
+        Samples along the first axis.
+    dt : float
+        Sampling time.
+
+    Returns
+    -------
+    xdot, xddot : ndarray, shape of ``x``
+    """
+    x = np.asarray(x, dtype=float)
+    xp = np.concatenate([np.zeros((3,) + x.shape[1:]), x], axis=0)
+    d1 = (3 * xp[3:] - 4 * xp[2:-1] + xp[1:-2]) / (2 * dt)
+    d2 = (2 * xp[3:] - 5 * xp[2:-1] + 4 * xp[1:-2] - xp[:-3]) / dt ** 2
+    return d1, d2

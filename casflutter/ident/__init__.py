@@ -5,8 +5,12 @@ Bai 1998, extended to MIMO) and stage 2: the mu-step prediction error (Ipopt thr
 or the free-run simulation error (Levenberg--Marquardt with exact forward sensitivities
 through the recursion of eq. 3, or Ipopt on a multiple-shooting NLP).
 ``select_orders(data, grid)`` compares candidate orders by free-run error on held-out data.
+``identify_common_denominator(data, na, nb)`` identifies the linear model with one scalar
+denominator by variable projection (for aerodynamics linear in the motion).
 """
 
+from ._common_denominator import (CommonDenominatorResult,  # noqa: F401
+                                  identify_common_denominator)
 from ._identify import (FitReport, IdentificationResult, IdentificationSettings,  # noqa: F401
                         IdentificationWarning, fit_report, identify)
 from ._model import (HWLModel, HWLStructure, UnstableModelWarning,  # noqa: F401

@@ -43,9 +43,9 @@ import scipy.sparse as sp
 from scipy.linalg import expm
 
 from .._nlp import RootResult, solve_newton
-from ..aeroelastic import ModalStructure
 from ..errors import ConfigError, ConvergenceError, DimensionError
 from ..ident import HWLModel, hwl_predict_function
+from ..structure import ModalStructure
 from ._branch import BranchStart, run_from_hopf
 from ._normal_form import MultilinearForms, find_neimark_sacker, lyapunov_map
 from ._results import LCOBranch, LCOPoint, LCOSettings

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from .._resources import problems_dir, read_toml
 from ..errors import ConfigError
 from ..truth import problem_definition
 from ._branch import BranchStart, run_from_hopf
@@ -48,7 +49,7 @@ def truth_outputs(truth, f: ca.Function, sensor_kind: str = "displacement") -> O
     nx = int(f.size1_in(0))
     x = ca.SX.sym("x", nx)
     V = ca.SX.sym("V")
-    H = ca.DM(np.asarray(ms.sensor_rows, float))
+    H = ca.DM(np.asarray(ms.Hs, float))
     names, units, rows = [], [], []
     sunits = truth.sensor_units()
     if getattr(truth, "lco_modal_outputs", True):
@@ -249,7 +250,8 @@ def lco_branch(truth, vrange=None, settings: LCOSettings | None = None,
 
 def default_vrange(truth) -> tuple[float, float]:
     """``[lco] vrange`` of the problem's definition (problem speed unit), else its ``[rom]
-    V_range`` (speed index).
+    V_range`` (speed index, a problem file's ROM route), else ``flutter.V_range`` of the
+    problem's ``flutter.toml`` (the ROM route of a built-in problem).
 
     Raises
     ------
@@ -270,6 +272,10 @@ def default_vrange(truth) -> tuple[float, float]:
     rom = dict(definition.get("rom", {}))
     if "V_range" in rom:
         lo, hi = rom["V_range"]
+        return float(lo), float(hi)
+    route = problems_dir() / str(getattr(truth, "name", "")) / "flutter.toml"
+    if getattr(truth, "name", "") and route.is_file():
+        lo, hi = read_toml(route, "flutter configuration").get("flutter", {})["V_range"]
         return float(lo), float(hi)
     raise ConfigError("no speed range: pass vrange (or --vrange LO HI), or add [lco] vrange to "
                       "the problem definition")

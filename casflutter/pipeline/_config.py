@@ -1,375 +1,483 @@
-"""The TOML configuration of ``casflutter run`` (issue: the paper's wing end to end).
+"""The configuration of a study run: one TOML file, one table per stage.
 
-Every choice of the pipeline lives in one file, validated *before* any work starts: unknown
-keys, wrong types and impossible values fail with a :class:`~casflutter.errors.ConfigError`
-that names the key and what is allowed.
+Each table is the stage's own settings class, so a field a stage adds is a key at once:
+
+============== ==============================================================================
+table          settings
+============== ==============================================================================
+``[problem]``  the truth: a problem name and parameter changes (:func:`casflutter.truth.load_problem`)
+``[data]``     the chirp records (:class:`casflutter.truth.RecordSettings`)
+``[rom]``      the identification (:class:`casflutter.ident.IdentificationSettings`, the HWL
+               orders or the common-denominator orders), the order of Σf and the iteration
+               of the identification speed to the ROM's own flutter speed
+``[flutter]``  the Hopf search (:func:`casflutter.aeroelastic.find_flutter`)
+``[lco]``      the nonlinear ROM and truth simulations above flutter (paper Fig. 9)
+``[controller]`` the synthesis (:class:`casflutter.design.SynthesisOptions`) with the order,
+               the starts and the design speeds
+``[verify]``   targets and sweeps of the verification
+``[closed_loop]`` simulations and a truth sweep of the closed loops above flutter
+``[suppression]`` the gain-ramp run on the truth (:class:`casflutter.truth.SuppressionSettings`)
+``[parametric]`` the parametric ROM (ROMs at several speeds, interpolated in V)
+``[sensors]``  the sensor rows ``Hs`` (eq. 7) and their kind
+``[solver]``   flat Ipopt options for every NLP
+============== ==============================================================================
+
+``stages`` lists the optional stages to run after the flutter search; the records, the ROM,
+Σf, ΣAE and the flutter speeds of the ROM and the truth always run.  Every value is checked
+before any work (:func:`casflutter._settings.build_settings`): unknown keys, wrong types and
+impossible values fail with a :class:`~casflutter.errors.ConfigError` naming the key.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import asdict, dataclass, field, fields, is_dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, get_origin, get_type_hints
 
 from .._resources import problems_dir, read_toml
+from .._settings import build_settings, finite_numbers, set_dotted
+from ..design import SynthesisOptions
 from ..errors import ConfigError
+from ..ident import HWLOrders, IdentificationSettings
+from ..structure import SENSOR_KINDS, check_sensor_rows
+from ..truth import (RecordSettings, SuppressionSettings, file_problem_names, load_problem,
+                     problem_definition, problem_names)
 
-__all__ = ["RunConfig", "load_config", "default_config_path", "check_sensor_rows"]
+__all__ = ["RunConfig", "ProblemSection", "DataSection", "RomSection", "FlutterSection",
+           "LcoSection", "ControllerSettings", "VerifySection", "ClosedLoopSection",
+           "ParametricSection", "SensorsSection", "SolverSection", "STAGES", "load_config",
+           "default_config_path", "config_path", "flutter_config"]
+
+#: Optional stages, in the order they run (``RunConfig.stages``).
+STAGES = ("frozen", "parametric", "lco", "controller", "closed_loop", "suppression")
+
+#: Keys that were renamed: old dotted name -> new one.
+_RENAMED = {"data.band_hz": "data.band", "flutter.vrange": "flutter.V_range",
+            "controller.speed_factors": "controller.speeds"}
+
+
+def _positive(name: str, value) -> None:
+    if not value > 0:
+        raise ConfigError(f"{name} = {value!r}: must be > 0")
+
+
+def _integer(name: str, value, low: int) -> None:
+    if isinstance(value, bool) or not isinstance(value, int) or value < low:
+        raise ConfigError(f"{name} = {value!r}: must be an integer >= {low}")
 
 
 @dataclass(frozen=True)
 class ProblemSection:
-    """``[problem]``: which truth and its parameter overrides."""
+    """``[problem]``: which truth, and its parameter changes."""
 
     name: str = "seed_wing"
-    #: parameter overrides, ``{name = value}`` (validated by the truth's parameter class)
+    """A problem name (``casflutter problems``) or the path of a problem TOML file."""
     set: dict = field(default_factory=dict)
+    """Parameter changes ``{name = value}``, checked by the truth's parameter class."""
+
+    def __post_init__(self):
+        try:
+            load_problem(self.name)
+        except ConfigError as exc:
+            if not str(exc).startswith("unknown problem"):
+                raise ConfigError(f"name = {self.name!r}: {exc}") from None
+            raise ConfigError(f"name = {self.name!r}: allowed "
+                              f"{', '.join(problem_names() + file_problem_names())}, or a "
+                              "problem TOML file") from None
+        try:
+            load_problem(self.name, self.set)
+        except ConfigError as exc:
+            raise ConfigError(f"set: {exc}") from None
+
+    def load(self):
+        """The truth simulator (:func:`casflutter.truth.load_problem`).
+
+        Returns
+        -------
+        AeroelasticTruth
+        """
+        return load_problem(self.name, self.set)
 
 
 @dataclass(frozen=True)
-class DataSection:
-    """``[data]``: chirp records of the truth at the nominal speed (paper §IV.A)."""
+class DataSection(RecordSettings):
+    """``[data]``: the chirp records of the truth (:class:`casflutter.truth.RecordSettings`).
 
-    V0: float = 0.69
-    dt: float = 0.002
-    duration: float = 8.0
-    band_hz: list = field(default_factory=lambda: [0.2, 60.0])
-    #: chirp amplitude of each modal displacement / the flap [rad] (one channel per record)
-    amplitude: float = 0.01
-    #: samples between a motion and the force it produces in the records: 1 models the
-    #: loosely coupled CFD time march (the flow of step k sees the grid of step k-1), the
-    #: reason for the paper's input delay r = 1
+    The run's records model the loosely coupled CFD time march of the paper (the force of
+    step k is computed on the grid of step k-1), hence a default coupling delay of one
+    sample.
+    """
+
     coupling_delay: int = 1
 
 
 @dataclass(frozen=True)
-class RomSection:
-    """``[rom]``: HWL orders (mu, na, nb, r, p, q), stage-2 criterion, order of Σf."""
+class RomSection(IdentificationSettings):
+    """``[rom]``: the identified ROM (:class:`casflutter.ident.IdentificationSettings`), its
+    orders, the order of Σf and the iteration of the identification speed."""
 
     orders: list = field(default_factory=lambda: [3, 1, 1, 1, 2, 2])
-    criterion: str = "prediction"
-    regularization: float = 0.0
-    nf: Any = 15
+    """HWL orders ``[mu, na, nb, r, p, q]`` (``method = "hwl"``; paper Table I)."""
+    nf: int | str = 15
+    """Order of Σf (ERA, eq. 5), or ``"auto"`` for the exact (minimal) order."""
+    method: str = "hwl"
+    """``"hwl"``: :func:`casflutter.ident.identify` (two stages, Ipopt);
+    ``"common_denominator"``: :func:`casflutter.ident.identify_common_denominator` (the linear
+    ROM with one scalar denominator, exact for linear Wagner aerodynamics)."""
+    na: int = 2
+    """Denominator order of the common-denominator ROM (2: Jones' two-lag Wagner function)."""
+    nb: int = 6
+    """Largest input lag of the common-denominator ROM."""
+    v0_iterations: int = 1
+    """Identifications at most: the first at ``data.V0``, each further one at the previous
+    ROM's flutter speed (``V0 <- Vf``), until the two agree to ``v0_rtol``; at the fixed point
+    the ROM equals the truth at its flutter speed."""
+    v0_rtol: float = 2e-3
+    """Stop when ``|Vf - V0| <= v0_rtol Vf``."""
+
+    def __post_init__(self):
+        super().__post_init__()
+        if self.method not in ("hwl", "common_denominator"):
+            raise ConfigError(f"method = {self.method!r}: allowed 'hwl', 'common_denominator'")
+        o = self.orders
+        if len(o) != 6 or not all(isinstance(x, int) and not isinstance(x, bool) for x in o):
+            raise ConfigError(f"orders = {o!r}: give six integers [mu, na, nb, r, p, q]")
+        try:
+            HWLOrders.from_tuple(o)
+        except ValueError as exc:
+            raise ConfigError(f"orders = {o!r}: {exc}") from None
+        nf = self.nf
+        if not (nf == "auto" or (isinstance(nf, int) and not isinstance(nf, bool) and nf >= 1)):
+            raise ConfigError(f"nf = {nf!r}: a positive integer or \"auto\"")
+        _integer("na", self.na, 1)
+        _integer("nb", self.nb, 1)
+        _integer("v0_iterations", self.v0_iterations, 1)
+        _positive("v0_rtol", self.v0_rtol)
 
 
 @dataclass(frozen=True)
 class FlutterSection:
-    """``[flutter]``: speed-index range of the Hopf search."""
+    """``[flutter]``: the Hopf search of :func:`casflutter.aeroelastic.find_flutter` on the
+    ROM and the truth."""
 
-    vrange: list = field(default_factory=lambda: [0.05, 2.5])
+    V_range: tuple = (0.05, 2.5)
+    """Speed-index range ``[low, high]``."""
     n_grid: int = 121
+    """Points of the uniform V grid."""
+    max_refine: int = 3
+    """Largest number of grid refinements of the eigenvalue tracking (identical strips give
+    repeated lag eigenvalues whose eigenvector matching stays ambiguous however fine the
+    grid, without changing any crossing)."""
+
+    def __post_init__(self):
+        vr = finite_numbers("V_range", self.V_range, 2, what="[low, high]")
+        if not 0 <= vr[0] < vr[1]:
+            raise ConfigError(f"V_range = {list(vr)!r}: [low, high] with 0 <= low < high")
+        object.__setattr__(self, "V_range", vr)
+        _integer("n_grid", self.n_grid, 3)
+        _integer("max_refine", self.max_refine, 0)
 
 
 @dataclass(frozen=True)
 class LcoSection:
-    """``[lco]``: nonlinear ROM simulation at Vf (paper Fig. 9)."""
+    """``[lco]``: the nonlinear ROM in the loop and the truth above their flutter speeds
+    (paper Fig. 9), from a deflected flutter mode."""
 
     duration: float = 20.0
+    """Length of the simulations."""
     initial_deflection: float = 0.05
-    #: simulate at ``speed_factor * Vf``: exactly at the Hopf point the linear damping is zero
-    #: and the approach to the LCO is infinitely slow, so a few per cent above is the default
+    """Initial deflection of the flutter mode (also the tap of the suppression run)."""
     speed_factor: float = 1.05
+    """Simulate at ``speed_factor`` times each model's own Hopf speed: exactly at the Hopf
+    point the linear damping is zero and the approach to the LCO is infinitely slow."""
+
+    def __post_init__(self):
+        for name in ("duration", "initial_deflection", "speed_factor"):
+            _positive(name, getattr(self, name))
 
 
 @dataclass(frozen=True)
-class ControllerSection:
-    """``[controller]``: fixed-order robust synthesis on the LFT at Vf (paper §III.C)."""
+class ControllerSettings(SynthesisOptions):
+    """``[controller]``: the fixed-order robust synthesis on the LFT at Vf (paper §III.C):
+    :class:`casflutter.design.SynthesisOptions` with the controller order, the starts and the
+    design speeds."""
 
     order: int = 3
+    """Controller order."""
     starts: int = 4
-    #: nominal speeds of the plant set, as multiples of Vf: the LFT (eq. 14) is built at each
-    #: and the worst-case norm is minimised (the multi-speed design); [1.0] is the paper's
-    speeds: list = field(default_factory=lambda: [1.0])
-    #: minimax solves per start: the deterministic budget of the synthesis
-    max_outer: int = 20
-    #: frequency slots per plant in the minimax NLP
-    nslots: int = 8
-    #: required closed-loop decay after the stabilisation phase, relative to the plant's
-    #: largest eigenvalue modulus (the Tustin realisation has poles near 2/dt: keep it small)
-    stability_margin: float = 1e-4
-    #: short stabilisation solves per start
-    max_stab_rounds: int = 8
-    #: Ipopt iterations per minimax/stabilisation solve (with ``max_outer`` and
-    #: ``max_stab_rounds`` the deterministic budget of the synthesis)
-    max_iter: int = 80
-    #: first start from the zero controller (``false``: every start seeded random)
-    zero_start: bool = True
-    #: wall-clock budget [s] for all starts, 0 for none (a time budget makes the result
-    #: depend on the machine's speed: the same seed then need not give the same controller)
-    time_limit: float = 0.0
+    """Starts of the synthesis (the first is the zero controller unless ``zero_start`` is
+    false, the others seeded random)."""
+    speeds: tuple = (1.0,)
+    """Nominal speeds of the design plants as multiples of Vf (must contain 1.0, the plant
+    the verification checks): the LFT (eq. 14) is built at each and the worst-case norm is
+    minimised; ``[1.0]`` is the paper's design."""
+
+    def __post_init__(self):
+        super().__post_init__()
+        _integer("order", self.order, 0)
+        _integer("starts", self.starts, 1)
+        sp = finite_numbers("speeds", self.speeds, what="a non-empty list of positive "
+                            "multiples of Vf, containing 1.0")
+        if not sp or not all(x > 0 for x in sp) or 1.0 not in sp:
+            raise ConfigError(f"speeds = {list(sp)!r}: a non-empty list of positive multiples "
+                              "of Vf, containing 1.0 (the nominal plant)")
+        object.__setattr__(self, "speeds", sp)
 
 
 @dataclass(frozen=True)
-class SuppressionSection:
-    """``[suppression]``: closed-loop truth simulation with the gain ramped 0 -> 1 and released
-    (paper Fig. 11), at ``speed_factor`` times the truth's own flutter speed (where the wing
-    itself has an LCO)."""
+class VerifySection:
+    """``[verify]``: targets and sweeps of the independent verification (eq. 10-16)."""
 
-    speed_factor: float = 1.05
-    settle: float = 10.0
-    ramp: float = 5.0
-    hold: float = 10.0
-    release: float = 10.0
+    required: tuple = ()
+    """``[lo, hi]``: the verified exact stable interval must contain ``[lo, hi] Vf``
+    (``RunResult.interval_ok``); empty: no target."""
+    sweep: tuple = ()
+    """``[lo, hi]``: also a dense eigenvalue sweep of the ROM loop over ``[lo, hi] Vf``
+    (:func:`casflutter.verify.speed_sweep`); empty: none."""
+    n_sweep: int = 601
+    """Points of that sweep."""
+
+    def __post_init__(self):
+        for name in ("required", "sweep"):
+            v = getattr(self, name)
+            if len(v):
+                v = finite_numbers(name, v, 2, what="[lo, hi] multiples of Vf")
+                if not 0 <= v[0] < v[1]:
+                    raise ConfigError(f"{name} = {list(v)!r}: [lo, hi] with 0 <= lo < hi")
+            object.__setattr__(self, name, tuple(v))
+        if self.required and not self.required[0] < 1 < self.required[1]:
+            raise ConfigError(f"required = {list(self.required)!r}: lo < 1 < hi")
+        _integer("n_sweep", self.n_sweep, 10)
+
+
+@dataclass(frozen=True)
+class ClosedLoopSection:
+    """``[closed_loop]``: the loops above flutter, open and closed with the controller: the
+    discrete ROM in the loop and the sampled-data truth with a flap actuator, simulated at
+    ``speed_factor`` times each model's flutter speed from a deflection of its flutter mode,
+    and the truth's linear closed loop swept over speed."""
+
+    speed_factor: float = 1.1
+    """Simulation speed as a multiple of the flutter speed (above it)."""
+    duration: float = 150.0
+    """Length of each simulation."""
+    dt: float = 0.05
+    """Sample time of the sampled-data truth loop (the ROM runs at its own dt)."""
+    deflection: float = 0.01
+    """Initial deflection of the flutter mode."""
+    actuator_omega: float = 10.0
+    """Natural frequency of the truth's flap actuator [rad per time unit]; the ROM has none."""
+    actuator_zeta: float = 0.7
+    """Damping ratio of the flap actuator."""
+    sweep_range: tuple = (0.02, 1.6)
+    """Range of the truth's closed-loop sweep, as multiples of its flutter speed."""
+    n_sweep: int = 400
+    """Points of that sweep."""
+
+    def __post_init__(self):
+        if not self.speed_factor > 1:
+            raise ConfigError(f"speed_factor = {self.speed_factor!r}: must be > 1 (above "
+                              "flutter)")
+        for name in ("duration", "dt", "actuator_omega"):
+            _positive(name, getattr(self, name))
+        if self.deflection == 0:
+            raise ConfigError("deflection = 0: a loop at rest stays at rest; give a deflection")
+        if self.actuator_zeta < 0:
+            raise ConfigError(f"actuator_zeta = {self.actuator_zeta!r}: must be >= 0")
+        sr = finite_numbers("sweep_range", self.sweep_range, 2, what="[lo, hi] multiples of "
+                            "the flutter speed")
+        if not 0 < sr[0] < 1 < sr[1]:
+            raise ConfigError(f"sweep_range = {list(sr)!r}: [lo, hi] with 0 < lo < 1 < hi")
+        object.__setattr__(self, "sweep_range", sr)
+        _integer("n_sweep", self.n_sweep, 10)
+
+
+@dataclass(frozen=True)
+class ParametricSection:
+    """``[parametric]``: the parametric ROM (:class:`casflutter.realize.ParametricROM`):
+    common-denominator ROMs identified at Chebyshev–Lobatto speeds over ``flutter.V_range``
+    with the records of ``[data]``, interpolated in V."""
+
+    n_speeds: int = 7
+    """Number of identification speeds."""
+    max_refine: int = 2
+    """Grid refinements of its flutter search (the delay states of the canonical form make
+    defective blocks at ``s = -2/dt`` whose eigenvectors cannot be matched)."""
+
+    def __post_init__(self):
+        _integer("n_speeds", self.n_speeds, 2)
+        _integer("max_refine", self.max_refine, 0)
 
 
 @dataclass(frozen=True)
 class SensorsSection:
-    """``[sensors]``: the measured outputs ``zm = Hs u''`` of the accelerometers (eq. 7).
+    """``[sensors]``: the measured outputs ``zm`` (eq. 7), used by every stage: Σs in the ROM
+    loop, the LFT's measured output (eq. 14), the truth's LCO and the closed-loop runs."""
 
-    The rows of ``Hs`` are the sensor locations in modal coordinates (paper §IV: the mode
-    shapes at each accelerometer in its measuring direction, from FEA); the seed wing's two
-    tip-store accelerometers are printed there.  One set of rows is used by every stage:
-    Σs in the ROM loop (eq. 6--9), the LFT's measured output (eq. 14), the truth's LCO and
-    the closed-loop suppression run.
-    """
-
-    #: one row of N numbers (one per mode of the problem) per accelerometer; empty (the
-    #: default): the problem's own rows (``truth.modal_structure().sensor_rows``)
     rows: list = field(default_factory=list)
+    """``Hs``: one row of N numbers (the mode shapes at the sensor, in its measuring
+    direction) per sensor; empty: the problem's own rows."""
+    kind: str = "acceleration"
+    """``"acceleration"`` (``zm = Hs u''``, the paper's accelerometers), ``"velocity"`` or
+    ``"displacement"``."""
+
+    def __post_init__(self):
+        if self.kind not in SENSOR_KINDS[:3]:
+            raise ConfigError(f"kind = {self.kind!r}: allowed "
+                              f"{', '.join(map(repr, SENSOR_KINDS[:3]))}")
 
 
 @dataclass(frozen=True)
 class SolverSection:
-    """``[solver]``: flat Ipopt options for every NLP (``"ipopt.tol" = 1e-8``)."""
+    """``[solver]``: flat Ipopt options for every NLP (``"ipopt.tol" = 1e-8``), under each
+    stage's own (``rom.ipopt_options``, ``controller.ipopt``)."""
 
     ipopt: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
 class RunConfig:
-    """The whole configuration; each field is one TOML table."""
+    """The whole configuration of a run; each field is one TOML table (module docstring)."""
 
     problem: ProblemSection = field(default_factory=ProblemSection)
     data: DataSection = field(default_factory=DataSection)
     rom: RomSection = field(default_factory=RomSection)
     flutter: FlutterSection = field(default_factory=FlutterSection)
     lco: LcoSection = field(default_factory=LcoSection)
-    controller: ControllerSection = field(default_factory=ControllerSection)
-    suppression: SuppressionSection = field(default_factory=SuppressionSection)
+    controller: ControllerSettings = field(default_factory=ControllerSettings)
+    verify: VerifySection = field(default_factory=VerifySection)
+    closed_loop: ClosedLoopSection = field(default_factory=ClosedLoopSection)
+    suppression: SuppressionSettings = field(default_factory=SuppressionSettings)
+    parametric: ParametricSection = field(default_factory=ParametricSection)
     sensors: SensorsSection = field(default_factory=SensorsSection)
     solver: SolverSection = field(default_factory=SolverSection)
     seed: int = 0
+    stages: tuple = ("lco", "controller", "suppression")
+
+    def __post_init__(self):
+        _integer("seed", self.seed, 0)
+        stages = tuple(self.stages)
+        bad = [s for s in stages if s not in STAGES]
+        if bad:
+            raise ConfigError(f"stages: unknown stage {bad[0]!r}; allowed {', '.join(STAGES)}")
+        for later in ("closed_loop", "suppression"):
+            if later in stages and "controller" not in stages:
+                raise ConfigError(f"stages: {later!r} needs the 'controller' stage")
+        if "parametric" in stages and self.rom.method != "common_denominator":
+            raise ConfigError("stages: 'parametric' interpolates common-denominator ROMs; set "
+                              "rom.method = \"common_denominator\"")
+        if "closed_loop" in stages and self.sensors.kind != "displacement":
+            raise ConfigError("stages: 'closed_loop' sweeps the truth's linear loop read by "
+                              "displacement sensors; set sensors.kind = \"displacement\"")
+        if "suppression" in stages and self.sensors.kind == "velocity":
+            raise ConfigError("stages: 'suppression' reads acceleration or displacement "
+                              "sensors; set sensors.kind accordingly")
+        object.__setattr__(self, "stages", tuple(s for s in STAGES if s in stages))
+        if self.sensors.rows:
+            check_sensor_rows(self.sensors.rows, self.problem.load().n_modes,
+                              key="sensors.rows", problem=self.problem.name)
 
     def to_dict(self) -> dict:
+        """The configuration as nested plain values (``config.json``).
+
+        Returns
+        -------
+        dict
+        """
         return asdict(self)
 
 
-_POSITIVE = {"dt", "duration", "settle", "ramp", "hold", "release", "V0",
-             "speed_factor", "amplitude"}
-
-
-def _check_value(path: str, name: str, value, typ):
-    origin = get_origin(typ) or typ
-    if typ is Any:
-        return value
-    if origin is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ConfigError(f"{path}: expected a number, got {type(value).__name__} {value!r}")
-        value = float(value)
-        if name in _POSITIVE and not value > 0:
-            raise ConfigError(f"{path} = {value}: must be > 0")
-        if name == "regularization" and value < 0:
-            raise ConfigError(f"{path} = {value}: must be >= 0")
-        return value
-    if origin is bool:
-        if not isinstance(value, bool):
-            raise ConfigError(f"{path}: expected true or false, got {type(value).__name__} "
-                              f"{value!r}")
-        return value
-    if origin is int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(f"{path}: expected an integer, got {type(value).__name__} {value!r}")
-        return value
-    if origin is str:
-        if not isinstance(value, str):
-            raise ConfigError(f"{path}: expected a string, got {type(value).__name__} {value!r}")
-        return value
-    if origin is list:
-        if not isinstance(value, list):
-            raise ConfigError(f"{path}: expected a list, got {type(value).__name__} {value!r}")
-        return value
-    if origin is dict:
-        if not isinstance(value, dict):
-            raise ConfigError(f"{path}: expected a table, got {type(value).__name__} {value!r}")
-        return value
-    return value
-
-
-def _build(cls, table: dict, prefix: str):
-    hints = get_type_hints(cls)
-    allowed = [f.name for f in fields(cls)]
-    unknown = [k for k in table if k not in allowed]
-    if unknown:
-        where = f"[{prefix}]" if prefix else "top level"
-        raise ConfigError(f"unknown key {unknown[0]!r} in {where}; allowed: {', '.join(allowed)}")
-    kwargs = {}
-    for f in fields(cls):
-        if f.name not in table:
-            continue
-        value = table[f.name]
-        path = f"{prefix}.{f.name}" if prefix else f.name
-        typ = hints[f.name]
-        if is_dataclass(typ):
-            if not isinstance(value, dict):
-                raise ConfigError(f"[{path}] must be a table, got {value!r}")
-            kwargs[f.name] = _build(typ, value, path)
-        else:
-            kwargs[f.name] = _check_value(path, f.name, value, typ)
-    return cls(**kwargs)
-
-
-def _semantic_checks(cfg: RunConfig) -> None:
-    o = cfg.rom.orders
-    if len(o) != 6 or not all(isinstance(x, int) and not isinstance(x, bool) for x in o):
-        raise ConfigError(f"rom.orders = {o!r}: give six integers [mu, na, nb, r, p, q]")
-    from ..ident import HWLOrders
-    try:
-        HWLOrders.from_tuple(o)
-    except ValueError as exc:
-        raise ConfigError(f"rom.orders = {o!r}: {exc}") from None
-    if cfg.rom.criterion not in ("prediction", "simulation"):
-        raise ConfigError(f"rom.criterion = {cfg.rom.criterion!r}: allowed 'prediction', "
-                          "'simulation'")
-    nf = cfg.rom.nf
-    if not (nf == "auto" or (isinstance(nf, int) and not isinstance(nf, bool) and nf >= 1)):
-        raise ConfigError(f"rom.nf = {nf!r}: a positive integer or \"auto\"")
-    band = cfg.data.band_hz
-    if len(band) != 2 or not 0 <= band[0] < band[1]:
-        raise ConfigError(f"data.band_hz = {band!r}: [low, high] with 0 <= low < high")
-    if band[1] >= 0.5 / cfg.data.dt:
-        raise ConfigError(f"data.band_hz upper edge {band[1]} Hz is above the Nyquist frequency "
-                          f"{0.5 / cfg.data.dt:g} Hz of data.dt = {cfg.data.dt}")
-    if cfg.data.duration / cfg.data.dt < 200:
-        raise ConfigError(f"data.duration / data.dt = {cfg.data.duration / cfg.data.dt:.0f} "
-                          "samples: at least 200 are needed")
-    vr = cfg.flutter.vrange
-    if len(vr) != 2 or not 0 <= vr[0] < vr[1]:
-        raise ConfigError(f"flutter.vrange = {vr!r}: [low, high] with 0 <= low < high")
-    if cfg.controller.order < 0:
-        raise ConfigError(f"controller.order = {cfg.controller.order}: must be >= 0")
-    sp = cfg.controller.speeds
-    if not sp or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and x > 0
-                         for x in sp):
-        raise ConfigError(f"controller.speeds = {sp!r}: a non-empty list of positive multiples "
-                          "of Vf")
-    if cfg.controller.time_limit < 0:
-        raise ConfigError(f"controller.time_limit = {cfg.controller.time_limit}: >= 0 (0: none)")
-    if cfg.controller.nslots < 2 or cfg.controller.max_stab_rounds < 1:
-        raise ConfigError("controller.nslots must be >= 2 and controller.max_stab_rounds >= 1")
-    if not cfg.controller.stability_margin > 0:
-        raise ConfigError(f"controller.stability_margin = {cfg.controller.stability_margin}: "
-                          "must be > 0")
-    if cfg.controller.max_iter < 1:
-        raise ConfigError(f"controller.max_iter = {cfg.controller.max_iter}: must be >= 1")
-    if cfg.controller.max_outer < 1:
-        raise ConfigError(f"controller.max_outer = {cfg.controller.max_outer}: must be >= 1")
-    if cfg.controller.starts < 1:
-        raise ConfigError(f"controller.starts = {cfg.controller.starts}: must be >= 1")
-    if cfg.data.coupling_delay < 0:
-        raise ConfigError(f"data.coupling_delay = {cfg.data.coupling_delay}: must be >= 0")
-    from ..truth import PROBLEMS, problem_names
-    if cfg.problem.name not in problem_names():
-        raise ConfigError(f"problem.name = {cfg.problem.name!r}: allowed "
-                          f"{', '.join(problem_names())}")
-    # the truth's own check of problem.set (names and physical values), as run_pipeline uses it
-    try:
-        PROBLEMS[cfg.problem.name].Params.from_sets(f"{k}={v}" for k, v in cfg.problem.set.items())
-    except ConfigError as exc:
-        raise ConfigError(f"problem.set: {exc}") from None
-    if cfg.sensors.rows:
-        from ..truth import load_problem
-        n_modes = load_problem(cfg.problem.name,
-                               [f"{k}={v}" for k, v in cfg.problem.set.items()]).n_modes
-        check_sensor_rows(cfg.sensors.rows, n_modes, key="sensors.rows",
-                          problem=cfg.problem.name)
-
-
-def check_sensor_rows(rows, n_modes: int, *, key: str = "sensors.rows",
-                      problem: str = "the problem") -> list[list[float]]:
-    """Check sensor rows ``Hs`` (eq. 7) given as nested lists: ``(n_sensors, n_modes)``.
+def config_path(problem: str, name: str = "run") -> Path:
+    """The configuration ``problems/PROBLEM/NAME.toml`` shipped with the package.
 
     Parameters
     ----------
-    rows : sequence of sequences of float
-        One row per sensor, one number per mode.
-    n_modes : int
-        Number of modes ``N`` of the problem.
-    key : str
-        Name of the setting, for the error message.
     problem : str
-        Name of the problem, for the error message.
+        Problem name.
+    name : str
+        ``"run"`` (the study), ``"flutter"`` (the ROM route of ``casflutter flutter``),
+        ``"flutter_check"`` ...
 
     Returns
     -------
-    list of list of float
-        The rows as floats.
+    Path
 
     Raises
     ------
     ConfigError
-        Not a non-empty list of lists, a row whose length is not ``n_modes``, an entry that
-        is not a finite number, or a row of zeros (a sensor that sees no mode).
+        No such file.
     """
-    want = (f"give a list of rows, one per sensor, each a list of {n_modes} numbers (one per "
-            f"mode of {problem}), e.g. {key} = [[{', '.join(['0.1'] * n_modes)}]]")
-    if isinstance(rows, (str, bytes)) or not hasattr(rows, "__len__") or len(rows) == 0:
-        raise ConfigError(f"{key} = {rows!r}: {want}")
-    out = []
-    for i, row in enumerate(rows):
-        if isinstance(row, (str, bytes)) or not hasattr(row, "__len__"):
-            raise ConfigError(f"{key}[{i}] = {row!r} is not a list: {want}")
-        if len(row) != n_modes:
-            raise ConfigError(f"{key}[{i}] has {len(row)} entries, {problem} has {n_modes} "
-                              f"modes: {want}")
-        vals = []
-        for j, x in enumerate(row):
-            if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
-                raise ConfigError(f"{key}[{i}][{j}] = {x!r}: must be a finite number")
-            vals.append(float(x))
-        if not any(vals):
-            raise ConfigError(f"{key}[{i}] is all zeros: a sensor that sees no mode; drop the "
-                              "row")
-        out.append(vals)
-    return out
+    path = problems_dir() / problem / f"{name}.toml"
+    if not path.is_file():
+        raise ConfigError(f"problem {problem!r} has no {name} configuration: {path} not found; "
+                          "write one (the tables of casflutter.pipeline.RunConfig) or pass a "
+                          "configuration file")
+    return path
+
+
+#: The ROM route of ``casflutter flutter`` on a problem without a ``flutter.toml``: the
+#: settings every ROM route shares (a problem file's ``[rom]`` table adds its own).
+_ROUTE = {"stages": ["frozen", "parametric"], "rom.method": "common_denominator",
+          "rom.nf": "auto", "data.coupling_delay": 0, "flutter.max_refine": 8,
+          "flutter.n_grid": 201, "sensors.kind": "displacement"}
+#: the keys of a problem file's ``[rom]`` table and the configuration keys they set
+_ROUTE_KEYS = {"V0": "data.V0", "dt": "data.dt", "duration": "data.duration",
+               "band": "data.band", "amplitude": "data.amplitude", "taper": "data.taper",
+               "flap": "data.flap", "na": "rom.na", "nb": "rom.nb",
+               "V_range": "flutter.V_range", "n_grid": "flutter.n_grid",
+               "n_speeds": "parametric.n_speeds"}
+
+
+def flutter_config(problem: str, *, updates=None) -> RunConfig:
+    """The ROM-route configuration of ``casflutter flutter PROBLEM``.
+
+    ``problems/PROBLEM/flutter.toml`` when the problem has one; otherwise (a problem file,
+    e.g. a rig section) the shared route settings with the ``[rom]`` table of the problem's
+    definition (``V0``, ``V_range``, ``dt``, ``duration``, ``band`` and optionally
+    ``amplitude``, ``taper``, ``flap``, ``na``, ``nb``, ``n_grid``, ``n_speeds``).
+
+    Parameters
+    ----------
+    problem : str
+        Problem name or problem file.
+    updates : mapping, optional
+        Changes by dotted path (as :func:`load_config`).
+
+    Returns
+    -------
+    RunConfig
+
+    Raises
+    ------
+    ConfigError
+        No route settings for the problem, or an invalid key or value (named).
+    """
+    if problem in problem_names():
+        return load_config(config_path(problem, "flutter"), updates=updates)
+    table = dict(problem_definition(problem).get("rom", {}))
+    unknown = [k for k in table if k not in _ROUTE_KEYS]
+    if unknown:
+        raise ConfigError(f"unknown key {unknown[0]!r} in the [rom] table of {problem}; "
+                          f"allowed: {', '.join(_ROUTE_KEYS)}")
+    missing = [k for k in ("V0", "V_range", "dt", "duration", "band") if k not in table]
+    if missing:
+        raise ConfigError(f"problem {problem} has no ROM-route settings for "
+                          f"{', '.join(missing)}: add them to its [rom] table")
+    route = {**_ROUTE, **{_ROUTE_KEYS[k]: v for k, v in table.items()},
+             "problem.name": str(problem), **(updates or {})}
+    table = {}
+    for key, value in route.items():
+        set_dotted(table, RunConfig, key, value)
+    return build_settings(RunConfig, table)
 
 
 def default_config_path() -> Path:
-    """The default configuration shipped with the package (the seed wing)."""
-    return problems_dir() / "seed_wing" / "run.toml"
+    """The default configuration shipped with the package (the seed wing's study).
 
-
-def _apply_update(table: dict, dotted: str, value) -> None:
-    """Set ``dotted`` (``"controller.order"``, ``"problem.set.zeta"``) in the raw TOML
-    ``table``.  The path follows the sections of :class:`RunConfig`; inside a table-valued
-    key (``problem.set``, ``solver.ipopt``) the rest of the path is one key, dots included
-    (``"solver.ipopt.ipopt.tol"``).  A table value is merged key by key.  Names are not
-    checked here: ``_build`` rejects unknown ones with the list of allowed keys."""
-    _set_path(table, RunConfig, str(dotted).split("."), value, str(dotted))
-
-
-def _set_path(node: dict, cls, parts: list, value, dotted: str) -> None:
-    name, rest = parts[0], parts[1:]
-    typ = get_type_hints(cls).get(name) if cls is not None else None
-    section = typ is not None and is_dataclass(typ)
-    mapping = typ is not None and not section and (get_origin(typ) or typ) is dict
-    if not rest:
-        if isinstance(value, dict) and (section or mapping):
-            for k, v in value.items():  # merge a table key by key
-                _set_path(node, cls, [name, str(k)], v, dotted)
-        else:
-            node[name] = value
-        return
-    if typ is not None and not (section or mapping):
-        raise ConfigError(f"{dotted!r}: {name!r} is a single value, not a table; drop the "
-                          "rest of the path")
-    sub = node.setdefault(name, {})
-    if not isinstance(sub, dict):
-        raise ConfigError(f"{dotted!r}: [{name}] must be a table, got {sub!r}")
-    if mapping:  # problem.set / solver.ipopt: the rest of the path is one key
-        sub[".".join(rest)] = value
-    else:
-        _set_path(sub, typ if section else None, rest, value, dotted)
+    Returns
+    -------
+    Path
+    """
+    return config_path("seed_wing", "run")
 
 
 def load_config(path=None, *, updates=None, **overrides) -> RunConfig:
@@ -386,12 +494,23 @@ def load_config(path=None, *, updates=None, **overrides) -> RunConfig:
         is merged key by key).  Unknown names fail like unknown keys in the file.
     **overrides
         Replace top-level fields (e.g. ``seed=3``).
+
+    Returns
+    -------
+    RunConfig
+
+    Raises
+    ------
+    ConfigError
+        A missing or malformed file, or any unknown or invalid key (named).
     """
     path = Path(path) if path is not None else default_config_path()
     table = read_toml(path, "configuration file")
     table.update({k: v for k, v in overrides.items() if v is not None})
     for key, value in (updates or {}).items():
-        _apply_update(table, key, value)
-    cfg = _build(RunConfig, table, "")
-    _semantic_checks(cfg)
-    return cfg
+        set_dotted(table, RunConfig, key, value)
+    for old, new in _RENAMED.items():
+        section, key = old.split(".")
+        if isinstance(table.get(section), dict) and key in table[section]:
+            raise ConfigError(f"{old} was renamed {new}: rename the key in {path}")
+    return build_settings(RunConfig, table)

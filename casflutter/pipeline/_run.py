@@ -1,18 +1,31 @@
-"""``casflutter run``: the paper's study end to end (§IV, Table I).
+"""The study run: the paper's stages, left to right, on a truth problem (§IV, Table I).
 
-Stages (each timed, progress on stderr):
+Always:
 
-1. chirp records of the truth at the nominal speed ``V0`` (modal displacements and flap);
-2. HWL ROM with the configured orders (paper: (3, 1, 1, 1, 2, 2)), eq. 1--4;
-3. linearise -> ERA -> Tustin -> Σf (eq. 5);
-4. Σs (eq. 6--7, accelerometer sensors) and ΣAE (eq. 8--9);
-5. Hopf: flutter speed index Vf, its frequency and the critical mode (and the truth's own);
-6. nonlinear ROM simulation at Vf -> LCO and its spectrum (paper Fig. 9), beside the truth's;
-7. LFT at Vf (eq. 10--15);
-8. fixed-order controller on the sensors (paper §III.C);
-9. verification: γ, small-gain and exact stable intervals of V (independent code);
-10. closed-loop nonlinear truth simulation with the controller gain ramped 0 -> 1 and released
-    (paper Fig. 11): LCO attenuation.
+1. ``data`` — chirp records of the truth at ``V0`` (:func:`casflutter.truth.truth_records`);
+2. ``rom`` — the ROM: the HWL model of eq. 1-4 (:func:`casflutter.ident.identify`) or the
+   linear common-denominator model (:func:`casflutter.ident.identify_common_denominator`);
+3. ``realize`` — Σf by ERA and Tustin (eq. 5, :func:`casflutter.realize.realize`);
+4. ``structure`` — Σs with the configured sensors (eq. 6-7) and ΣAE (eq. 8-9);
+5. ``flutter`` — the Hopf points of ΣAE and of the truth (:func:`casflutter.aeroelastic.find_flutter`).
+
+With ``rom.v0_iterations > 1`` stages 1-5 repeat at the ROM's own flutter speed until the
+identification speed and the flutter speed agree.  Then the optional ``stages``:
+
+- ``frozen`` — the flutter speed of the truth with its aerodynamics frozen at ``V0``
+  (:func:`casflutter.truth.frozen_aero_truth`): the V²-scaling part of the ROM's error;
+- ``parametric`` — ROMs identified at several speeds, interpolated in V, and their flutter;
+- ``lco`` — the nonlinear ROM in the loop and the truth above their Hopf points (Fig. 9);
+- ``controller`` — the LFT at Vf (eq. 10-15, ``lft``), the fixed-order synthesis (§III.C,
+  ``controller``) and the independent verification (``verify``);
+- ``closed_loop`` — the ROM and the truth above flutter, open and closed loop, and the
+  truth's linear closed loop over speed;
+- ``suppression`` — the truth with the controller gain ramped 0 -> 1 and released (Fig. 11).
+
+Two configurations ship with the package: ``problems/seed_wing/run.toml`` (the paper's
+study, ``casflutter run``) and ``problems/typical_section/flutter_check.toml`` (an order-2
+controller designed on the ROM identified at its own flutter speed and checked on the
+truth); ``problems/NAME/flutter.toml`` are the ROM routes of ``casflutter flutter``.
 """
 
 from __future__ import annotations
@@ -20,109 +33,89 @@ from __future__ import annotations
 import json
 import sys
 import time
-from dataclasses import dataclass, field, replace
+from contextlib import contextmanager
+from dataclasses import replace
 from pathlib import Path
-from typing import Any
 
+import control
 import numpy as np
+from scipy.io import savemat
 
+from .._linalg import spectral_abscissa
+from .._settings import settings_as
+from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, build_lft,
+                           find_flutter, simulate_loop)
+from ..data import envelope_growth_rate
+from ..design import SynthesisOptions, synthesize
 from ..errors import CasflutterError
+from ..ident import (IdentificationResult, IdentificationSettings, fit_report, identify,
+                     identify_common_denominator)
+from ..realize import ParametricROM, realize, speed_nodes
+from ..report import write_figures, write_html
+from ..truth import (RecordSettings, closed_loop_truth, frozen_aero_truth, suppression_run,
+                     truth_lco, truth_loop_matrix, truth_loop_sweep, truth_records)
+from ..verify import controller_to_json, speed_sweep, verify_controller
 from ._config import RunConfig, load_config
+from ._result import (ClosedLoopChecks, LcoResult, ParametricResult, RunResult,
+                      SimulationCheck, _jsonable)
 
-__all__ = ["RunResult", "run_pipeline"]
-
-
-@dataclass(frozen=True)
-class RunResult:
-    """Everything ``casflutter run`` produced.
-
-    Attributes
-    ----------
-    summary : dict
-        The content of ``summary.json``.
-    out_dir : Path
-        Where the files were written.
-    files : dict
-        Name -> path of every file written.
-    objects : dict
-        The live objects of each stage (model, realisation, system, flutter results,
-        LFT, synthesis and verification results, simulations), for scripts.
-    """
-
-    summary: dict
-    out_dir: Path
-    files: dict
-    objects: dict = field(repr=False, default_factory=dict)
+__all__ = ["run"]
 
 
 class _Progress:
-    def __init__(self, quiet: bool, n_stages: int = 10):
+    """Stage timings, and a line per stage on stderr unless quiet."""
+
+    def __init__(self, quiet: bool, names: list[str]):
         self.quiet = quiet
-        self.n = n_stages
+        self.names = names
         self.timings: dict[str, float] = {}
         self.t0 = time.perf_counter()
 
-    def stage(self, k: int, name: str):
-        progress = self
-
-        class _Ctx:
-            def __enter__(self_inner):
-                if not progress.quiet:
-                    print(f"[{k}/{progress.n}] {name} ...", file=sys.stderr, flush=True)
-                self_inner.t = time.perf_counter()
-                return self_inner
-
-            def __exit__(self_inner, exc_type, exc, tb):
-                dt = time.perf_counter() - self_inner.t
-                progress.timings[name] = dt
-                if not progress.quiet and exc_type is None:
-                    print(f"      {name}: {dt:.2f} s", file=sys.stderr, flush=True)
-                return False
-
-        return _Ctx()
+    @contextmanager
+    def stage(self, name: str):
+        if not self.quiet:
+            k = self.names.index(name) + 1
+            print(f"[{k}/{len(self.names)}] {name} ...", file=sys.stderr, flush=True)
+        t = time.perf_counter()
+        yield
+        dt = time.perf_counter() - t
+        self.timings[name] = self.timings.get(name, 0.0) + dt
+        if not self.quiet:
+            print(f"      {name}: {dt:.2f} s", file=sys.stderr, flush=True)
 
     def note(self, text: str):
         if not self.quiet:
             print(f"      {text}", file=sys.stderr, flush=True)
 
 
-def _jsonable(x: Any):
-    if isinstance(x, dict):
-        return {k: _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, (np.floating, float)):
-        return None if not np.isfinite(x) else float(x)
-    if isinstance(x, (np.integer,)):
-        return int(x)
-    if isinstance(x, np.ndarray):
-        return _jsonable(x.tolist())
-    return x
+def _stage_names(cfg: RunConfig) -> list[str]:
+    names = ["data", "rom", "realize", "structure", "flutter"]
+    for s in cfg.stages:
+        names += ["lft", "controller", "verify"] if s == "controller" else [s]
+    return names
 
 
-def delayed(data, samples: int):
-    """Records whose forces lag the motion by ``samples`` (the explicit CFD coupling delay,
-    see :class:`~casflutter.pipeline._config.DataSection`)."""
-    from ..data import IOData, Record
-
-    if samples == 0:
-        return data
-    recs = tuple(Record(np.vstack([np.zeros((samples, r.n_outputs)), r.y[:-samples]]), r.u,
-                        r.v, r.name) for r in data.records)
-    return IOData(recs, data.dt, data.output_names, data.u_names, data.v_name, data.meta)
+def _mode(res: FlutterResult) -> int:
+    """The flutter mode (the mode deflected in the simulations), else mode 0."""
+    m = res.flutter_mode
+    return int(m) if m is not None and m >= 0 else 0
 
 
-def _flutter_summary(res, hz_per_unit: float) -> dict:
-    if res.flutter is None:
-        return {"V": None, "freq_hz": None, "mode": None, "status": res.status}
-    mode = res.flutter_mode
-    return {"V": float(res.Vf), "freq_hz": float(res.omega_f) / (2 * np.pi) * hz_per_unit,
-            "mode": None if mode is None or mode < 0 else int(mode) + 1, "status": res.status}
+def _identify(data, cfg: RunConfig):
+    """The ROM of the records: ``(identification result, model)``."""
+    r = cfg.rom
+    if r.method == "common_denominator":
+        ident = identify_common_denominator(data, r.na, r.nb)
+    else:
+        settings = replace(settings_as(r, IdentificationSettings),
+                           ipopt_options={**cfg.solver.ipopt, **r.ipopt_options})
+        ident = identify(data, tuple(r.orders), settings=settings)
+    return ident, ident.model
 
 
-def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
-                 seed: int | None = None, quiet: bool = False, write: bool = True) -> RunResult:
-    """Run the study (module docstring) and write its outputs.
+def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int | None = None,
+        quiet: bool = False, write: bool = True) -> RunResult:
+    """Run the stages of a configuration (module docstring) and write its outputs.
 
     Parameters
     ----------
@@ -136,199 +129,241 @@ def run_pipeline(config: RunConfig | str | Path | None = None, *, out_dir=None,
         No progress on stderr.
     write : bool
         Write files (summary, figures, report, ROM, controller).
-    """
-    from ..aeroelastic import AeroelasticSystem, build_lft, find_flutter, simulate_loop
-    from ..design import SynthesisOptions, synthesize
-    from ..ident import identify
-    from ..realize import realize
-    from ..truth import load_problem
-    from ..verify import verify_controller
-    from ._rom_data import truth_records
-    from ._suppression import (accelerometer_structure, sensor_rows_of, suppression_run,
-                               truth_lco)
 
+    Returns
+    -------
+    RunResult
+
+    Raises
+    ------
+    ConfigError
+        An invalid configuration (before any work).
+    CasflutterError
+        No ROM flutter in ``flutter.V_range`` when a later stage needs it (or no truth
+        flutter for the closed-loop stage), or a simulation that blew up.
+    casflutter.errors.SynthesisError
+        No synthesis start stabilised the design plants.
+
+    Examples
+    --------
+    >>> import casflutter as cf                                  # doctest: +SKIP
+    >>> result = cf.run(cf.load_config(), write=False)           # doctest: +SKIP
+    >>> result.flutter.Vf, result.verification.exact_V           # doctest: +SKIP
+    """
     cfg = config if isinstance(config, RunConfig) else load_config(config)
     if seed is not None:
         cfg = replace(cfg, seed=int(seed))
-    out = Path(out_dir or "casflutter-run")
-    prog = _Progress(quiet)
-    objects: dict[str, Any] = {}
-    sets = [f"{k}={v}" for k, v in cfg.problem.set.items()]
-    truth = load_problem(cfg.problem.name, sets)
-    objects["truth"] = truth
-    ms = truth.modal_structure()
-    # the accelerometers of every stage: Σs, the LFT, the truth's LCO and the suppression run
-    Hs = sensor_rows_of(truth, cfg.sensors.rows)
-    objects["sensor_rows"] = Hs
-    hz = 1.0  # frequencies are cycles per the problem's time unit (seconds for the seed wing)
+    prog = _Progress(quiet, _stage_names(cfg))
+    truth = cfg.problem.load()
+    structure = truth.modal_structure().with_sensors(cfg.sensors.rows or None, cfg.sensors.kind)
+    rows = cfg.sensors.rows or None
+    records = settings_as(cfg.data, RecordSettings)
+    vr = cfg.flutter.V_range
+    flutter_kw = dict(n_grid=cfg.flutter.n_grid, max_refine=cfg.flutter.max_refine)
+    needs_vf = cfg.rom.v0_iterations > 1 or bool(set(cfg.stages) & {"lco", "controller"})
+    out: dict = {"config": cfg, "truth": truth}
 
-    with prog.stage(1, "data"):
-        d = cfg.data
-        data = delayed(truth_records(truth, d.V0, dt=d.dt, duration=d.duration,
-                                     band=tuple(d.band_hz), amplitude=d.amplitude),
-                       d.coupling_delay)
-        objects["data"] = data
-    with prog.stage(2, "rom"):
-        ident = identify(data, tuple(cfg.rom.orders), criterion=cfg.rom.criterion,
-                         regularization=cfg.rom.regularization,
-                         ipopt_options=dict(cfg.solver.ipopt))
-        model = ident.model
-        objects["identification"] = ident
-        prog.note(f"{model}; fit error % " +
-                  ", ".join(f"{e:.3f}" for e in ident.fit.error_percent))
-    with prog.stage(3, "realize"):
-        real = realize(model, cfg.rom.nf)
-        objects["realization"] = real
-    with prog.stage(4, "structure"):
-        structure = accelerometer_structure(truth, Hs)
-        system = AeroelasticSystem.from_parts(real.sigma_f, structure, warn_unstable=False)
-        objects["system"] = system
-        if not system.rom_stable:
-            prog.note("warning: Σf is unstable on its own (ΣAE unstable at V = 0)")
-    with prog.stage(5, "flutter"):
-        vr = tuple(cfg.flutter.vrange)
-        # a bounded refinement: repeated lag eigenvalues of identical strips make the
-        # eigenvector matching ambiguous without changing any crossing
-        flutter = find_flutter(system, vr, n_grid=cfg.flutter.n_grid, max_refine=3)
-        N = truth.n_modes
-        flutter_truth = find_flutter(truth, vr, n_grid=cfg.flutter.n_grid, max_refine=3,
-                                     mode_states=[np.array([i, N + i]) for i in range(N)],
-                                     omega=ms.omega)
-        objects["flutter"], objects["flutter_truth"] = flutter, flutter_truth
-        if flutter.flutter is None:
-            raise CasflutterError(f"the ROM has no flutter crossing in V ∈ {vr}: "
-                                  f"{flutter.message}; widen flutter.vrange")
-        Vf = float(flutter.Vf)
-        prog.note(f"ROM Vf = {Vf:.4f}, {flutter.frequency_hz * hz:.3f} Hz; truth Vf = "
-                  f"{flutter_truth.Vf if flutter_truth.flutter else float('nan'):.4f}")
-    with prog.stage(6, "lco"):
-        # The nonlinear ROM carries its full linear part (exact order); when Σf is truncated
-        # (the paper's nf = 15) its own Hopf point differs from Vf.  Simulate a few per cent
-        # above the Hopf point of the exact-order linearisation, where the LCO develops.
-        exact = realize(model, "auto")
-        sys_exact = AeroelasticSystem.from_parts(exact.sigma_f, structure, warn_unstable=False)
-        fl_exact = find_flutter(sys_exact, vr, n_grid=cfg.flutter.n_grid, max_refine=3)
-        objects["flutter_exact_order"] = fl_exact
-        V_hopf = float(fl_exact.Vf) if fl_exact.flutter is not None else Vf
-        V_lco = V_hopf * cfg.lco.speed_factor
-        n_steps = int(round(cfg.lco.duration / model.dt))
-        xs0 = np.zeros(2 * truth.n_modes)
-        crit = flutter.flutter_mode if flutter.flutter_mode is not None and flutter.flutter_mode >= 0 else 0
-        xs0[2 * crit] = cfg.lco.initial_deflection
-        lco = simulate_loop(model, structure, V_lco, n_steps, xs0=xs0)
-        objects["lco"] = lco
-        objects["lco_speeds"] = {"V_hopf_exact_order": V_hopf, "V": V_lco}
-        # the truth's own LCO: the same distance above its own Hopf point (the ROM's speed
-        # can be far above the truth's flutter speed, where the truth diverges)
-        V_lco_truth = (float(flutter_truth.Vf) * cfg.lco.speed_factor
-                       if flutter_truth.flutter is not None else V_lco)
-        lco_truth = truth_lco(truth, V_lco_truth, cfg.lco.duration, crit,
-                              cfg.lco.initial_deflection, dt=model.dt, sensor_rows=Hs)
-        lco_truth["V"] = V_lco_truth
-        objects["lco_truth"] = lco_truth
-        prog.note(f"ROM LCO at V = {V_lco:.4f} (exact-order Hopf {V_hopf:.4f}): "
-                  f"{lco.sensors.kind}, {lco.sensors.frequency_hz:.3f} Hz")
-    with prog.stage(7, "lft"):
-        lft = build_lft(system, Vf)
-        objects["lft"] = lft
-    with prog.stage(8, "controller"):
-        c = cfg.controller
-        opts = SynthesisOptions(time_limit=c.time_limit or None, max_outer=c.max_outer,
-                                max_iter=c.max_iter, zero_start=c.zero_start,
-                                nslots=c.nslots, stability_margin=c.stability_margin,
-                                max_stab_rounds=c.max_stab_rounds,
-                                ipopt=dict(cfg.solver.ipopt))
-        # D22 (accelerometers see the flap) depends on the nominal speed: the multi-speed
-        # design uses each plant's own loop shift and the nominal plant's for the result
-        plants = [lft.plant_without_d22() if f == 1.0 else
-                  build_lft(system, Vf * f).plant_without_d22() for f in c.speeds]
-        syn = synthesize(plants if len(plants) > 1 else plants[0], lft.nmeas, lft.ncon,
-                         c.order, starts=c.starts, seed=cfg.seed, options=opts)
-        K = lft.physical_controller(syn.controller)
-        objects["synthesis"], objects["controller"] = syn, K
-    with prog.stage(9, "verify"):
-        ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
-        objects["verification"] = ver
-    with prog.stage(10, "suppression"):
-        # the truth flutters at its own speed: suppress its LCO there (paper Fig. 11 was
-        # measured on the real wing at an LCO condition)
-        V_lco = float(flutter_truth.Vf) if flutter_truth.flutter is not None else Vf
-        sup = suppression_run(truth, K, cfg, V_lco, dt=model.dt, mode=crit)
-        objects["suppression"] = sup
-    summary = _summary(cfg, ident, real, system, flutter, flutter_truth, lco, lco_truth, syn,
-                       ver, sup, hz, prog, objects.get("lco_speeds", {}))
-    files: dict[str, Path] = {}
-    if write:
-        files = _write_outputs(out, summary, objects, cfg, prog)
-    return RunResult(summary, out, files, objects)
+    # 1-5: records, ROM, Σf, ΣAE, flutter; repeated at the ROM's own flutter speed
+    V0, history = cfg.data.V0, []
+    for it in range(cfg.rom.v0_iterations):
+        with prog.stage("data"):
+            data = truth_records(truth, records, V0=V0)
+        with prog.stage("rom"):
+            ident, model = _identify(data, cfg)
+        with prog.stage("realize"):
+            real = realize(model, cfg.rom.nf)
+        with prog.stage("structure"):
+            system = AeroelasticSystem.from_parts(real.sigma_f, structure, warn_unstable=False)
+            if not system.rom_stable:
+                prog.note("warning: Σf is unstable on its own (ΣAE unstable at V = 0)")
+        with prog.stage("flutter"):
+            flutter = find_flutter(system, vr, **flutter_kw)
+            Vf = flutter.Vf
+            last = (it == cfg.rom.v0_iterations - 1 or Vf is None
+                    or abs(Vf - V0) <= cfg.rom.v0_rtol * Vf)
+            if last:
+                flutter_truth = find_flutter(truth, vr, **flutter_kw)
+            if Vf is None and needs_vf:
+                raise CasflutterError(f"the ROM identified at V0 = {V0:.4g} has no flutter "
+                                      f"crossing in V ∈ {vr}: {flutter.message}; widen "
+                                      "flutter.V_range")
+            history.append((float(V0), None if Vf is None else float(Vf)))
+        if last:
+            break
+        V0 = float(Vf)
+    fit = (ident.fit if isinstance(ident, IdentificationResult)
+           else fit_report(model, data, "simulation"))
+    prog.note(f"{model}; fit error % " + ", ".join(f"{e:.3f}" for e in fit.error_percent))
+    prog.note(f"ROM Vf = {Vf if Vf is not None else float('nan'):.4f}; truth Vf = "
+              f"{flutter_truth.Vf if flutter_truth.flutter else float('nan'):.4f}")
+    out.update(data=data, identification=ident, identification_history=tuple(history),
+               fit=fit, realization=real, system=system, flutter=flutter,
+               flutter_truth=flutter_truth)
+    crit = _mode(flutter)
 
-
-def _summary(cfg, ident, real, system, flutter, flutter_truth, lco, lco_truth, syn, ver, sup,
-             hz, prog, objects_speeds) -> dict:
-    model = ident.model
-    sens = lco.sensors if getattr(lco, "sensors", None) is not None else lco.modes
+    if "frozen" in cfg.stages:
+        with prog.stage("frozen"):
+            out["flutter_frozen"] = find_flutter(frozen_aero_truth(truth, V0), vr, **flutter_kw)
+    if "parametric" in cfg.stages:
+        with prog.stage("parametric"):
+            speeds = speed_nodes(vr, cfg.parametric.n_speeds)
+            prom = ParametricROM(speeds, tuple(
+                identify_common_denominator(truth_records(truth, records, V0=float(v)),
+                                            cfg.rom.na, cfg.rom.nb) for v in speeds))
+            psys = ParametricSystem(prom, structure)
+            out["parametric"] = ParametricResult(prom, psys, find_flutter(
+                psys, vr, n_grid=cfg.flutter.n_grid, max_refine=cfg.parametric.max_refine))
+    if "lco" in cfg.stages:
+        with prog.stage("lco"):
+            out["lco"] = _lco(cfg, truth, model, structure, flutter, flutter_truth, prog)
+    if "controller" in cfg.stages:
+        with prog.stage("lft"):
+            lft = build_lft(system, Vf)
+        with prog.stage("controller"):
+            c = cfg.controller
+            options = replace(settings_as(c, SynthesisOptions),
+                              ipopt={**cfg.solver.ipopt, **c.ipopt})
+            # D22 (accelerometers see the flap) depends on the nominal speed: the multi-speed
+            # design uses each plant's own loop shift and the nominal plant's for the result
+            plants = [lft.plant_without_d22() if f == 1.0 else
+                      build_lft(system, Vf * f).plant_without_d22() for f in c.speeds]
+            syn = synthesize(plants if len(plants) > 1 else plants[0], lft.nmeas, lft.ncon,
+                             c.order, starts=c.starts, seed=cfg.seed, options=options)
+            K = lft.physical_controller(syn.controller)
+        with prog.stage("verify"):
+            ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
+            if cfg.verify.sweep:
+                lo, hi = cfg.verify.sweep
+                out["rom_sweep"] = speed_sweep(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf,
+                                               n_delta=lft.n_delta,
+                                               V=np.linspace(lo * Vf, hi * Vf,
+                                                             cfg.verify.n_sweep))
+        out.update(lft=lft, synthesis=syn, controller=K, verification=ver)
+    if "closed_loop" in cfg.stages:
+        with prog.stage("closed_loop"):
+            out["closed_loop"] = _closed_loop(cfg, truth, model, system, out["lft"],
+                                              out["controller"], flutter, flutter_truth, rows)
+    if "suppression" in cfg.stages:
+        with prog.stage("suppression"):
+            # the truth flutters at its own speed: suppress its LCO there (paper Fig. 11 was
+            # measured on the real wing at an LCO condition)
+            V_ref = flutter_truth.Vf if flutter_truth.flutter is not None else Vf
+            out["suppression"] = suppression_run(
+                truth, out["controller"], float(V_ref), cfg.suppression, dt=model.dt,
+                mode=crit, deflection=cfg.lco.initial_deflection, sensor_rows=rows,
+                sensor=cfg.sensors.kind)
     timings = dict(prog.timings)
     timings["total"] = time.perf_counter() - prog.t0
-    small = getattr(ver, "small_gain_V", None)
-    stable = getattr(ver, "exact_V", None)
-    return _jsonable({
-        "problem": cfg.problem.name,
-        "V0": cfg.data.V0,
-        "n_sensors": int(system.structure.n_sensors),
-        "orders": list(model.orders.as_tuple()),
-        "n_params": model.n_params,
-        "fit_error_percent": list(ident.fit.error_percent),
-        "nf": real.order,
-        "ns": 2 * model.n_modes,
-        "nae": int(system.state_matrix(0.0).shape[0]),
-        "flutter": _flutter_summary(flutter, hz),
-        "flutter_truth": _flutter_summary(flutter_truth, hz),
-        "lco": {"V": objects_speeds.get("V"),
-                "V_hopf_exact_order": objects_speeds.get("V_hopf_exact_order"),
-                "freq_hz": sens.frequency_hz * hz if sens.frequency_hz is not None else None,
-                "amplitude": list(sens.amplitude), "kind": sens.kind,
-                "truth_V": lco_truth.get("V"),
-                "truth_freq_hz": lco_truth.get("freq_hz"),
-                "truth_amplitude": lco_truth.get("amplitude"),
-                "truth_kind": lco_truth.get("kind")},
-        "controller": {"order": syn.order, "gamma": syn.gamma if ver is None else ver.gamma,
-                       "small_gain_V": list(small) if small is not None else None,
-                       "stable_V": list(stable) if stable is not None else None,
-                       "stable": bool(ver.stable)},
-        "suppression": {"attenuation_percent": sup.get("attenuation_percent"),
-                        "lco_returns": sup.get("lco_returns"),
-                        "V": sup.get("V")},
-        "timings_s": timings,
-        "seed": cfg.seed,
-    })
+    result = RunResult(**out, timings=timings)
+    if write:
+        target = Path(out_dir or "casflutter-run")
+        result = replace(result, out_dir=target, files=_write_outputs(target, result))
+    return result
 
 
-def _write_outputs(out: Path, summary: dict, objects: dict, cfg: RunConfig, prog) -> dict:
-    from scipy.io import savemat
+def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth, prog) -> LcoResult:
+    """Paper Fig. 9: the ROM's and the truth's LCO a little above their own Hopf points.
 
-    from ..verify import controller_to_json
-    from ._report import write_figures, write_html
+    The nonlinear ROM carries its full linear part (exact order); when Σf is truncated
+    (the paper's nf = 15) its own Hopf point differs from Vf.  It is simulated a few per
+    cent above the Hopf point of the exact-order linearisation, where the LCO develops; the
+    truth the same distance above its own Hopf point (the ROM's speed can be far above the
+    truth's flutter speed, where the truth diverges).
+    """
+    vr, lc = cfg.flutter.V_range, cfg.lco
+    exact = realize(model, "auto")
+    sys_exact = AeroelasticSystem.from_parts(exact.sigma_f, structure, warn_unstable=False)
+    fl_exact = find_flutter(sys_exact, vr, n_grid=cfg.flutter.n_grid,
+                            max_refine=cfg.flutter.max_refine)
+    V_hopf = float(fl_exact.Vf) if fl_exact.flutter is not None else float(flutter.Vf)
+    V_lco = V_hopf * lc.speed_factor
+    crit = _mode(flutter)
+    sim = simulate_loop(model, structure, V_lco, int(round(lc.duration / model.dt)),
+                        xs0=structure.displaced_state(crit, lc.initial_deflection))
+    V_truth = (float(flutter_truth.Vf) * lc.speed_factor if flutter_truth.flutter is not None
+               else V_lco)
+    tr = truth_lco(truth, V_truth, lc.duration, crit, lc.initial_deflection, dt=model.dt,
+                   sensor_rows=structure.Hs, sensor=structure.sensor)
+    prog.note(f"ROM LCO at V = {V_lco:.4f} (exact-order Hopf {V_hopf:.4f}): "
+              f"{sim.sensors.kind}, {sim.sensors.frequency_hz:.3f} Hz")
+    return LcoResult(rom=sim, truth=tr, V=V_lco, V_hopf_exact_order=V_hopf,
+                     flutter_exact_order=fl_exact)
 
+
+def _rate(timepts, X) -> float:
+    """Largest envelope growth rate over the columns, second half of the record."""
+    h = timepts.size // 2
+    return float(max(envelope_growth_rate(timepts[h:], X[h:, j]) for j in range(X.shape[1])))
+
+
+def _closed_loop(cfg: RunConfig, truth, model, system, lft, K, flutter, flutter_truth,
+                 rows) -> ClosedLoopChecks:
+    """The loops above flutter, open and closed, and the truth's closed loop over speed."""
+    s = cfg.closed_loop
+    if flutter_truth.Vf is None:
+        raise CasflutterError(f"the truth has no flutter in {cfg.flutter.V_range}: "
+                              f"{flutter_truth.message}")
+    Vf, Vt = float(flutter.Vf), float(flutter_truth.Vf)
+    act = dict(actuator_omega=s.actuator_omega, actuator_zeta=s.actuator_zeta)
+    sweep = truth_loop_sweep(truth, K, Vt, Vt * np.linspace(*s.sweep_range, s.n_sweep),
+                             sensor_rows=rows, **act)
+    # the discrete ROM in the loop, and the linear loops of the same ROM at V: the LFT
+    # closed at ΔV (eq. 15), open and with K
+    V = s.speed_factor * Vf
+    structure = system.structure
+    n = int(round(s.duration / model.dt))
+    xs0 = structure.displaced_state(_mode(flutter), s.deflection)
+    ol = simulate_loop(model, structure, V, n, xs0=xs0)
+    cl = simulate_loop(model, structure, V, n, xs0=xs0, controller=K)
+    G = lft.close(V ** 2 - lft.Vf ** 2)
+    Gv = control.ss(G.A, np.asarray(G.B)[:, -1:], G.C, np.asarray(G.D)[:, -1:])
+    A_cl = np.asarray(control.feedback(Gv, K, sign=1).A)
+    rom_sim = SimulationCheck("rom", float(V), ol.timepts, ol.zm, cl.zm,
+                              _rate(ol.timepts, ol.zm), _rate(cl.timepts, cl.zm),
+                              spectral_abscissa(G.A), spectral_abscissa(A_cl))
+    # the sampled-data truth with the flap actuator
+    V = s.speed_factor * Vt
+    t = np.arange(0.0, s.duration, s.dt)
+    x0 = truth.displaced_state(_mode(flutter_truth), s.deflection)
+    kw = dict(act, sensor="displacement", sensor_rows=rows)
+    tol = closed_loop_truth(truth, K, V, t, x0, lambda tt: 0.0, **kw).zm
+    tcl = closed_loop_truth(truth, K, V, t, x0, lambda tt: 1.0, **kw).zm
+    if not (np.all(np.isfinite(tol)) and np.all(np.isfinite(tcl))):
+        raise CasflutterError(f"the truth simulation at V = {V:.4f} blew up; shorten "
+                              "closed_loop.duration or lower closed_loop.speed_factor")
+    A_cl = truth_loop_matrix(truth, K, V, sensor_rows=rows, **act)
+    truth_sim = SimulationCheck("truth", float(V), t, tol, tcl, _rate(t, tol), _rate(t, tcl),
+                                spectral_abscissa(truth.state_matrix(V)),
+                                spectral_abscissa(A_cl))
+    return ClosedLoopChecks(truth_sweep=sweep, rom_simulation=rom_sim,
+                            truth_simulation=truth_sim)
+
+
+def _write_outputs(out: Path, result: RunResult) -> dict:
+    """``summary.json``, ``rom.npz``, the controller (JSON and .mat), ``config.json``, the
+    figures and ``report.html``."""
     out.mkdir(parents=True, exist_ok=True)
     files = {}
+    summary = result.summary()
     tmp = out / "summary.json.tmp"
     with open(tmp, "w") as fh:
         json.dump(summary, fh, indent=2)
     tmp.replace(out / "summary.json")
     files["summary"] = out / "summary.json"
-    objects["identification"].model.save(out / "rom.npz")
+    result.identification.model.save(out / "rom.npz")
     files["rom"] = out / "rom.npz"
-    K = objects["controller"]
-    with open(out / "controller.json", "w") as fh:
-        json.dump(controller_to_json(K), fh, indent=2)
-    files["controller_json"] = out / "controller.json"
-    savemat(out / "controller.mat", {"A": np.asarray(K.A), "B": np.asarray(K.B),
-                                      "C": np.asarray(K.C), "D": np.asarray(K.D)})
-    files["controller_mat"] = out / "controller.mat"
+    K = result.controller
+    if K is not None:
+        with open(out / "controller.json", "w") as fh:
+            json.dump(controller_to_json(K), fh, indent=2)
+        files["controller_json"] = out / "controller.json"
+        savemat(out / "controller.mat", {"A": np.asarray(K.A), "B": np.asarray(K.B),
+                                          "C": np.asarray(K.C), "D": np.asarray(K.D)})
+        files["controller_mat"] = out / "controller.mat"
     with open(out / "config.json", "w") as fh:
-        json.dump(_jsonable(cfg.to_dict()), fh, indent=2)
+        json.dump(_jsonable(result.config.to_dict()), fh, indent=2)
     files["config"] = out / "config.json"
-    figs = write_figures(out, objects, cfg)
+    figs = write_figures(out, result)
     files.update(figs)
     files["report"] = write_html(out, summary, figs)
     return files

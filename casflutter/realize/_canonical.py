@@ -4,8 +4,7 @@ ERA (:func:`casflutter.realize.era`) returns a *balanced* realisation whose stat
 fixed by an SVD, so two ROMs identified at neighbouring speeds can have unrelated bases and
 interpolating their matrices is meaningless.  The block observer-canonical form below is a
 fixed, explicit function of the model's coefficients ``{A, H, h, B, b}``: a ROM whose
-coefficients depend continuously on the speed index (the parametric ROM of
-:mod:`casflutter.pipeline`) gets a realisation of fixed dimension whose matrices, and hence
+coefficients depend continuously on the speed index (:class:`casflutter.realize.ParametricROM`) gets a realisation of fixed dimension whose matrices, and hence
 whose eigenvalues and eigenvectors, depend continuously on V.
 
 Write the linearised model (eq. 3 with ``p = q = 1``) with every lag ``l = 0..L``
@@ -33,7 +32,7 @@ import numpy as np
 
 from ..errors import DimensionError
 
-__all__ = ["lag_coefficients", "canonical_realization"]
+__all__ = ["lag_coefficients", "canonical_matrices", "canonical_realization"]
 
 
 def lag_coefficients(model) -> tuple[np.ndarray, np.ndarray]:
@@ -71,6 +70,39 @@ def lag_coefficients(model) -> tuple[np.ndarray, np.ndarray]:
     return Abar, Bbar
 
 
+def canonical_matrices(Abar: np.ndarray, Bbar: np.ndarray) -> tuple[np.ndarray, ...]:
+    """``(Ad, Bd, Cd, Dd)`` of the block observer-canonical form of lag coefficients.
+
+    Parameters
+    ----------
+    Abar, Bbar : ndarray
+        As returned by :func:`lag_coefficients` (``L >= 1`` lags).
+
+    Returns
+    -------
+    Ad : ndarray, shape (N L, N L)
+    Bd : ndarray, shape (N L, m)
+    Cd : ndarray, shape (N, N L)
+    Dd : ndarray, shape (N, m)
+        Module docstring; polynomial (linear) in the coefficients.
+    """
+    L = Abar.shape[0] - 1
+    N, m = Bbar.shape[1], Bbar.shape[2]
+    n = N * L
+    Ad = np.zeros((n, n))
+    Bd = np.zeros((n, m))
+    D0 = Bbar[0]
+    for i in range(1, L + 1):
+        rows = slice((i - 1) * N, i * N)
+        Ad[rows, :N] = -Abar[i]
+        if i < L:
+            Ad[rows, i * N:(i + 1) * N] = np.eye(N)
+        Bd[rows] = Bbar[i] - Abar[i] @ D0
+    Cd = np.zeros((N, n))
+    Cd[:, :N] = np.eye(N)
+    return Ad, Bd, Cd, D0
+
+
 def canonical_realization(model) -> control.StateSpace:
     """Discrete block observer-canonical realisation of an HWL model's linearisation.
 
@@ -96,24 +128,13 @@ def canonical_realization(model) -> control.StateSpace:
     """
     Abar, Bbar = lag_coefficients(model)
     L = Abar.shape[0] - 1
-    N, m = Bbar.shape[1], Bbar.shape[2]
+    N = Bbar.shape[1]
     if L == 0:
         raise DimensionError("the model has no lag (max_lag = 0): it is a static gain with no "
                              "state to realise; use lag_coefficients(model)[1][0] as D")
-    n = N * L
-    Ad = np.zeros((n, n))
-    Bd = np.zeros((n, m))
-    D0 = Bbar[0]
-    for i in range(1, L + 1):
-        rows = slice((i - 1) * N, i * N)
-        Ad[rows, :N] = -Abar[i]
-        if i < L:
-            Ad[rows, i * N:(i + 1) * N] = np.eye(N)
-        Bd[rows] = Bbar[i] - Abar[i] @ D0
-    Cd = np.zeros((N, n))
-    Cd[:, :N] = np.eye(N)
+    Ad, Bd, Cd, Dd = canonical_matrices(Abar, Bbar)
     inputs = list(model.u_names) * model.has_u + [model.v_name] * model.has_v
-    return control.ss(Ad, Bd, Cd, D0, model.dt, inputs=inputs,
+    return control.ss(Ad, Bd, Cd, Dd, model.dt, inputs=inputs,
                       outputs=list(model.output_names),
                       states=[f"x{i}_{j}" for i in range(1, L + 1) for j in range(1, N + 1)],
                       name="hwl_canonical")

@@ -23,15 +23,33 @@ from dataclasses import dataclass
 
 import control
 import numpy as np
+from scipy.signal import cont2discrete
 
 from ..errors import DimensionError, OrderError
 
-__all__ = ["Realization", "era", "tustin_to_continuous", "continuous_to_tustin", "realize",
-           "choose_order"]
+__all__ = ["Realization", "era", "inverse_tustin", "tustin_to_continuous", "continuous_to_tustin",
+           "realize", "choose_order"]
 
 
 def choose_order(hankel_sv: np.ndarray, tol: float = 1e-9) -> int:
-    """Number of Hankel singular values above ``tol`` times the largest."""
+    """Number of Hankel singular values above ``tol`` times the largest.
+
+    Parameters
+    ----------
+    hankel_sv : array_like
+        Hankel singular values, decreasing.
+    tol : float
+        Relative threshold.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    OrderError
+        All singular values are zero.
+    """
     s = np.asarray(hankel_sv, dtype=float)
     if s.size == 0 or s[0] <= 0:
         raise OrderError("all Hankel singular values are zero: the linear part of the model "
@@ -55,6 +73,8 @@ def era(markov: np.ndarray, order: int | str = "auto", *, dt: float = 1.0,
         Sampling time of the result.
     hankel_blocks : int, optional
         Block rows (= block columns) of the Hankel matrix; default ``(n - 1) // 2``.
+    tol : float
+        Relative threshold of the ``"auto"`` order.
 
     Returns
     -------
@@ -84,37 +104,81 @@ def era(markov: np.ndarray, order: int | str = "auto", *, dt: float = 1.0,
     return control.ss(sys.A, sys.B, sys.C, sys.D, dt), S
 
 
-def tustin_to_continuous(sysd: control.StateSpace) -> control.StateSpace:
-    """Inverse of the Tustin (bilinear) discretisation, ``s = (2/T)(z - 1)/(z + 1)``.
+def inverse_tustin(Ad, Bd, Cd, Dd, dt: float) -> tuple[np.ndarray, ...]:
+    """Matrices of the inverse Tustin (bilinear) transform, ``s = (2/T)(z - 1)/(z + 1)``.
 
-    With ``M = (Ad + I)/2``: ``A = (2/T)(I - M^-1)``, ``B = M^-1 Bd / T``,
-    ``C = Cd M^-1``, ``D = Dd - Cd (Ad + I)^-1 Bd`` — the exact inverse of
+    With ``P = Ad + I``: ``A = (2/T)(I - 2 P^-1)``, ``B = 2 P^-1 Bd / T``,
+    ``C = 2 Cd P^-1``, ``D = Dd - Cd P^-1 Bd`` — the exact inverse of
     ``scipy.signal.cont2discrete(..., method="bilinear")``.
+
+    Parameters
+    ----------
+    Ad, Bd, Cd, Dd : ndarray
+        The discrete system.
+    dt : float
+        Its sampling time ``T``.
+
+    Returns
+    -------
+    A, B, C, D : ndarray
+        The continuous system.
+    """
+    n = Ad.shape[0]
+    I = np.eye(n)
+    Pinv = np.linalg.inv(Ad + I)
+    A = (2.0 / dt) * (I - 2.0 * Pinv)
+    B = 2.0 * Pinv @ Bd / dt
+    C = 2.0 * Cd @ Pinv
+    D = Dd - Cd @ Pinv @ Bd
+    return A, B, C, D
+
+
+def tustin_to_continuous(sysd: control.StateSpace) -> control.StateSpace:
+    """Inverse of the Tustin (bilinear) discretisation (:func:`inverse_tustin`).
+
+    Parameters
+    ----------
+    sysd : control.StateSpace
+        Discrete system with a numeric ``dt``.
+
+    Returns
+    -------
+    control.StateSpace
+        The continuous system, with the same input and output labels.
+
+    Raises
+    ------
+    DimensionError
+        ``sysd`` is not discrete, or has a pole at ``z = -1``.
     """
     T = sysd.dt
     if T is None or T is True or not T > 0:
         raise DimensionError("tustin_to_continuous needs a discrete system with a numeric dt")
     Ad, Bd, Cd, Dd = (np.asarray(x, dtype=float) for x in (sysd.A, sysd.B, sysd.C, sysd.D))
-    n = Ad.shape[0]
-    I = np.eye(n)
-    P = Ad + I
-    if np.linalg.cond(P) > 1e12:
+    if np.linalg.cond(Ad + np.eye(Ad.shape[0])) > 1e12:
         raise DimensionError("the discrete system has a pole at z = -1 (Nyquist): the Tustin "
                              "transform has no continuous counterpart; lower the order or "
                              "resample")
-    Pinv = np.linalg.inv(P)
-    A = (2.0 / T) * (I - 2.0 * Pinv)
-    B = 2.0 * Pinv @ Bd / T
-    C = 2.0 * Cd @ Pinv
-    D = Dd - Cd @ Pinv @ Bd
+    A, B, C, D = inverse_tustin(Ad, Bd, Cd, Dd, T)
     return control.ss(A, B, C, D, inputs=sysd.input_labels, outputs=sysd.output_labels,
-                      states=n)
+                      states=Ad.shape[0])
 
 
 def continuous_to_tustin(sys: control.StateSpace, dt: float) -> control.StateSpace:
-    """Tustin (bilinear) discretisation (``scipy.signal.cont2discrete``, bilinear)."""
-    from scipy.signal import cont2discrete
+    """Tustin (bilinear) discretisation (``scipy.signal.cont2discrete``, bilinear).
 
+    Parameters
+    ----------
+    sys : control.StateSpace
+        Continuous system.
+    dt : float
+        Sampling time.
+
+    Returns
+    -------
+    control.StateSpace
+        Discrete system with the same input and output labels.
+    """
     Ad, Bd, Cd, Dd, _ = cont2discrete((sys.A, sys.B, sys.C, sys.D), dt, method="bilinear")
     return control.ss(Ad, Bd, Cd, Dd, dt, inputs=sys.input_labels, outputs=sys.output_labels)
 
@@ -151,7 +215,13 @@ class Realization:
         return self.order
 
     def split(self):
-        """``(Af, Bf, bf, Cf, Df, df)`` of eq. 5 (``bf``/``df`` None without flap input)."""
+        """The blocks of Σf (eq. 5).
+
+        Returns
+        -------
+        tuple of ndarray
+            ``(Af, Bf, bf, Cf, Df, df)``; ``bf``, ``df`` are ``None`` without a flap input.
+        """
         s = self.sigma_f
         N = s.noutputs
         B, D = np.asarray(s.B), np.asarray(s.D)
@@ -167,11 +237,18 @@ def realize(model, order: int | str = "auto", *, tol: float = 1e-9,
     Parameters
     ----------
     model : casflutter.ident.HWLModel
+        The identified ROM.
     order : int or "auto"
         ``nf``; ``"auto"`` keeps Hankel singular values above ``tol`` (relative).
+    tol : float
+        Relative threshold of the ``"auto"`` order.
     n_markov : int, optional
         Number of Markov parameters used (default: enough for a Hankel matrix of
         ``max(4 * max_lag, 60)`` blocks).
+
+    Returns
+    -------
+    Realization
     """
     o = model.orders
     N = model.n_modes

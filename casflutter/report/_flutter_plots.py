@@ -108,11 +108,9 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
         Channels to draw (default all).
     fmax_hz : float, optional
         Upper limit of the spectrum axis (default 4× the fundamental).
-    truth : dict, optional
-        The truth's own response beside the ROM's (sensor outputs only): keys ``timepts``,
-        ``zm``, ``analysis`` (a :class:`casflutter.aeroelastic.ResponseAnalysis`), ``V`` and
-        optionally ``t_start`` (where the history begins), as returned by the pipeline's
-        truth LCO stage; drawn dashed.
+    truth : casflutter.truth.TruthLco, optional
+        The truth's own response beside the ROM's (sensor outputs only), from
+        :func:`casflutter.truth.truth_lco`; drawn dashed.
     """
     if which not in ("sensors", "modes"):
         raise ValueError(f"which={which!r}; choose 'sensors' or 'modes'")
@@ -131,17 +129,15 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
     if an is not None and an.kind == "lco":
         title += f", fundamental {an.frequency_hz:.4g} Hz"
     if truth is not None and which == "sensors":
-        ta = truth.get("analysis")
+        ta = truth.analysis
         for j in chans:
-            at.plot(truth["timepts"], truth["zm"][:, j], lw=0.8, ls="--",
-                    label=f"truth zm[{j}]")
-        title += f"; truth at V = {truth.get('V', float('nan')):.4g}: "
-        title += ta.kind if ta is not None else "?"
-        if ta is not None and ta.kind == "lco":
+            at.plot(truth.timepts, truth.zm[:, j], lw=0.8, ls="--", label=f"truth zm[{j}]")
+        title += f"; truth at V = {truth.V:.4g}: {ta.kind}"
+        if ta.kind == "lco":
             title += f", {ta.frequency_hz:.4g} Hz"
-        if truth.get("t_start", 0.0) > 0:
-            title += f" (its last {truth['timepts'][-1]:.3g} s after {truth['t_start']:.3g} s)"
-        if ta is not None and ta.spectrum.size:
+        if truth.t_start > 0:
+            title += f" (its last {truth.timepts[-1]:.3g} s after {truth.t_start:.3g} s)"
+        if ta.spectrum.size:
             afr.plot(ta.spectrum_freq_hz, ta.spectrum, lw=0.9, ls="--", label="truth")
     at.set_title(title, fontsize="medium")
     at.legend(fontsize="small", ncol=3)

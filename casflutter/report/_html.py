@@ -39,7 +39,8 @@ def _fmt(x, digits=4):
 def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflutter run") -> str:
     """HTML text of the report (figures read from PNG files and embedded as base64)."""
     s = summary
-    fl, ctrl = s.get("flutter", {}), s.get("controller", {})
+    fl, ctrl = s.get("flutter") or {}, s.get("controller") or {}
+    lco, sup = s.get("lco") or {}, s.get("suppression") or {}
     ours = {
         "nominal speed index V0": s.get("V0"),
         "number of modes N": len(s.get("fit_error_percent", [])),
@@ -49,14 +50,14 @@ def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflu
         "order of ΣAE": s.get("nae"),
         "flutter speed index Vf": fl.get("V"),
         "flutter mode": fl.get("mode"),
-        "LCO fundamental frequency [Hz]": s.get("lco", {}).get("freq_hz"),
+        "LCO fundamental frequency [Hz]": lco.get("freq_hz"),
         "order of controller K(s)": ctrl.get("order"),
         "number of sensors": s.get("n_sensors"),
         "stable speed range (controller)": ctrl.get("stable_V"),
-        "LCO attenuation": (None if s.get("suppression", {}).get("attenuation_percent") is None
-                            else f"{s['suppression']['attenuation_percent']:.1f} %"),
+        "LCO attenuation": (None if sup.get("attenuation_percent") is None
+                            else f"{sup['attenuation_percent']:.1f} %"),
     }
-    ft, lco = s.get("flutter_truth", {}), s.get("lco", {})
+    ft = s.get("flutter_truth") or {}
     truth = {   # the truth simulator's own values, where it has one
         "flutter speed index Vf": ft.get("V"),
         "flutter mode": ft.get("mode"),
@@ -87,8 +88,8 @@ figcaption{{font-size:90%;color:#555}}</style></head><body>
 <h2>Table I</h2>
 <table><tr><th>quantity</th><th>this run (ROM)</th><th>truth simulator</th><th>paper</th></tr>
 {rows}</table>
-<p>ROM fit error per mode [%]: {fit}. Truth flutter: V = {_fmt(s.get('flutter_truth', {}).get('V'))},
-{_fmt(s.get('flutter_truth', {}).get('freq_hz'))} Hz. Controller: verified γ = {_fmt(ctrl.get('gamma'))},
+<p>ROM fit error per mode [%]: {fit}. Truth flutter: V = {_fmt(ft.get('V'))},
+{_fmt(ft.get('freq_hz'))} Hz. Controller: verified γ = {_fmt(ctrl.get('gamma'))},
 small-gain interval of V {_fmt(ctrl.get('small_gain_V'))}, exact stable interval {_fmt(ctrl.get('stable_V'))}.</p>
 <h2>Figures</h2>
 {''.join(imgs)}

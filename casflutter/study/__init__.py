@@ -14,16 +14,17 @@
 - :func:`gamma_sensitivity`: dγ*/dp of fixed-order H∞ synthesis at its solution (envelope
   theorem of the minimax NLP, CasADi AD), checked against closed-form optima.
 - :func:`pipeline_evaluator`: the ``pipeline`` evaluator, one ``casflutter run`` per point,
-  parameters as dotted run-config paths (``controller.order``, ``problem.set.zeta_lateral``).
+  parameters as dotted run-config paths (``controller.order``, ``problem.set.zeta_lateral``);
+  :func:`rom_flutter_evaluator` the same for the ROM route of ``casflutter flutter``.
 - :func:`cached_solver`: one parametric CasADi solver per worker process and structure
   (the ``truth_hopf`` evaluator builds its NLP once per worker).
 """
 
 from ._evaluators import (Evaluator, evaluator_names, get_evaluator, register_evaluator,
-                          synthesis_gamma, truth_flutter)
+                          synthesis_gamma, truth_flutter_evaluator)
 from ._gamma import GammaSensitivity, gamma_sensitivity
 from ._pipeline_eval import (PIPELINE_OUTPUTS, PIPELINE_SETTINGS, flatten_summary,
-                             pipeline_config, pipeline_evaluator)
+                             pipeline_config, pipeline_evaluator, rom_flutter_evaluator)
 from ._hopf import (HopfPoint, flutter_sensitivity_nlp, hopf_point, quadratic_coefficients,
                     truth_hopf)
 from ._runner import Progress, SweepResult, evaluate_point, run_sweep
@@ -38,8 +39,8 @@ __all__ = [
     "Study", "Parameter", "load_study", "point_key", "PointStore",
     "run_sweep", "SweepResult", "Progress", "evaluate_point",
     "Evaluator", "register_evaluator", "get_evaluator", "evaluator_names",
-    "truth_flutter", "synthesis_gamma",
-    "pipeline_evaluator", "pipeline_config", "flatten_summary", "PIPELINE_OUTPUTS",
+    "truth_flutter_evaluator", "synthesis_gamma",
+    "pipeline_evaluator", "rom_flutter_evaluator", "pipeline_config", "flatten_summary", "PIPELINE_OUTPUTS",
     "PIPELINE_SETTINGS",
     "sweep_table", "write_table", "plot_sweep",
     "flutter_sensitivity", "flutter_speed_fd", "FlutterSensitivity", "ParameterSensitivity",

@@ -15,11 +15,12 @@ failure (the runner records the error and carries on).  Built-in evaluators:
 ``truth_hopf``
     The same flutter speed as the root of the Hopf system, a parametric CasADi NLP built once
     per worker process and reused for every point (:func:`casflutter.study.truth_hopf`).
-``rom_flutter``
-    The ROM route of the pipeline, registered only when ``casflutter.pipeline`` provides it.
 ``pipeline``
-    The whole seed-wing study (``casflutter run``) per point, parameters by dotted path into
-    the run configuration (:mod:`casflutter.study._pipeline_eval`).
+    The whole study (``casflutter run``) per point, parameters by dotted path into the run
+    configuration (:mod:`casflutter.study._pipeline_eval`).
+``rom_flutter``
+    The ROM route of ``casflutter flutter`` (a run of ``problems/NAME/flutter.toml``) per
+    point, by dotted path as for ``pipeline``.
 
 Further evaluators plug in with :func:`register_evaluator` or as ``"package.module:function"``
 in the study file (the form that also reaches spawned and Dask worker processes).
@@ -42,11 +43,17 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
+from ..aeroelastic import find_flutter
+from ..design import load_compleib, synthesize
 from ..errors import ConfigError
+from ._hopf import truth_hopf
+from ._pipeline_eval import (PIPELINE_OUTPUTS, ROM_FLUTTER_OUTPUTS, pipeline_check,
+                             pipeline_evaluator, rom_flutter_check, rom_flutter_evaluator)
 from ._spec import check_setting
+from ._truth_point import load_truth
 
 __all__ = ["Evaluator", "register_evaluator", "get_evaluator", "evaluator_names",
-           "truth_flutter", "synthesis_gamma"]
+           "truth_flutter_evaluator", "synthesis_gamma"]
 
 
 @dataclass(frozen=True)
@@ -118,7 +125,6 @@ def register_evaluator(name: str, function: Callable, outputs=(), description: s
 
 def evaluator_names() -> list[str]:
     """Names of the registered evaluators."""
-    _maybe_register_pipeline()
     return sorted(_REGISTRY)
 
 
@@ -131,7 +137,6 @@ def get_evaluator(ref: str) -> Evaluator:
         Unknown name (the message lists the registered ones) or an import path that does
         not resolve.
     """
-    _maybe_register_pipeline()
     if ref in _REGISTRY:
         return _REGISTRY[ref]
     if ":" in ref:
@@ -148,45 +153,6 @@ def get_evaluator(ref: str) -> Evaluator:
 
 # ----------------------------------------------------------------------- truth flutter
 
-_TRUTH_OPTIONS = {
-    "problem": "truth problem name (casflutter problems)",
-    "V_min": "lowest speed index of the flutter search (default 0.02)",
-    "V_max": "highest speed index of the flutter search (default 4.0)",
-    "n_grid": "grid points of the eigenvalue tracking (default 81)",
-    "lco_speed_ratio": "if given: simulate the nonlinear truth at this multiple of Vf",
-    "lco_time": "LCO simulation length in the problem's time unit (default 600)",
-    "lco_samples": "output samples of the LCO simulation (default 6001)",
-    "lco_x0": "initial modal displacement of every mode for the LCO run (default 0.01)",
-}
-
-
-def _split_truth(params: Mapping[str, Any], settings: Mapping[str, Any]):
-    from ..truth import PROBLEMS  # noqa: PLC0415
-
-    merged = {**settings, **params}
-    merged.pop("_base_dir", None)
-    name = str(merged.pop("problem", "typical_section"))
-    if name not in PROBLEMS:
-        raise ConfigError(f"unknown problem {name!r}; available: {', '.join(PROBLEMS)}")
-    valid = PROBLEMS[name].Params.parameter_names()
-    truth_params = {k: v for k, v in merged.items() if k in valid}
-    options = {k: v for k, v in merged.items() if k not in valid}
-    bad = set(options) - set(_TRUTH_OPTIONS)
-    if bad:
-        raise ConfigError(f"truth_flutter: {sorted(bad)} are neither parameters of {name!r} "
-                          f"({', '.join(valid)}) nor options ({', '.join(_TRUTH_OPTIONS)})")
-    return name, truth_params, options
-
-
-def load_truth(params: Mapping[str, Any], settings: Mapping[str, Any] | None = None):
-    """The truth model of a point: ``(model, options)`` (see :func:`truth_flutter`)."""
-    from ..truth import PROBLEMS  # noqa: PLC0415
-
-    name, tp, options = _split_truth(params, settings or {})
-    cls = PROBLEMS[name]
-    return cls(cls.Params().with_updates(**tp)), options
-
-
 def _lco_amplitude(model, V: float, options: Mapping[str, Any]) -> dict[str, float]:
     """Half peak-to-peak of every physical coordinate over the last quarter of a free run
     of the nonlinear truth at ``V``, and its relative change against the previous quarter
@@ -194,9 +160,8 @@ def _lco_amplitude(model, V: float, options: Mapping[str, Any]) -> dict[str, flo
     T = float(options.get("lco_time", 600.0))
     n = int(options.get("lco_samples", 6001))
     x0 = float(options.get("lco_x0", 0.01))
-    N = model.n_modes
     t = np.linspace(0.0, T, n)
-    sim = model.simulate(t, np.concatenate([np.full(N, x0), np.zeros(N)]), V)
+    sim = model.simulate(t, model.modal_state(u=np.full(model.n_modes, x0)), V)
     if not sim.success:
         raise RuntimeError(f"LCO simulation failed at V = {V:g}: {sim.message}")
     shapes = model.modal_structure().shapes
@@ -213,7 +178,8 @@ def _lco_amplitude(model, V: float, options: Mapping[str, Any]) -> dict[str, flo
     return out
 
 
-def truth_flutter(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dict[str, Any]:
+def truth_flutter_evaluator(params: Mapping[str, Any],
+                            settings: Mapping[str, Any]) -> dict[str, Any]:
     """Flutter and divergence of a truth problem's full-order linear system.
 
     Parameters
@@ -234,8 +200,6 @@ def truth_flutter(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dic
         ``lco_speed_ratio``, ``lco_amplitude`` (largest coordinate), one
         ``lco_amplitude_<coordinate>`` per coordinate, ``lco_settling``, ``lco_V``.
     """
-    from ..aeroelastic import find_flutter  # noqa: PLC0415
-
     model, options = load_truth(params, settings)
     t0 = time.perf_counter()
     res = find_flutter(model.state_matrix, (float(options.get("V_min", 0.02)),
@@ -257,7 +221,7 @@ def truth_flutter(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dic
 
 
 def _truth_flutter_check(params: Mapping[str, Any], settings: Mapping[str, Any]) -> None:
-    """Pre-flight check of :func:`truth_flutter`: the problem, its parameter names and
+    """Pre-flight check of :func:`truth_flutter_evaluator`: the problem, its parameter names and
     values, the option names and values (builds the truth, no flutter search)."""
     _, options = load_truth(params, settings)
     v_min = check_setting(options, "V_min", 0.02, low=0.0)
@@ -297,8 +261,6 @@ def synthesis_gamma(params: Mapping[str, Any], settings: Mapping[str, Any]) -> d
     expose them), so this evaluator cannot reuse a solver across points; the study's
     own parametric solvers use :func:`casflutter.study.cached_solver`.
     """
-    from ..design import load_compleib, synthesize  # noqa: PLC0415
-
     merged = {**settings, **params}
     base = Path(str(merged.pop("_base_dir", ".")))
     if "plant" not in merged or "order" not in merged:
@@ -343,7 +305,7 @@ def _synthesis_check(params: Mapping[str, Any], settings: Mapping[str, Any]) -> 
         check_setting(merged, "time_limit", None, positive=True)
 
 
-register_evaluator("truth_flutter", truth_flutter,
+register_evaluator("truth_flutter", truth_flutter_evaluator,
                    outputs=("flutter_status", "Vf", "omega_f", "frequency_hz", "flutter_mode",
                             "divergence_V", "n_crossings", "flutter_time", "lco_amplitude",
                             "lco_settling", "lco_V"),
@@ -359,14 +321,7 @@ register_evaluator("synthesis", synthesis_gamma,
 
 
 
-def _truth_hopf(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dict[str, Any]:
-    """See :func:`casflutter.study.truth_hopf` (imported lazily)."""
-    from ._hopf import truth_hopf  # noqa: PLC0415
-
-    return truth_hopf(params, settings)
-
-
-register_evaluator("truth_hopf", _truth_hopf,
+register_evaluator("truth_hopf", truth_hopf,
                    outputs=("Vf", "omega_f", "frequency_hz", "return_status", "iterations",
                             "solve_time", "solver_builds", "pid", "hopf_time"),
                    description="truth flutter speed by the Hopf-point NLP (one cached "
@@ -374,71 +329,14 @@ register_evaluator("truth_hopf", _truth_hopf,
                    modules=("casflutter.truth", "casflutter.study._hopf"))
 
 
-def rom_flutter_evaluator(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dict[str, Any]:
-    """The ROM route of :func:`casflutter.pipeline.rom_flutter` at one point.
-
-    Parameters
-    ----------
-    params, settings : mapping
-        ``problem``; any truth parameter; any :class:`casflutter.pipeline.RomSettings` field
-        (``V0`` nominal speed, ``na``/``nb`` ROM orders, ``n_speeds``, ``dt``, ``duration``,
-        ``band`` ...); ``parametric`` (bool, default False: also the parametric ROM).
-
-    Returns
-    -------
-    dict
-        ``Vf_truth``, ``Vf_rom``, ``Vf_frozen``, ``Vf_parametric``, ``omega_f_rom``,
-        ``rom_error``, ``scaling_error``, ``identification_error``, ``parametric_error``,
-        ``rom_stable``, ``rom_status`` and ``time_<stage>`` per pipeline stage.
-    """
-    from dataclasses import fields  # noqa: PLC0415
-
-    from ..pipeline import RomSettings, rom_flutter, rom_settings  # noqa: PLC0415
-    from ..truth import PROBLEMS  # noqa: PLC0415
-
-    merged = {**settings, **params}
-    merged.pop("_base_dir", None)
-    name = str(merged.pop("problem", "typical_section"))
-    parametric = bool(merged.pop("parametric", False))
-    rom_keys = {f.name for f in fields(RomSettings)}
-    overrides = {k: merged.pop(k) for k in list(merged) if k in rom_keys}
-    if name not in PROBLEMS:
-        raise ConfigError(f"unknown problem {name!r}; available: {', '.join(PROBLEMS)}")
-    cls = PROBLEMS[name]
-    truth = cls(cls.Params().with_updates(**merged))  # unknown names raise ConfigError
-    res = rom_flutter(truth, rom_settings(name, **overrides), parametric=parametric)
-    out = {"Vf_truth": res.truth.Vf, "Vf_rom": res.rom.Vf, "Vf_frozen": res.frozen.Vf,
-           "Vf_parametric": None if res.parametric is None else res.parametric.Vf,
-           "omega_f_rom": res.rom.omega_f, "rom_error": res.rom_error,
-           "scaling_error": res.scaling_error, "identification_error": res.identification_error,
-           "parametric_error": res.parametric_error, "rom_stable": res.rom_stable,
-           "rom_status": res.rom.status}
-    out.update({f"time_{k}": v for k, v in res.timings.items()})
-    return out
-
-
-def _maybe_register_pipeline() -> None:
-    """Register ``rom_flutter`` and ``pipeline`` when :mod:`casflutter.pipeline` provides
-    the ROM route and ``run_pipeline``."""
-    if "rom_flutter" in _REGISTRY and "pipeline" in _REGISTRY:
-        return
-    try:
-        from ..pipeline import rom_flutter, rom_settings, run_pipeline  # noqa: F401, PLC0415
-    except ImportError:
-        return
-    from ._pipeline_eval import (PIPELINE_OUTPUTS, pipeline_check,  # noqa: PLC0415
-                                 pipeline_evaluator)
-
-    register_evaluator("pipeline", pipeline_evaluator, outputs=PIPELINE_OUTPUTS,
-                       description="the whole seed-wing study (casflutter run) per point: "
-                                   "sweep run-config keys by dotted path (controller.order, "
-                                   "rom.orders, data.V0, problem.set.zeta ...)",
-                       modules=("casflutter.pipeline", "casflutter.study._pipeline_eval"),
-                       check=pipeline_check)
-    register_evaluator("rom_flutter", rom_flutter_evaluator,
-                       outputs=("Vf_truth", "Vf_rom", "Vf_frozen", "Vf_parametric",
-                                "rom_error", "scaling_error", "identification_error",
-                                "parametric_error", "rom_stable", "rom_status"),
-                       description="ROM route (chirp data, HWL ROM, ERA/Tustin, V^2-scaled "
-                                   "loop) vs the truth flutter speed",
-                       modules=("casflutter.pipeline",))
+register_evaluator("pipeline", pipeline_evaluator, outputs=PIPELINE_OUTPUTS,
+                   description="the whole study (casflutter run) per point: sweep run-config "
+                               "keys by dotted path (controller.order, rom.orders, data.V0, "
+                               "problem.set.zeta ...)",
+                   modules=("casflutter.pipeline", "casflutter.study._pipeline_eval"),
+                   check=pipeline_check)
+register_evaluator("rom_flutter", rom_flutter_evaluator, outputs=ROM_FLUTTER_OUTPUTS,
+                   description="ROM route (chirp data, linear ROM, ERA/Tustin, V^2-scaled "
+                               "loop) vs the truth flutter speed: casflutter flutter per point",
+                   modules=("casflutter.pipeline", "casflutter.study._pipeline_eval"),
+                   check=rom_flutter_check)

@@ -27,6 +27,7 @@ import casadi as ca
 import numpy as np
 from scipy.optimize import minimize_scalar, nnls
 
+from ..design import partition
 from ..errors import ConfigError, DimensionError
 
 __all__ = ["GammaSensitivity", "gamma_sensitivity"]
@@ -78,8 +79,6 @@ class GammaSensitivity:
 
 
 def _blocks(P, nmeas: int, ncon: int, order: int) -> list[np.ndarray]:
-    from ..design import partition  # noqa: PLC0415
-
     a = partition(P, nmeas, ncon).augmented(order)
     return [np.atleast_2d(np.asarray(M, float)) for M in
             (a.A, a.B1, a.B2, a.C1, a.C2, a.D11, a.D12, a.D21)]

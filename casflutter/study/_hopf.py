@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import os
 import time
+from dataclasses import dataclass
 from typing import Any, Callable, Mapping, Sequence
 
 import casadi as ca
@@ -28,8 +29,10 @@ import numpy as np
 
 from .._nlp import make_solver
 from ..errors import ConfigError, ConvergenceError
-from ._sensitivity import FlutterSensitivity, ParameterSensitivity, _model
+from ..truth import load_problem
+from ._sensitivity import FlutterSensitivity, ParameterSensitivity
 from ._solvers import cached_solver, solver_builds
+from ._truth_point import load_truth
 
 __all__ = ["quadratic_coefficients", "hopf_point", "HopfPoint", "flutter_sensitivity_nlp",
            "truth_hopf"]
@@ -41,6 +44,21 @@ def quadratic_coefficients(matrix_fn: Callable[[float], np.ndarray],
                            V_nodes: Sequence[float] = (0.5, 1.0, 1.5), *,
                            check_V: float = 2.5, rtol: float = 1e-9):
     """``(A0, A1, A2)`` with ``A(V) = A0 + V A1 + V² A2``, verified at ``check_V``.
+
+    Parameters
+    ----------
+    matrix_fn : callable
+        ``V -> A(V)``.
+    V_nodes : sequence of three floats
+        Speeds at which ``A`` is sampled.
+    check_V : float
+        Speed of the check.
+    rtol : float
+        Relative tolerance of the check.
+
+    Returns
+    -------
+    A0, A1, A2 : ndarray
 
     Raises
     ------
@@ -84,8 +102,45 @@ def hopf_solver(n: int):
     return cached_solver(("hopf", int(n)), lambda: _build(int(n)))
 
 
-class HopfPoint(dict):
-    """Result of :func:`hopf_point` (a dict: ``Vf, omega_f, eigenvector, status, ...``)."""
+@dataclass(frozen=True)
+class HopfPoint:
+    """Result of :func:`hopf_point`.
+
+    Attributes
+    ----------
+    Vf : float
+        Flutter speed index.
+    omega_f : float
+        Flutter frequency ``|Im λ|``.
+    eigenvector : ndarray (complex)
+        Critical eigenvector, normalised ``cᴴ x = 1``.
+    p : ndarray
+        The NLP parameter vector ``(A0, A1, A2, c)``.
+    w : ndarray
+        The NLP solution ``(V, ω, Re x, Im x)``.
+    return_status : str
+        Ipopt's status, verbatim.
+    iterations : int
+        Ipopt iterations.
+    solve_time : float
+        Seconds.
+    solver_builds : int
+        Builds of this NLP in this process (1 when the solver is reused).
+    lam_g, lam_x : ndarray
+        Multipliers at the solution.
+    """
+
+    Vf: float
+    omega_f: float
+    eigenvector: np.ndarray
+    p: np.ndarray
+    w: np.ndarray
+    return_status: str
+    iterations: int
+    solve_time: float
+    solver_builds: int
+    lam_g: np.ndarray
+    lam_x: np.ndarray
 
 
 def _scan(A0, A1, A2, V_grid):
@@ -111,12 +166,18 @@ def hopf_point(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray, *,
                V_range: tuple[float, float] = (0.02, 4.0), n_scan: int = 41) -> HopfPoint:
     """Flutter speed of ``A0 + V A1 + V² A2`` by a coarse scan and the Hopf NLP.
 
+    Parameters
+    ----------
+    A0, A1, A2 : ndarray
+        ``A(V) = A0 + V A1 + V² A2`` (:func:`quadratic_coefficients`).
+    V_range : (float, float)
+        Range of the coarse scan.
+    n_scan : int
+        Points of the coarse scan.
+
     Returns
     -------
     HopfPoint
-        ``Vf``, ``omega_f``, ``eigenvector`` (normalised, ``cᴴ x = 1``), ``p`` (the NLP
-        parameter vector), ``w`` (the NLP solution), ``return_status``, ``iterations``,
-        ``solve_time``, ``solver_builds`` (builds of this NLP in this process).
 
     Raises
     ------
@@ -177,9 +238,28 @@ def flutter_sensitivity_nlp(problem: str = "typical_section",
     ``dVf/dθ = (∂w*/∂p)[V] · ∂p/∂θ`` where ``p = (A0, A1, A2, c)`` and ``∂p/∂θ`` is a central
     difference of the quadratic coefficients (``c`` held fixed).  Same result type as
     :func:`flutter_sensitivity` (``method = "parametric NLP"``).
+
+    Parameters
+    ----------
+    problem : str
+        Truth problem name.
+    parameters : sequence of str, optional
+        Parameters to differentiate by (default: all).
+    params : mapping, optional
+        Parameter values of the nominal point (default: the published ones).
+    V_range : (float, float)
+        Range of the coarse scan.
+    n_scan : int
+        Points of the coarse scan.
+    rel_step : float
+        Relative step of the difference of the quadratic coefficients.
+
+    Returns
+    -------
+    FlutterSensitivity
     """
     params = dict(params or {})
-    model = _model(problem, params)
+    model = load_problem(problem, params)
     valid = model.params.parameter_names()
     names = list(parameters) if parameters else valid
     bad = [nm for nm in names if nm not in valid]
@@ -189,15 +269,15 @@ def flutter_sensitivity_nlp(problem: str = "typical_section",
     A0, A1, A2 = quadratic_coefficients(model.state_matrix)
     hp = hopf_point(A0, A1, A2, V_range=V_range, n_scan=n_scan)
     n = A0.shape[0]
-    J = np.asarray(_sens_function(n)(hp["w"], hp["p"]))
-    cpart = hp["p"][3 * n * n:]
+    J = np.asarray(_sens_function(n)(hp.w, hp.p))
+    cpart = hp.p[3 * n * n:]
     sens = []
     for nm in names:
         p0 = float(nominal[nm])
         h = rel_step * max(abs(p0), 1.0)
 
         def pvec(val):
-            m = _model(problem, {**nominal, nm: val})
+            m = load_problem(problem, {**nominal, nm: val})
             Q = quadratic_coefficients(m.state_matrix)
             return np.concatenate([Q[0].ravel(order="F"), Q[1].ravel(order="F"),
                                    Q[2].ravel(order="F"), cpart])
@@ -205,25 +285,28 @@ def flutter_sensitivity_nlp(problem: str = "typical_section",
         try:
             dp, kind = (pvec(p0 + h) - pvec(p0 - h)) / (2 * h), "central"
         except ConfigError:
-            dp, kind = (-3 * hp["p"] + 4 * pvec(p0 + h) - pvec(p0 + 2 * h)) / (2 * h), "forward"
+            dp, kind = (-3 * hp.p + 4 * pvec(p0 + h) - pvec(p0 + 2 * h)) / (2 * h), "forward"
         dw = J @ dp
-        dVf, dom = float(dw[0]), float(np.sign(hp["w"][1]) * dw[1])
-        norm, by = ((p0 / hp["Vf"]) * dVf, "value") if p0 != 0 else (dVf / hp["Vf"], "unit")
+        dVf, dom = float(dw[0]), float(np.sign(hp.w[1]) * dw[1])
+        norm, by = ((p0 / hp.Vf) * dVf, "value") if p0 != 0 else (dVf / hp.Vf, "unit")
         sens.append(ParameterSensitivity(name=nm, value=p0, dVf_dp=dVf, domega_dp=dom,
                                          dlambda_dp=complex(np.nan, np.nan), normalized=norm,
                                          normalized_by=by, difference=kind))
-    return FlutterSensitivity(problem=problem, params=nominal, Vf=hp["Vf"], omega_f=hp["omega_f"],
-                              eigenvalue=complex(0.0, hp["omega_f"]),
+    return FlutterSensitivity(problem=problem, params=nominal, Vf=hp.Vf, omega_f=hp.omega_f,
+                              eigenvalue=complex(0.0, hp.omega_f),
                               dlambda_dV=complex(np.nan, np.nan), sensitivities=tuple(sens),
                               rel_step=rel_step, method="parametric NLP (CasADi)",
-                              flutter_message=hp["return_status"])
+                              flutter_message=hp.return_status)
 
 
 def truth_hopf(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dict[str, Any]:
     """Sweep evaluator: truth flutter speed by the cached Hopf NLP.
 
-    Parameters and settings as for :func:`truth_flutter` (``problem``, any truth
-    parameter, ``V_min``, ``V_max``), plus ``n_scan`` (coarse scan points, default 41).
+    Parameters
+    ----------
+    params, settings : mapping
+        As for :func:`casflutter.study.truth_flutter_evaluator` (``problem``, any truth
+        parameter, ``V_min``, ``V_max``), plus ``n_scan`` (coarse scan points, default 41).
 
     Returns
     -------
@@ -232,15 +315,13 @@ def truth_hopf(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dict[s
         ``iterations``, ``solve_time``, ``solver_builds`` (times this worker process built
         the NLP of this size: 1 when the solver is reused), ``pid``.
     """
-    from ._evaluators import load_truth  # noqa: PLC0415
-
     t0 = time.perf_counter()
-    model, options = load_truth(params, {k: v for k, v in settings.items() if k != "n_scan"})
+    model, options = load_truth(params, settings, extra_options=("n_scan",))
     A0, A1, A2 = quadratic_coefficients(model.state_matrix)
     hp = hopf_point(A0, A1, A2, V_range=(float(options.get("V_min", 0.02)),
                                          float(options.get("V_max", 4.0))),
                     n_scan=int(settings.get("n_scan", 41)))
-    return {"Vf": hp["Vf"], "omega_f": hp["omega_f"], "frequency_hz": hp["omega_f"] / (2 * np.pi),
-            "return_status": hp["return_status"], "iterations": hp["iterations"],
-            "solve_time": hp["solve_time"], "solver_builds": hp["solver_builds"],
+    return {"Vf": hp.Vf, "omega_f": hp.omega_f, "frequency_hz": hp.omega_f / (2 * np.pi),
+            "return_status": hp.return_status, "iterations": hp.iterations,
+            "solve_time": hp.solve_time, "solver_builds": hp.solver_builds,
             "pid": os.getpid(), "hopf_time": time.perf_counter() - t0}

@@ -1,8 +1,11 @@
-"""The ``pipeline`` evaluator: the whole seed-wing study (``casflutter run``) at one point.
+"""The ``pipeline`` and ``rom_flutter`` evaluators: a study run (:func:`casflutter.pipeline.run`)
+at one point.
 
-Every swept parameter and every fixed setting that is not one of the evaluator's own
-settings is a change of the run configuration by dotted path (the TOML tables of
-``problems/seed_wing/run.toml``, see :mod:`casflutter.pipeline._config`):
+``pipeline`` runs the whole study (``casflutter run``, default ``problems/seed_wing/run.toml``);
+``rom_flutter`` runs the ROM route of ``casflutter flutter`` (``problems/NAME/flutter.toml`` of
+the ``problem`` setting).  Every swept parameter and every fixed setting that is not one of
+the evaluator's own settings is a change of the run configuration by dotted path (the TOML
+tables of :class:`casflutter.pipeline.RunConfig`):
 
 - a stage's key: ``data.V0`` (nominal speed of the records), ``rom.orders`` (HWL orders
   ``[mu, na, nb, r, p, q]``), ``rom.nf`` (order of Σf, eq. 5), ``controller.order``,
@@ -15,9 +18,10 @@ settings is a change of the run configuration by dotted path (the TOML tables of
 
 The changes go through :func:`casflutter.pipeline.load_config` (``updates=``), so a point
 with an unknown or invalid name fails before any work with the configuration's own message
-(the key and what is allowed); :func:`pipeline_check`, the evaluator's pre-flight check,
-does so for every point of a study before the first one runs.  The outputs are ``RunResult.summary`` (``summary.json``)
-flattened into columns (:func:`flatten_summary`).
+(the key and what is allowed); :func:`pipeline_check`, the evaluators' pre-flight check,
+does so for every point of a study before the first one runs.  The outputs of ``pipeline``
+are ``RunResult.summary()`` (``summary.json``) flattened into columns
+(:func:`flatten_summary`).
 """
 
 from __future__ import annotations
@@ -29,21 +33,23 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from ..errors import ConfigError
+from ..pipeline import config_path, default_config_path, load_config, run
 
-__all__ = ["PIPELINE_SETTINGS", "PIPELINE_OUTPUTS", "pipeline_config", "pipeline_check",
-           "flatten_summary", "pipeline_evaluator"]
+__all__ = ["PIPELINE_SETTINGS", "PIPELINE_OUTPUTS", "ROM_FLUTTER_SETTINGS", "ROM_FLUTTER_OUTPUTS",
+           "pipeline_config", "pipeline_check", "flatten_summary", "pipeline_evaluator",
+           "rom_flutter_check", "rom_flutter_evaluator"]
 
 #: The evaluator's own settings (everything else is a configuration change).
 PIPELINE_SETTINGS = {
     "config": "base run configuration (TOML, relative to the study file; default the seed "
-              "wing's problems/seed_wing/run.toml)",
+              "wing's problems/seed_wing/run.toml, for rom_flutter problems/PROBLEM/flutter.toml)",
     "out_dir": "write each point's files (summary.json, figures, report) to "
                "OUT_DIR/<point>; relative to the working directory (default: no files)",
     "quiet": "no stage progress on stderr (default true)",
 }
 
 #: The columns :func:`pipeline_evaluator` returns (``time_<stage>`` for each of the ten
-#: stages of :func:`casflutter.pipeline.run_pipeline` besides ``time_total``).
+#: stages of the default configuration besides ``time_total``).
 PIPELINE_OUTPUTS = (
     "Vf_rom", "freq_hz_rom", "mode_rom", "Vf_truth", "freq_hz_truth", "mode_truth",
     "lco_V", "lco_kind", "lco_freq_hz", "lco_amplitude", "lco_truth_V", "lco_truth_kind",
@@ -54,6 +60,19 @@ PIPELINE_OUTPUTS = (
     "time_realize", "time_structure", "time_flutter", "time_lco", "time_lft",
     "time_controller", "time_verify", "time_suppression", "time_total",
 )
+
+
+#: The ``rom_flutter`` evaluator's own settings besides :data:`PIPELINE_SETTINGS`.
+ROM_FLUTTER_SETTINGS = {
+    "problem": "the problem whose problems/PROBLEM/flutter.toml is the base configuration "
+               "(default typical_section)",
+    "parametric": "also the parametric ROM (default false)",
+}
+
+#: The columns :func:`rom_flutter_evaluator` returns (and ``time_<stage>``).
+ROM_FLUTTER_OUTPUTS = ("Vf_truth", "Vf_rom", "Vf_frozen", "Vf_parametric", "omega_f_rom",
+                       "rom_error", "scaling_error", "identification_error",
+                       "parametric_error", "rom_stable", "rom_status")
 
 
 def _split(params: Mapping[str, Any], settings: Mapping[str, Any]):
@@ -83,8 +102,6 @@ def pipeline_config(params: Mapping[str, Any], settings: Mapping[str, Any] | Non
     ConfigError
         An unknown or invalid name or value (from :func:`casflutter.pipeline.load_config`).
     """
-    from ..pipeline import default_config_path, load_config  # noqa: PLC0415
-
     base, own, updates = _split(params, settings or {})
     path = own.get("config")
     if path is None:
@@ -123,7 +140,12 @@ def _pair(value, i):
 
 
 def flatten_summary(summary: Mapping[str, Any]) -> dict[str, Any]:
-    """One row of columns from ``RunResult.summary`` (the content of ``summary.json``).
+    """One row of columns from ``RunResult.summary()`` (the content of ``summary.json``).
+
+    Parameters
+    ----------
+    summary : mapping
+        The summary of a run.
 
     Returns
     -------
@@ -134,24 +156,25 @@ def flatten_summary(summary: Mapping[str, Any]) -> dict[str, Any]:
         stable speed intervals as ``*_lo``/``*_hi``), the suppression (``attenuation_percent``
         ...), the ROM sizes and ``time_<stage>`` [s] for every stage and ``time_total``.
     """
-    fl, ft, lco = summary["flutter"], summary["flutter_truth"], summary["lco"]
-    ctl, sup = summary["controller"], summary["suppression"]
+    fl, ft, lco = summary["flutter"], summary["flutter_truth"], summary["lco"] or {}
+    ctl, sup = summary["controller"] or {}, summary["suppression"] or {}
     amp, tamp = lco.get("amplitude"), lco.get("truth_amplitude")
     out = {
         "Vf_rom": fl["V"], "freq_hz_rom": fl["freq_hz"], "mode_rom": fl["mode"],
         "Vf_truth": ft["V"], "freq_hz_truth": ft["freq_hz"], "mode_truth": ft["mode"],
-        "lco_V": lco["V"], "lco_kind": lco["kind"], "lco_freq_hz": lco["freq_hz"],
+        "lco_V": lco.get("V"), "lco_kind": lco.get("kind"), "lco_freq_hz": lco.get("freq_hz"),
         "lco_amplitude": max(amp) if amp else None, "lco_truth_V": lco.get("truth_V"),
         "lco_truth_kind": lco.get("truth_kind"),
         "lco_truth_freq_hz": lco.get("truth_freq_hz"),
         "lco_truth_amplitude": max(tamp) if tamp else None,
-        "controller_order": ctl["order"], "gamma": ctl["gamma"],
-        "small_gain_V_lo": _pair(ctl["small_gain_V"], 0),
-        "small_gain_V_hi": _pair(ctl["small_gain_V"], 1),
-        "stable_V_lo": _pair(ctl["stable_V"], 0), "stable_V_hi": _pair(ctl["stable_V"], 1),
-        "closed_loop_stable": ctl["stable"],
-        "attenuation_percent": sup["attenuation_percent"], "lco_returns": sup["lco_returns"],
-        "suppression_V": sup["V"],
+        "controller_order": ctl.get("order"), "gamma": ctl.get("gamma"),
+        "small_gain_V_lo": _pair(ctl.get("small_gain_V"), 0),
+        "small_gain_V_hi": _pair(ctl.get("small_gain_V"), 1),
+        "stable_V_lo": _pair(ctl.get("stable_V"), 0),
+        "stable_V_hi": _pair(ctl.get("stable_V"), 1),
+        "closed_loop_stable": ctl.get("stable"),
+        "attenuation_percent": sup.get("attenuation_percent"),
+        "lco_returns": sup.get("lco_returns"), "suppression_V": sup.get("V"),
         "fit_error_max": max(summary["fit_error_percent"]), "n_params": summary["n_params"],
         "nf": summary["nf"], "nae": summary["nae"],
     }
@@ -169,7 +192,7 @@ def _point_dir(params: Mapping[str, Any]) -> str:
 
 
 def pipeline_evaluator(params: Mapping[str, Any], settings: Mapping[str, Any]) -> dict[str, Any]:
-    """Run :func:`casflutter.pipeline.run_pipeline` at one point of a sweep.
+    """Run :func:`casflutter.pipeline.run` at one point of a sweep.
 
     Parameters
     ----------
@@ -190,16 +213,85 @@ def pipeline_evaluator(params: Mapping[str, Any], settings: Mapping[str, Any]) -
     ConfigError
         Before any work, for an unknown or invalid name (:func:`pipeline_config`).
     """
-    from ..pipeline import run_pipeline  # noqa: PLC0415
+    res = _run_point(params, settings)
+    out = flatten_summary(res.summary())
+    syn = res.synthesis
+    out["synthesis_success"] = None if syn is None else bool(syn.success)
+    out["synthesis_status"] = syn.statuses[-1] if syn is not None and syn.statuses else None
+    return out
 
+
+def _run_point(params: Mapping[str, Any], settings: Mapping[str, Any]):
     cfg = pipeline_config(params, settings)
     _, own, _ = _split(params, settings)
     out_dir = own.get("out_dir")
     write = out_dir is not None
-    res = run_pipeline(cfg, out_dir=Path(str(out_dir)) / _point_dir(params) if write else None,
-                       quiet=bool(own.get("quiet", True)), write=write)
-    out = flatten_summary(res.summary)
-    syn = res.objects.get("synthesis")
-    out["synthesis_success"] = None if syn is None else bool(syn.success)
-    out["synthesis_status"] = syn.statuses[-1] if syn is not None and syn.statuses else None
+    return run(cfg, out_dir=Path(str(out_dir)) / _point_dir(params) if write else None,
+               quiet=bool(own.get("quiet", True)), write=write)
+
+
+def _rom_flutter_settings(settings: Mapping[str, Any]) -> dict:
+    """The pipeline settings of a ``rom_flutter`` point: the problem's flutter.toml as the
+    base configuration, without the parametric ROM unless asked."""
+    settings = dict(settings)
+    problem = str(settings.pop("problem", "typical_section"))
+    parametric = bool(settings.pop("parametric", False))
+    if "config" not in settings:
+        settings["config"] = str(config_path(problem, "flutter"))
+    if not parametric:
+        settings["stages"] = ["frozen"]
+    return settings
+
+
+def rom_flutter_check(params: Mapping[str, Any], settings: Mapping[str, Any]) -> None:
+    """The pre-flight check of the ``rom_flutter`` evaluator (:func:`pipeline_check` on the
+    problem's flutter configuration).
+
+    Parameters
+    ----------
+    params, settings : mapping
+        As for :func:`rom_flutter_evaluator`.
+
+    Raises
+    ------
+    ConfigError
+        An unknown or invalid name or value (the message names the key).
+    """
+    pipeline_config(params, _rom_flutter_settings(settings))
+
+
+def rom_flutter_evaluator(params: Mapping[str, Any],
+                          settings: Mapping[str, Any]) -> dict[str, Any]:
+    """The ROM route of ``casflutter flutter`` at one point of a sweep.
+
+    Parameters
+    ----------
+    params : mapping
+        Swept configuration changes by dotted path into ``problems/PROBLEM/flutter.toml``
+        (``data.V0`` nominal speed, ``rom.na``, ``flutter.n_grid``, ``problem.set.mu`` ...).
+    settings : mapping
+        :data:`ROM_FLUTTER_SETTINGS`, :data:`PIPELINE_SETTINGS` and fixed changes.
+
+    Returns
+    -------
+    dict
+        ``Vf_truth``, ``Vf_rom``, ``Vf_frozen``, ``Vf_parametric``, ``omega_f_rom``,
+        ``rom_error``, ``scaling_error``, ``identification_error``, ``parametric_error``,
+        ``rom_stable``, ``rom_status`` and ``time_<stage>`` per stage.
+
+    Raises
+    ------
+    ConfigError
+        Before any work, for an unknown or invalid name (:func:`pipeline_config`).
+    """
+    res = _run_point(params, _rom_flutter_settings(settings))
+    out = {"Vf_truth": res.flutter_truth.Vf, "Vf_rom": res.flutter.Vf,
+           "Vf_frozen": None if res.flutter_frozen is None else res.flutter_frozen.Vf,
+           "Vf_parametric": None if res.parametric is None else res.parametric.flutter.Vf,
+           "omega_f_rom": res.flutter.omega_f, "rom_error": res.rom_error,
+           "scaling_error": res.scaling_error,
+           "identification_error": res.identification_error,
+           "parametric_error": res.parametric_error, "rom_stable": res.system.rom_stable,
+           "rom_status": res.flutter.status}
+    out.update({f"time_{k}": v for k, v in res.timings.items()})
     return out

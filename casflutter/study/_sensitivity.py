@@ -23,7 +23,9 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 from scipy.linalg import eig
 
+from ..aeroelastic import find_flutter
 from ..errors import ConfigError, ConvergenceError
+from ..truth import load_problem
 
 __all__ = ["ParameterSensitivity", "FlutterSensitivity", "flutter_sensitivity",
            "flutter_speed_fd"]
@@ -134,15 +136,6 @@ class FlutterSensitivity:
                     for s in self.ranked()]}
 
 
-def _model(problem: str, params: Mapping[str, float]):
-    from ..truth import PROBLEMS  # noqa: PLC0415
-
-    if problem not in PROBLEMS:
-        raise ConfigError(f"unknown problem {problem!r}; available: {', '.join(PROBLEMS)}")
-    cls = PROBLEMS[problem]
-    return cls(cls.Params().with_updates(**params))
-
-
 def _step(value: float, rel_step: float) -> float:
     return rel_step * max(abs(value), 1.0)
 
@@ -154,7 +147,7 @@ def _matrix_derivative(problem: str, params: Mapping[str, float], name: str, V: 
     h = _step(p0, rel_step)
 
     def A_at(p):
-        return _model(problem, {**params, name: p}).state_matrix(V)
+        return load_problem(problem, {**params, name: p}).state_matrix(V)
 
     try:
         Ap, Am = A_at(p0 + h), A_at(p0 - h)
@@ -205,10 +198,9 @@ def flutter_sensitivity(problem: str = "typical_section",
     ConfigError
         Unknown problem or parameter names.
     """
-    from ..aeroelastic import find_flutter  # noqa: PLC0415
 
     params = dict(params or {})
-    model = _model(problem, params)
+    model = load_problem(problem, params)
     names = list(parameters) if parameters else model.params.parameter_names()
     valid = model.params.parameter_names()
     bad = [n for n in names if n not in valid]
@@ -264,14 +256,13 @@ def flutter_speed_fd(problem: str, name: str, *, params: Mapping[str, float] | N
 
     ``step`` defaults to ``1e-4 · max(|p|, 1)``.
     """
-    from ..aeroelastic import find_flutter  # noqa: PLC0415
 
     params = dict(params or {})
-    p0 = float(getattr(_model(problem, params).params, name))
+    p0 = float(getattr(load_problem(problem, params).params, name))
     h = step if step is not None else 1e-4 * max(abs(p0), 1.0)
 
     def Vf(p):
-        m = _model(problem, {**params, name: p})
+        m = load_problem(problem, {**params, name: p})
         r = find_flutter(m.state_matrix, V_range, n_grid=n_grid, omega=m.modal_structure().omega)
         if r.Vf is None:
             raise ConvergenceError(f"no flutter speed at {name} = {p}: {r.message}", r)

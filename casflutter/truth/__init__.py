@@ -1,4 +1,5 @@
-"""Full-order truth simulators that stand in for the paper's CFD.
+"""Full-order truth simulators that stand in for the paper's CFD, and the experiments run on
+them.
 
 Given prescribed modal displacements (and flap) they return the generalised aerodynamic
 forces ``y`` of eq. (6), so identification runs on them as it would on CFD output; their
@@ -14,25 +15,44 @@ own linear state space in the speed index ``V`` gives the true flutter speed.
 - :class:`PitchPlungeSection` -- a dimensional pitch--plunge rig section read from a TOML
   file (``kind = "pitch_plunge"``; Wagner or quasi-steady aerodynamics, polynomial pitch
   spring, flap), e.g. the Texas A&M NATA section in ``problems/nata``.
+- :func:`load_problem` -- a problem by name or file, with parameter changes.
+- :func:`truth_records` -- chirp records of a truth (the paper's CFD runs, §IV.A).
+- :func:`truth_lco`, :func:`closed_loop_truth`, :func:`suppression_run`,
+  :func:`truth_loop_sweep` -- the truth's own LCO, and the truth in closed loop with a
+  controller (the wind tunnel, paper Fig. 11).
+- :func:`frozen_aero_truth` -- the truth with its aerodynamics frozen at one speed: what a
+  ROM with the V² scaling of eq. 8 represents.
 """
 
 from ._aero import JONES_A, JONES_B, jones_C, strip_coefficients, theodorsen_T
-from ._base import AeroelasticTruth, AeroMatrices, ModalStructure, SimulationResult
+from ._base import AeroelasticTruth, AeroMatrices, SimulationResult
+from ._closed_loop import (SuppressionResult, SuppressionSettings, TruthLoopSimulation,
+                           TruthLoopSweep, closed_loop_truth, gain_schedule, suppression_run,
+                           truth_loop_matrix, truth_loop_sweep)
+from ._frozen import frozen_aero_truth
 from ._goland import GolandParams, GolandWing
-from ._seed_wing import (SEED_FREQUENCIES_HZ, SEED_MODE_NAMES, SEED_SENSOR_ROWS, SEED_U_REF,
-                         SeedWing, SeedWingParams)
+from ._lco import TruthLco, truth_lco
+from ._params import parse_sets
+from ._records import RecordSettings, truth_records
 from ._pitch_plunge import FlapCoefficients, PitchPlungeParams, PitchPlungeSection
 from ._registry import (PROBLEMS, file_problem_names, load_problem, load_problem_file,
                         problem_definition, problem_label, problem_names)
+from ._seed_wing import (SEED_FREQUENCIES_HZ, SEED_MODE_NAMES, SEED_SENSOR_ROWS, SEED_U_REF,
+                         SeedWing, SeedWingParams)
 from ._typical_section import TypicalSection, TypicalSectionParams
 
 __all__ = [
-    "AeroelasticTruth", "AeroMatrices", "ModalStructure", "SimulationResult",
+    "AeroelasticTruth", "AeroMatrices", "SimulationResult",
     "TypicalSection", "TypicalSectionParams", "GolandWing", "GolandParams",
     "SeedWing", "SeedWingParams", "SEED_FREQUENCIES_HZ", "SEED_MODE_NAMES", "SEED_SENSOR_ROWS",
     "SEED_U_REF",
     "PitchPlungeSection", "PitchPlungeParams", "FlapCoefficients",
     "PROBLEMS", "problem_names", "file_problem_names", "load_problem", "load_problem_file",
-    "problem_definition", "problem_label",
+    "problem_definition", "problem_label", "parse_sets",
+    "RecordSettings", "truth_records", "frozen_aero_truth",
+    "TruthLco", "truth_lco",
+    "TruthLoopSimulation", "closed_loop_truth", "gain_schedule", "SuppressionSettings",
+    "SuppressionResult", "suppression_run", "truth_loop_matrix", "TruthLoopSweep",
+    "truth_loop_sweep",
     "JONES_A", "JONES_B", "jones_C", "theodorsen_T", "strip_coefficients",
 ]

@@ -32,9 +32,10 @@ from scipy.interpolate import make_interp_spline
 from scipy.linalg import eigh
 
 from ..errors import ConfigError, DataError, DimensionError
+from ..structure import ModalStructure
 from ._aero import JONES_A, check_timepts, integrate_lags, sample_derivatives
 
-__all__ = ["AeroMatrices", "ModalStructure", "SimulationResult", "AeroelasticTruth"]
+__all__ = ["AeroMatrices", "SimulationResult", "AeroelasticTruth"]
 
 
 @dataclass(frozen=True)
@@ -57,65 +58,6 @@ class AeroMatrices:
     Gv: np.ndarray
     Gv1: np.ndarray
     lams: tuple[float, float]
-
-
-@dataclass(frozen=True)
-class ModalStructure:
-    """The structural data of eq. (6)-(7) for a truth model.
-
-    Attributes
-    ----------
-    omega : numpy.ndarray
-        In-vacuo natural frequencies ``omega_i`` [rad per time unit], ascending.
-    zeta : numpy.ndarray
-        Modal damping ratios ``zeta_i``.
-    alpha : float
-        Flow constant ``alpha`` of eq. (6): the structure is
-        ``u'' + 2 zeta omega u' + omega^2 u = alpha V^2 y``.
-    mode_names : tuple of str
-        A name per mode (e.g. ``"plunge"``, ``"pitch"``, ``"bending 1"``).
-    shapes : numpy.ndarray
-        ``Phi``, ``(n, N)``: physical/assumed-mode coordinates ``x = Phi u``.
-    coordinate_names : tuple of str
-        Names of the ``n`` physical coordinates.
-    sensor_rows : numpy.ndarray
-        ``Hs`` of eq. (7), ``(ns, N)``: sensor readings ``z_m = Hs u`` (displacements; the
-        accelerations are ``Hs u''``).
-    sensor_names : tuple of str
-        A name per sensor row.
-    time_unit : str
-        The unit of time of ``omega`` and of ``timepts``.
-    speed_index : str
-        The convention of the speed index ``V``.
-    """
-
-    omega: np.ndarray
-    zeta: np.ndarray
-    alpha: float
-    mode_names: tuple[str, ...]
-    shapes: np.ndarray
-    coordinate_names: tuple[str, ...]
-    sensor_rows: np.ndarray
-    sensor_names: tuple[str, ...]
-    time_unit: str
-    speed_index: str
-
-    @property
-    def n_modes(self) -> int:
-        """Number of modes ``N``."""
-        return int(self.omega.size)
-
-    def As_Bs(self) -> tuple[np.ndarray, np.ndarray]:
-        """The matrices ``As = diag(A_s^i)``, ``Bs = diag(B_s^i)`` of eq. (7)."""
-        N = self.n_modes
-        As = np.zeros((2 * N, 2 * N))
-        Bs = np.zeros((2 * N, N))
-        for i in range(N):
-            As[2 * i, 2 * i + 1] = 1.0
-            As[2 * i + 1, 2 * i] = -self.omega[i] ** 2
-            As[2 * i + 1, 2 * i + 1] = -2.0 * self.zeta[i] * self.omega[i]
-            Bs[2 * i + 1, i] = self.alpha
-        return As, Bs
 
 
 @dataclass(frozen=True)
@@ -237,25 +179,82 @@ class AeroelasticTruth(abc.ABC):
         """The same problem with some parameters changed (unknown names raise ConfigError)."""
         return type(self)(self.params.with_updates(**changes))
 
-    @classmethod
-    def from_sets(cls, sets=()):
-        """The problem with ``["name=value", ...]`` applied to the published parameters."""
-        return cls(cls.Params.from_sets(sets))
-
     @property
     def n_modes(self) -> int:
         """Number of structural modes ``N``."""
         return int(self._omega.size)
 
     def modal_structure(self) -> ModalStructure:
-        """Frequencies, damping, flow constant, mode shapes, sensor rows and names."""
+        """Σs of the truth (eq. 6-7): frequencies, damping, flow constant, mode shapes, the
+        problem's sensor rows (read as displacements unless the problem says otherwise) and
+        the names of modes, coordinates and sensors.
+
+        Returns
+        -------
+        casflutter.structure.ModalStructure
+        """
         nm = self._names()
         return ModalStructure(omega=self._omega.copy(), zeta=self._zeta(), alpha=self.alpha,
-                              mode_names=tuple(nm["mode_names"]), shapes=self._Phi.copy(),
+                              Hs=np.asarray(nm["sensor_rows"], float),
+                              sensor=nm.get("sensor", "displacement"),
+                              mode_names=tuple(nm["mode_names"]),
+                              sensor_names=tuple(nm["sensor_names"]), shapes=self._Phi.copy(),
                               coordinate_names=tuple(nm["coordinate_names"]),
-                              sensor_rows=np.asarray(nm["sensor_rows"], float),
-                              sensor_names=tuple(nm["sensor_names"]),
                               time_unit=nm["time_unit"], speed_index=nm["speed_index"])
+
+    @property
+    def mode_states(self) -> list[np.ndarray]:
+        """Indices ``[u_i, u'_i]`` of each mode in the truth's state ``[u, u', lags]`` (for the
+        origin-mode attribution of :func:`casflutter.aeroelastic.find_flutter`)."""
+        N = self.n_modes
+        return [np.array([i, N + i]) for i in range(N)]
+
+    def modal_state(self, u=None, udot=None) -> np.ndarray:
+        """The truth's structural state ``[u, u']`` of given modal displacements and
+        velocities (an initial state of :meth:`simulate`, the flow at rest).
+
+        Parameters
+        ----------
+        u, udot : array_like, shape (N,), optional
+            Modal displacements and velocities (default zero).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(2N,)``.
+        """
+        N = self.n_modes
+        x = np.zeros(2 * N)
+        for values, offset, name in ((u, 0, "u"), (udot, N, "udot")):
+            if values is None:
+                continue
+            v = np.asarray(values, dtype=float).ravel()
+            if v.size != N:
+                raise DimensionError(f"{name} has {v.size} entries, the truth has {N} modes")
+            x[offset:offset + N] = v
+        return x
+
+    def displaced_state(self, mode: int, deflection: float) -> np.ndarray:
+        """The truth's structural state ``[u, u']`` at rest with mode ``mode`` displaced.
+
+        Parameters
+        ----------
+        mode : int
+            0-based mode index.
+        deflection : float
+            Modal displacement ``u_mode``.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(2N,)``: an initial state of :meth:`simulate` (the flow at rest).
+        """
+        N = self.n_modes
+        if not 0 <= int(mode) < N:
+            raise DimensionError(f"mode {mode} is not one of the {N} modes (0-based)")
+        u = np.zeros(N)
+        u[int(mode)] = deflection
+        return self.modal_state(u)
 
     def sensor_units(self) -> tuple[str, ...]:
         """Units of the sensor rows' readings (``""`` where the problem gives none)."""
@@ -536,6 +535,27 @@ class AeroelasticTruth(abc.ABC):
 
         return f
 
+    def _simulation_inputs(self, timepts, x0, v, nx: int):
+        """Checked inputs of a simulation: the times, the full initial state (``[u, u']`` is
+        completed with the lag states at rest), the flap samples and their quintic spline
+        (``None`` without flap motion)."""
+        t = np.asarray(timepts, float)
+        if t.ndim != 1 or t.size < 2 or np.any(np.diff(t) <= 0):
+            raise DataError("timepts must be a 1-D increasing array of at least 2 samples")
+        N = self.n_modes
+        x0 = np.asarray(x0, float).reshape(-1)
+        if x0.size == 2 * N:
+            x0 = np.concatenate([x0, np.zeros(nx - 2 * N)])
+        if x0.size != nx:
+            raise DimensionError(f"x0 must have length 2N = {2 * N} or {nx} (with lag states), "
+                                 f"got {x0.size}")
+        if v is None:
+            return t, x0, np.zeros(t.size), None
+        vs = _as_1d("v", v, t.size)
+        if t.size < 6:
+            raise DataError("a flap history needs at least 6 samples")
+        return t, x0, vs, make_interp_spline(t, vs, k=5)
+
     def simulate(self, timepts: np.ndarray, x0: np.ndarray, V: float,
                  v: np.ndarray | None = None, *, rtol: float = 1e-9,
                  atol: float = 1e-12) -> SimulationResult:
@@ -560,26 +580,11 @@ class AeroelasticTruth(abc.ABC):
         -------
         SimulationResult
         """
-        t = np.asarray(timepts, float)
-        if t.ndim != 1 or t.size < 2 or np.any(np.diff(t) <= 0):
-            raise DataError("timepts must be a 1-D increasing array of at least 2 samples")
         c = self._coupled(V)
         A, Bf, Minv, N = c["A"], c["Bflap"], c["Minv"], c["N"]
         nx = A.shape[0]
-        x0 = np.asarray(x0, float).reshape(-1)
-        if x0.size == 2 * N:
-            x0 = np.concatenate([x0, np.zeros(nx - 2 * N)])
-        if x0.size != nx:
-            raise DimensionError(f"x0 must have length 2N = {2 * N} or {nx} (with lag states), "
-                                 f"got {x0.size}")
-        if v is None:
-            vs = np.zeros(t.size)
-            vfun = None
-        else:
-            vs = _as_1d("v", v, t.size)
-            if t.size < 6:
-                raise DataError("a flap history needs at least 6 samples")
-            vfun = make_interp_spline(t, vs, k=5)
+        t, x0, vs, vfun = self._simulation_inputs(timepts, x0, v, nx)
+        if vfun is not None:
             vd1, vd2 = vfun.derivative(1), vfun.derivative(2)
         Phi = self._Phi
         has_nl = self._nonlinear_force(np.zeros(Phi.shape[0])) is not None

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import dataclasses
-from typing import Any, Iterable
+from typing import Any, Iterable, Mapping
 
 from ..errors import ConfigError
 
-__all__ = ["ParamsMixin", "ChordGeometryMixin"]
+__all__ = ["ParamsMixin", "ChordGeometryMixin", "parse_sets"]
 
 
 class ParamsMixin:
@@ -46,11 +46,25 @@ class ParamsMixin:
                 for f in dataclasses.fields(cls)]
 
     def as_dict(self) -> dict[str, float]:
-        """Parameters as a plain dict."""
+        """Parameters as a plain dict.
+
+        Returns
+        -------
+        dict
+        """
         return dataclasses.asdict(self)
 
     def with_updates(self, **changes: float):
         """A copy with some parameters changed.
+
+        Parameters
+        ----------
+        **changes : float
+            New values by parameter name.
+
+        Returns
+        -------
+        Parameters of this class.
 
         Raises
         ------
@@ -66,15 +80,20 @@ class ParamsMixin:
         return dataclasses.replace(self, **changes)
 
     @classmethod
-    def from_sets(cls, sets: Iterable[str] = (), base=None):
-        """Parameters from ``["name=value", ...]`` strings (the CLI's ``--set``).
+    def from_sets(cls, sets: Mapping[str, Any] | Iterable[str] = (), base=None):
+        """Parameters with changes: a mapping ``{name: value}`` or ``["name=value", ...]``
+        strings (the CLI's ``--set``).
 
         Parameters
         ----------
-        sets : iterable of str
-            Each ``"name=value"`` with a numeric value.
+        sets : mapping or iterable of str
+            The changes, numeric values.
         base : optional
             Parameters to start from (default: the published case).
+
+        Returns
+        -------
+        Parameters of this class.
 
         Raises
         ------
@@ -82,20 +101,48 @@ class ParamsMixin:
             Malformed item, unknown name (valid names listed) or non-physical value.
         """
         base = cls() if base is None else base
+        items = sets if isinstance(sets, Mapping) else parse_sets(sets)
         changes: dict[str, float] = {}
-        for item in sets:
-            name, sep, value = str(item).partition("=")
-            name = name.strip()
-            if not sep or not name:
-                raise ConfigError(f"--set item {item!r} is not of the form name=value")
+        for name, value in items.items():
             if name not in cls.parameter_names():
                 raise ConfigError(f"unknown parameter {name!r} for {cls.__name__}; valid "
                                   f"names: {', '.join(cls.parameter_names())}")
             try:
+                if isinstance(value, bool):
+                    raise ValueError
                 changes[name] = float(value)
-            except ValueError:
+            except (TypeError, ValueError):
                 raise ConfigError(f"--set {name}={value!r}: value must be a number") from None
         return base.with_updates(**changes)
+
+
+
+def parse_sets(items: Iterable[str]) -> dict[str, str]:
+    """``["name=value", ...]`` (the CLI's ``--set``) as ``{name: value}``.
+
+    Parameters
+    ----------
+    items : iterable of str
+        The items.
+
+    Returns
+    -------
+    dict
+        Name -> value text (the parameter class converts and checks it).
+
+    Raises
+    ------
+    ConfigError
+        An item that is not of the form ``name=value``.
+    """
+    out = {}
+    for item in items:
+        name, sep, value = str(item).partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise ConfigError(f"--set item {item!r} is not of the form name=value")
+        out[name] = value.strip()
+    return out
 
 
 def require(cond: bool, message: str) -> None:

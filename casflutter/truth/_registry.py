@@ -9,7 +9,9 @@ such a file (e.g. ``nata``).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any, Iterable, Mapping
 
+from .. import _resources
 from .._resources import read_toml
 from ..errors import ConfigError
 from ._base import AeroelasticTruth
@@ -32,12 +34,6 @@ PROBLEMS: dict[str, type[AeroelasticTruth]] = {
 FILE_KINDS: dict[str, type[AeroelasticTruth]] = {PITCH_PLUNGE_KIND: PitchPlungeSection}
 
 
-def _problems_dir() -> Path:
-    from .._resources import problems_dir
-
-    return problems_dir()
-
-
 def problem_names() -> list[str]:
     """Names of the problems that have a truth simulator."""
     return list(PROBLEMS)
@@ -46,7 +42,7 @@ def problem_names() -> list[str]:
 def file_problem_names() -> list[str]:
     """Names of the folders of ``problems/`` holding a problem file (``kind = ...``)."""
     try:
-        root = _problems_dir()
+        root = _resources.problems_dir()
     except FileNotFoundError:
         return []
     out = []
@@ -75,7 +71,7 @@ def _file_of(name: str) -> Path | None:
     if path.is_dir() and (path / "problem.toml").is_file():
         return path / "problem.toml"
     if name in file_problem_names():
-        return _problems_dir() / name / "problem.toml"
+        return _resources.problems_dir() / name / "problem.toml"
     return None
 
 
@@ -116,26 +112,36 @@ def load_problem_file(path, sets=()) -> AeroelasticTruth:
                                          sets=sets)
 
 
-def load_problem(name: str, sets=()) -> AeroelasticTruth:
-    """The truth model of problem ``name`` with ``--set``-style changes applied.
+def load_problem(name: str, params: Mapping[str, Any] | Iterable[str] = ()) -> AeroelasticTruth:
+    """The truth model of problem ``name`` with parameter changes: the one way from a problem
+    name and parameters to a truth.
 
     Parameters
     ----------
     name : str
         A name from :func:`problem_names` or :func:`file_problem_names`, or the path of a
         problem TOML file (see :func:`load_problem_file`).
-    sets : iterable of str
-        ``"name=value"`` items (unknown names raise :class:`ConfigError` listing the valid
-        ones).
+    params : mapping or iterable of str
+        ``{name: value}`` or ``--set``-style ``"name=value"`` items, applied to the
+        published (or the file's) parameters (unknown names raise :class:`ConfigError`
+        listing the valid ones).
 
     Returns
     -------
     AeroelasticTruth
+
+    Raises
+    ------
+    ConfigError
+        Unknown problem or parameter, or a non-physical value.
     """
     path = _file_of(name)
     if path is not None:
+        sets = ([f"{k}={v}" for k, v in params.items()] if isinstance(params, Mapping)
+                else params)
         return load_problem_file(path, sets)
-    return _cls(name).from_sets(sets)
+    cls = _cls(name)
+    return cls(cls.Params.from_sets(params))
 
 
 def problem_label(name: str) -> str:
@@ -162,7 +168,7 @@ def problem_definition(name: str, problems_dir: str | Path | None = None) -> dic
     if path is not None:
         return read_toml(path, "problem definition")
     _cls(name)
-    root = Path(problems_dir) if problems_dir is not None else _problems_dir()
+    root = Path(problems_dir) if problems_dir is not None else _resources.problems_dir()
     path = root / name / "problem.toml"
     if not path.is_file():
         raise ConfigError(f"problem definition {path} not found; pass problems_dir= pointing "

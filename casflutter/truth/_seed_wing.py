@@ -48,8 +48,8 @@ linearisation (flutter) but it makes the lateral mode's generalised force visibl
 in the chirp responses (paper Fig. 7: "less than 1 % error in all except the 2nd mode").
 The flap is massless and prescribed; the tip store is aerodynamically inert.
 
-Calibration (issue 5; measured numbers in ``problems/seed_wing/problem.toml``)
---------------------------------------------------------------------------
+Calibration (the values it gives are recorded in ``problems/seed_wing/problem.toml``)
+-------------------------------------------------------------------------------------
 - ``ea_chord`` (static divergence): the elastic axis sits at the quarter-chord aerodynamic
   centre (a quarter-chord spar), so the lift of a twisted strip has no moment arm and there
   is no torsional divergence.  What is left is the lateral mode's store-induced twist lifting
@@ -94,11 +94,9 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 from scipy.integrate import solve_ivp
-from scipy.interpolate import make_interp_spline
 
-from ..errors import DataError, DimensionError
 from ._aero import JONES_A, JONES_B, strip_coefficients
-from ._base import AeroelasticTruth, AeroMatrices, SimulationResult, _as_1d
+from ._base import AeroelasticTruth, AeroMatrices, SimulationResult
 from ._goland import _bending_shapes
 from ._params import ChordGeometryMixin, ParamsMixin, require
 
@@ -378,26 +376,12 @@ class SeedWing(AeroelasticTruth):
         SimulationResult
             ``y`` are the (nonlinear) generalised-force coefficients of eq. (6).
         """
-        t = np.asarray(timepts, float)
-        if t.ndim != 1 or t.size < 2 or np.any(np.diff(t) <= 0):
-            raise DataError("timepts must be a 1-D increasing array of at least 2 samples")
         V = self._check_V(V)
         c = self._coupled(V)
         N, ng = c["N"], c["ng"]
         nx = 2 * N + 2 * ng
-        x0 = np.asarray(x0, float).reshape(-1)
-        if x0.size == 2 * N:
-            x0 = np.concatenate([x0, np.zeros(nx - 2 * N)])
-        if x0.size != nx:
-            raise DimensionError(f"x0 must have length 2N = {2 * N} or {nx} (with lag states), "
-                                 f"got {x0.size}")
-        if v is None:
-            vs, vfun = np.zeros(t.size), None
-        else:
-            vs = _as_1d("v", v, t.size)
-            if t.size < 6:
-                raise DataError("a flap history needs at least 6 samples")
-            vfun = make_interp_spline(t, vs, k=5)
+        t, x0, vs, vfun = self._simulation_inputs(timepts, x0, v, nx)
+        if vfun is not None:
             vd1, vd2 = vfun.derivative(1), vfun.derivative(2)
         forces_at = self._forces(V, linear)
 
@@ -530,5 +514,6 @@ class SeedWing(AeroelasticTruth):
                 "coordinate_names": tuple(f"u{i + 1} ({n})" for i, n in enumerate(SEED_MODE_NAMES)),
                 "sensor_rows": np.asarray(SEED_SENSOR_ROWS, float),
                 "sensor_names": ("Acc1 (bending/torsion)", "Acc2 (lateral)"),
+                "sensor": "acceleration",
                 "time_unit": "s",
                 "speed_index": "V = U / U_ref, U_ref = 28.9 m/s (Table I)"}

@@ -201,7 +201,7 @@ def verify_controller(P: SystemLike, K: SystemLike, nmeas: int, ncon: int, *,
     n_delta : int, optional
         The first ``n_delta`` inputs/outputs of ``P`` are ``wf``/``zf`` (eq. 13-15).
     delta_channel : int, optional
-        Alias of ``n_delta`` (the name used in the issue).
+        Alias of ``n_delta``.
     method : {"auto", "slycot", "scipy"}
         H∞ norm implementation, see :func:`hinf_norm`.
     tol : float

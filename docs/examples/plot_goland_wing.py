@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from casflutter.aeroelastic import find_flutter
-from casflutter.pipeline import rom_flutter, rom_settings
+from casflutter.pipeline import config_path, load_config, run
 from casflutter.report import plot_vg_vf
 from casflutter.truth import load_problem, problem_definition
 
@@ -55,20 +55,22 @@ fig.axes[1].set_xlabel(r"speed index $V = U/(b\,\omega_{ref})$"
 # The ROM route.  Records of the truth are taken at :math:`V_0`; the single-speed ROM with the
 # :math:`V^2` scaling over-predicts the flutter speed, and the truth with its aerodynamics frozen
 # at :math:`V_0` shows that this error is the scaling's, not the identification's.  A parametric
-# ROM (ROMs at several speeds, interpolated in V) follows the truth.
-settings = rom_settings("goland", n_speeds=3 if QUICK else 7, duration=1.0 if QUICK else 2.0,
-                        n_grid=61 if QUICK else 201)
-route = rom_flutter(wing, settings, parametric=True)
-for name, res in (("truth", route.truth), (f"ROM at V0 = {settings.V0}", route.rom),
-                  ("frozen-aero truth", route.frozen), ("parametric ROM", route.parametric)):
+# ROM (ROMs at several speeds, interpolated in V) follows the truth.  The route is the
+# configuration ``problems/goland/flutter.toml`` of the study run (``casflutter flutter``).
+config = load_config(config_path("goland", "flutter"), updates={
+    "parametric.n_speeds": 3 if QUICK else 7, "data.duration": 1.0 if QUICK else 2.0,
+    "flutter.n_grid": 61 if QUICK else 201})
+route = run(config, quiet=True, write=False)
+models = (("truth", route.flutter_truth), (f"ROM at V0 = {config.data.V0}", route.flutter),
+          ("frozen-aero truth", route.flutter_frozen),
+          ("parametric ROM", route.parametric.flutter))
+for name, res in models:
     print(f"{name:>20}: V_f = {res.Vf:.4f} ({res.Vf * b * omega_ref:6.1f} m/s), "
           f"omega_f = {res.omega_f:.1f} rad/s")
 print(route.explanation())
 
 fig, ax = plt.subplots(figsize=(6.5, 3.5))
-for res, style, label in ((route.truth, "k-", "truth"), (route.rom, "C1--", "ROM at V0"),
-                          (route.frozen, "C0:", "frozen-aero truth"),
-                          (route.parametric, "C2-.", "parametric ROM")):
+for (label, res), style in zip(models, ("k-", "C1--", "C0:", "C2-.")):
     tr = res.tracking
     ax.plot(tr.V, tr.damping_ratio[:, res.flutter.branch], style, label=label)
 ax.axhline(0.0, color="0.6", lw=0.8)

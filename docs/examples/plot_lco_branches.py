@@ -26,7 +26,6 @@ import matplotlib.pyplot as plt
 import numpy as np
 from scipy.optimize import fsolve
 
-from casflutter.aeroelastic import ModalStructure
 from casflutter.ident import HWLModel
 from casflutter.lco import LCOSettings, lco_branch, rom_lco_branch
 from casflutter.report import plot_bifurcation, plot_bifurcation_pair
@@ -108,7 +107,7 @@ truth = load_problem("seed_wing")
 wing = lco_branch(truth, (0.8, 1.5), wing_settings)
 ms = truth.modal_structure()
 rom = HWLModel.load(problems_dir() / "seed_wing_rom" / "rom.npz")
-structure = ModalStructure(ms.omega, ms.zeta, ms.alpha, Hs=ms.sensor_rows, sensor="displacement")
+structure = ms.with_sensors(kind="displacement")
 rom_branch = rom_lco_branch(rom, structure, (0.8, 1.5), LCOSettings(max_points=10 if QUICK else 60),
                             mode_names=ms.mode_names, sensor_names=ms.sensor_names,
                             problem="seed wing ROM loop", speed_scale=truth.airspeed(1.0),

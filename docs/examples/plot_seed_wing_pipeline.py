@@ -2,7 +2,7 @@
 The paper's study end to end on the seed wing (``casflutter run``)
 ==================================================================
 
-:func:`casflutter.pipeline.run_pipeline` is what ``make demo`` (``casflutter run``) does:
+:func:`casflutter.run` is what ``make demo`` (``casflutter run``) does:
 on the seed wing (the paper's wind-tunnel wing with tip store: five modes at 2.19, 10.07,
 13.55, 16.48 and 38.09 Hz, nonlinear strip aerodynamics standing in for the CFD)
 
@@ -29,13 +29,13 @@ import tempfile
 
 import numpy as np
 
-from casflutter.pipeline import load_config, run_pipeline
+import casflutter as cf
 from casflutter.report import plot_gain_ramp, plot_lco, plot_pole_loci
 
-config = load_config()   # problems/seed_wing/run.toml
+config = cf.load_config()   # problems/seed_wing/run.toml
 out_dir = tempfile.mkdtemp(prefix="casflutter-run-")
-result = run_pipeline(config, out_dir=out_dir, quiet=True)
-s = result.summary
+result = cf.run(config, out_dir=out_dir, quiet=True)
+s = result.summary()        # the content of summary.json
 
 print(f"HWL orders {s['orders']}, {s['n_params']} parameters; fit error per mode [%]:",
       ", ".join(f"{e:.2f}" for e in s["fit_error_percent"]))
@@ -61,22 +61,21 @@ print("files:", sorted(p.name for p in result.files.values()))
 # The nonlinear ROM in feedback with the structure at the LCO speed, beside the truth (paper
 # Fig. 9): sensor time histories and their spectra.  This figure, Fig. 7, 8, 10 and 11 and
 # ``summary.json`` are also written to the output folder and embedded in ``report.html``
-# beside the paper's Table I; here they are drawn again from the live objects of the run.
-objects = result.objects
-fig = plot_lco(objects["lco"], truth=objects.get("lco_truth"))
+# beside the paper's Table I; here they are drawn again from the typed results of the run.
+fig = plot_lco(result.lco.rom, truth=result.lco.truth)
 
 # %%
 # The poles of ΣAE(V) over the speed range, open loop and closed with the controller (paper
 # Fig. 10), zoomed on the structural modes: the far aerodynamic and controller poles would set
 # the scale otherwise.
-V_grid = np.linspace(max(config.flutter.vrange[0], 1e-3), config.flutter.vrange[1], 60)
-fig = plot_pole_loci(objects["system"], V_grid, controller=objects["controller"])
-w_max = 1.3 * float(np.max(objects["system"].structure.omega))
+V_grid = np.linspace(max(config.flutter.V_range[0], 1e-3), config.flutter.V_range[1], 60)
+fig = plot_pole_loci(result.system, V_grid, controller=result.controller)
+w_max = 1.3 * float(np.max(result.system.structure.omega))
 fig.axes[0].set_xlim(-0.125 * w_max, 0.05 * w_max)
 fig.axes[0].set_ylim(0.0, w_max)
 
 # %%
 # The truth's sensors above its own flutter speed while the controller gain ramps from 0 to 1
 # and is released again (paper Fig. 11); the attenuation printed above is measured on it.
-sup = objects["suppression"]
-fig = plot_gain_ramp(sup["timepts"], sup["zm"], sup["gain"], sup["v"])
+sim = result.suppression.simulation
+fig = plot_gain_ramp(sim.timepts, sim.zm, sim.gain, sim.v)

@@ -19,7 +19,7 @@ import os
 import matplotlib.pyplot as plt
 
 from casflutter.aeroelastic import find_flutter
-from casflutter.pipeline import rom_flutter, rom_settings
+from casflutter.pipeline import config_path, load_config, run
 from casflutter.report import plot_root_locus, plot_vg_vf
 from casflutter.truth import load_problem, problem_definition
 
@@ -54,18 +54,19 @@ fig = plot_root_locus(result)
 # The ROM route (the paper's method on this truth).  The ROM is identified at a single
 # speed :math:`V_0`; the :math:`V^2` scaling of ΣAE then freezes the aerodynamic time scale at :math:`V_0`
 # (reduced frequency and lag rates), which is the error the explanation quantifies.  A
-# parametric ROM identified at several speeds and interpolated in :math:`V` removes it.
-settings = rom_settings("typical_section", n_speeds=3 if QUICK else 7,
-                        n_grid=61 if QUICK else 201)
-route = rom_flutter(truth, settings, parametric=True)
-for name, res in (("truth", route.truth), (f"ROM at V0 = {settings.V0}", route.rom),
-                  ("parametric ROM", route.parametric)):
+# parametric ROM identified at several speeds and interpolated in :math:`V` removes it.  The
+# route is the configuration ``problems/typical_section/flutter.toml`` of the study run.
+config = load_config(config_path("typical_section", "flutter"), updates={
+    "parametric.n_speeds": 3 if QUICK else 7, "flutter.n_grid": 61 if QUICK else 201})
+route = run(config, quiet=True, write=False)
+models = (("truth", route.flutter_truth), (f"ROM at V0 = {config.data.V0}", route.flutter),
+          ("parametric ROM", route.parametric.flutter))
+for name, res in models:
     print(f"{name:>20}: V_f = {res.Vf:.4f}, omega_f = {res.omega_f:.4f}")
 print(route.explanation())
 
 fig, axes = plt.subplots(2, 1, sharex=True, figsize=(6.5, 5.5))
-for res, style, label in ((route.truth, "k-", "truth"), (route.rom, "C1--", "ROM at V0"),
-                          (route.parametric, "C2:", "parametric ROM")):
+for (label, res), style in zip(models, ("k-", "C1--", "C2:")):
     tr = res.tracking
     b = res.flutter.branch
     axes[0].plot(tr.V, tr.damping_ratio[:, b], style, label=label)

@@ -5,7 +5,8 @@ from __future__ import annotations
 import control
 import numpy as np
 
-from casflutter.aeroelastic import AeroelasticSystem, ModalStructure
+from casflutter.aeroelastic import AeroelasticSystem
+from casflutter.structure import ModalStructure
 
 #: Two-mode binary-flutter case: static Σf with a non-symmetric stiffness coupling.
 OMEGA2 = np.array([10.0, 25.0])

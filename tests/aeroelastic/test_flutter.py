@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from casflutter.aeroelastic import (AeroelasticSystem, ModalStructure, find_flutter,
-                                    track_eigenvalues)
+from casflutter.aeroelastic import AeroelasticSystem, find_flutter, track_eigenvalues
+from casflutter.structure import ModalStructure
+from casflutter import truth
 from casflutter.errors import ConfigError
 
 from ._cases import binary_system, spectral_abscissa_bisection
@@ -139,7 +140,6 @@ def test_truth_typical_section_hp1_published_values():
     """Hodges & Pierce HP-1 typical section (truth simulator's own state_matrix, Jones
     aerodynamics): published V_F = 2.170, Ω_F/ω_θ = 0.644 (rtol 0.005) and the analytic
     divergence speed √(μ r²/(1 + 2a)) = √8."""
-    truth = pytest.importorskip("casflutter.truth")
     m = truth.load_problem("typical_section")
     ref = truth.problem_definition("typical_section")["reference"]
     N = m.n_modes
@@ -158,7 +158,6 @@ def test_truth_typical_section_hp1_published_values():
 def test_truth_goland_wing_tracking_agrees_with_bisection():
     """30-state Goland wing (7 modes, Jones lags): tracked Vf equals the independent
     spectral-abscissa bisection to 1e-8; the critical branch comes from the first torsion mode."""
-    truth = pytest.importorskip("casflutter.truth")
     m = truth.load_problem("goland")
     ms = m.modal_structure()
     N = m.n_modes
@@ -189,3 +188,16 @@ def test_adaptive_refinement_keeps_branch_identity_on_a_coarse_grid():
         on1 = np.allclose(k2, 25 + 30 * tr.V ** 2, rtol=1e-9)
         on2 = np.allclose(k2, 64 - 30 * tr.V ** 2, rtol=1e-9)
         assert on1 != on2
+
+
+def test_truth_supplies_its_own_mode_states_and_frequencies():
+    """A truth passed as it is: the origin modes come from its own state layout and
+    frequencies, the same as when they are given explicitly."""
+    T = truth.TypicalSection()
+    res = find_flutter(T, (0.5, 3.0), n_grid=61)
+    assert T.modal_structure().mode_names[res.flutter_mode] == "pitch"
+    N = T.n_modes
+    ref = find_flutter(T.state_matrix, (0.5, 3.0), n_grid=61,
+                       mode_states=[np.array([i, N + i]) for i in range(N)],
+                       omega=T.modal_structure().omega)
+    assert res.Vf == ref.Vf and np.array_equal(res.origin, ref.origin)

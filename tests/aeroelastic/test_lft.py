@@ -75,7 +75,8 @@ def test_loop_shifting_of_d22():
 def test_lft_closure_random_systems(seed):
     """Random Σf (N = 1..3 modes, order 0..4, with/without flap) and random sensors."""
     import control
-    from casflutter.aeroelastic import AeroelasticSystem, ModalStructure
+    from casflutter.aeroelastic import AeroelasticSystem
+    from casflutter.structure import ModalStructure
     rng = np.random.default_rng(seed)
     N, nf = int(rng.integers(1, 4)), int(rng.integers(0, 5))
     sensor = ["acceleration", "velocity", "displacement", "state"][seed % 4]

@@ -6,7 +6,8 @@ import pytest
 from matplotlib.figure import Figure
 from numpy.testing import assert_allclose
 
-from casflutter.aeroelastic import find_flutter, simulate_loop, ModalStructure
+from casflutter.aeroelastic import find_flutter, simulate_loop
+from casflutter.structure import ModalStructure
 from casflutter.errors import DimensionError
 from casflutter.report import plot_lco, plot_pole_loci, plot_root_locus, plot_vg_vf
 

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from casflutter.aeroelastic import (AeroelasticSystem, ModalStructure, aeroelastic_loop,
-                                    split_sigma_f)
+from casflutter.aeroelastic import AeroelasticSystem, aeroelastic_loop, split_sigma_f
+from casflutter.structure import ModalStructure
 from casflutter.errors import ConfigError, DimensionError
 
 from ._cases import binary_system

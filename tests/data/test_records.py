@@ -5,7 +5,7 @@ import pytest
 from scipy.io import savemat
 
 from casflutter.data import IOData, chirp_excitation
-from casflutter.errors import DataError
+from casflutter.errors import ConfigError, DataError
 
 
 @pytest.fixture
@@ -75,5 +75,5 @@ def test_chirp_band_and_decorrelation():
     corr = np.corrcoef(x.T)
     assert np.abs(corr[np.triu_indices(3, 1)]).max() < 0.3
     np.testing.assert_array_equal(x, chirp_excitation(4000, dt, 3, band=(1.0, 30.0), seed=1))
-    with pytest.raises(DataError, match="Nyquist"):
+    with pytest.raises(ConfigError, match="Nyquist"):
         chirp_excitation(100, 0.1, 1, band=(0.1, 6.0))

@@ -8,7 +8,7 @@ import pytest
 
 from casflutter.lco import lco_branch
 from casflutter.truth import load_problem
-from casflutter.truth._flutter import find_flutter
+from casflutter.aeroelastic import find_flutter
 
 from ._helpers import measure
 
@@ -22,7 +22,7 @@ def nata():
 def test_branch_shape(nata):
     truth, br = nata
     h = br.hopf
-    assert h.V == pytest.approx(find_flutter(truth, 2.0, 25.0).V, rel=1e-9)
+    assert h.V == pytest.approx(find_flutter(truth, (2.0, 25.0), n_grid=60).Vf, rel=1e-9)
     assert h.kind == "subcritical" and h.consistent and h.branch_direction == -1
     assert h.normal_form_agreement == pytest.approx(1.0, abs=0.01)
     assert br.outputs == ("heave", "pitch")
@@ -44,8 +44,8 @@ def test_stable_branch_against_simulation(nata):
     p = min(stable, key=lambda q: abs(q.V - 14.0))
     t = np.arange(0.0, 60.0, 0.002)
     sim = truth.simulate(t, _release(truth, 0.01), p.V)
-    pitch = sim.u @ truth.modal_structure().sensor_rows[1]
-    heave = sim.u @ truth.modal_structure().sensor_rows[0]
+    pitch = sim.u @ truth.modal_structure().Hs[1]
+    heave = sim.u @ truth.modal_structure().Hs[0]
     a_p, f_p = measure(t, pitch)
     a_h, _ = measure(t, heave)
     assert a_p == pytest.approx(p.amplitude["pitch"], rel=0.02)
@@ -60,7 +60,7 @@ def test_hysteresis_below_the_flutter_speed(nata):
     i = br.folds[0].index
     pu = min(br.points[:i], key=lambda q: abs(q.V - 10.0))
     t = np.arange(0.0, 60.0, 0.002)
-    rows = truth.modal_structure().sensor_rows[1]
+    rows = truth.modal_structure().Hs[1]
     small = truth.simulate(t, 0.9 * pu.state, pu.V)
     large = truth.simulate(t, 1.1 * pu.state, pu.V)
     assert np.max(np.abs(small.u[-5000:] @ rows)) < 0.1 * pu.amplitude["pitch"]

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from casflutter.aeroelastic import ModalStructure, simulate_loop
+from casflutter.aeroelastic import simulate_loop
 from casflutter.ident import HWLModel
 from casflutter.lco import LCOSettings, rom_lco_branch, rom_loop_map
 from casflutter.truth import SeedWing
@@ -22,7 +22,7 @@ ROM = Path(__file__).resolve().parents[2] / "problems" / "seed_wing_rom" / "rom.
 def loop():
     rom = HWLModel.load(ROM)
     ms = SeedWing().modal_structure()
-    st = ModalStructure(ms.omega, ms.zeta, ms.alpha, Hs=ms.sensor_rows, sensor="displacement")
+    st = ms.with_sensors(kind="displacement")
     return rom, st, ms
 
 
@@ -100,7 +100,7 @@ def test_accelerometer_outputs_against_simulate_loop(loop):
     """With sensor_kind="acceleration" the sensors are Hs u'' read at t_k as simulate_loop
     reads accelerometers (the held force of the previous step)."""
     rom, st, ms = loop
-    acc = ModalStructure(st.omega, st.zeta, st.alpha, Hs=st.Hs, sensor="acceleration")
+    acc = st.with_sensors(kind="acceleration")
     br = rom_lco_branch(rom, acc, (0.6, 1.32), LCOSettings(harmonics=8, sensor_kind="acceleration"),
                         mode_names=ms.mode_names, sensor_names=ms.sensor_names)
     p = br.points[-1]

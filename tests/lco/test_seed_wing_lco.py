@@ -24,7 +24,7 @@ def seed():
 def _signals(truth, sim):
     ms = truth.modal_structure()
     out = {n: sim.u[:, i] for i, n in enumerate(ms.mode_names)}
-    out.update({n: sim.u @ ms.sensor_rows[j] for j, n in enumerate(ms.sensor_names)})
+    out.update({n: sim.u @ ms.Hs[j] for j, n in enumerate(ms.sensor_names)})
     return out
 
 

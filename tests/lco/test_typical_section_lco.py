@@ -102,7 +102,7 @@ def test_against_time_simulation(cubic):
         p = min(br.points, key=lambda q: abs(q.V - target))
         t = np.arange(0.0, 900.0, 0.05)
         sim = truth.simulate(t, [0.0, 0.02, 0.0, 0.0], p.V)
-        theta = sim.u @ truth.modal_structure().sensor_rows[1]
+        theta = sim.u @ truth.modal_structure().Hs[1]
         amp, freq = measure(t, theta)
         assert amp == pytest.approx(p.amplitude["theta"], rel=0.02)
         assert freq == pytest.approx(p.freq_hz, rel=0.02)
@@ -129,7 +129,7 @@ def test_subcritical_spring_has_a_fold_and_hysteresis():
     # an unstable cycle between fold and Hopf, and the stable one at the same speed
     pu = next(p for p in br.points[:i] if not p.stable and fold.V + 0.05 < p.V < h.V - 0.05)
     t = np.arange(0.0, 600.0, 0.05)
-    rows = truth.modal_structure().sensor_rows[1]
+    rows = truth.modal_structure().Hs[1]
     inside = truth.simulate(t, 0.95 * pu.state, pu.V)
     outside = truth.simulate(t, 1.05 * pu.state, pu.V)
     th_in, th_out = inside.u @ rows, outside.u @ rows

@@ -25,6 +25,9 @@ duration = 3.0
 order = 2
 starts = 1
 max_outer = 4
+nslots = 8
+stability_margin = 1e-4
+max_stab_rounds = 8
 [suppression]
 settle = 2.0
 ramp = 1.0

@@ -15,9 +15,7 @@ import pytest
 from casflutter.aeroelastic import AeroelasticSystem, build_lft
 from casflutter.errors import ConfigError
 from casflutter.pipeline import load_config
-from casflutter.pipeline._suppression import (accelerometer_structure, closed_loop_truth,
-                                              sensor_rows_of, suppression_run, truth_lco)
-from casflutter.truth import load_problem
+from casflutter.truth import closed_loop_truth, load_problem, suppression_run, truth_lco
 
 #: paper §IV, the sensor locations in modal coordinates as printed
 PAPER_ROWS = [[0.1299, -0.0006, -0.2866, -0.1130, 0.0766],
@@ -29,6 +27,16 @@ S = np.array([[2.0, 0.5], [-0.3, 1.5]])
 @pytest.fixture(scope="module")
 def wing():
     return load_problem("seed_wing")
+
+
+def accelerometer_structure(truth, rows=None):
+    """Σs of the truth read by accelerometers at ``rows`` (default: its own)."""
+    return truth.modal_structure().with_sensors(rows, "acceleration")
+
+
+def sensor_rows_of(truth, rows=None):
+    """``Hs`` of the truth with ``rows`` (default: its own)."""
+    return truth.modal_structure().with_sensors(rows).Hs
 
 
 def _sigma_f(seed: int = 0, n: int = 8, N: int = 5) -> control.StateSpace:
@@ -50,14 +58,14 @@ def test_default_rows_are_the_papers(wing):
     after = accelerometer_structure(wing, sensor_rows_of(wing, cfg.sensors.rows))
     for name in ("omega", "zeta", "Hs"):
         np.testing.assert_array_equal(getattr(after, name), getattr(before, name))
-    np.testing.assert_array_equal(after.Hs, ms.sensor_rows)
+    np.testing.assert_array_equal(after.Hs, ms.Hs)
     assert after.sensor == "acceleration" and after.alpha == before.alpha
 
 
 def test_explicit_paper_rows_equal_the_default(wing):
     cfg = load_config(updates={"sensors.rows": PAPER_ROWS})
     np.testing.assert_array_equal(sensor_rows_of(wing, cfg.sensors.rows),
-                                  wing.modal_structure().sensor_rows)
+                                  wing.modal_structure().Hs)
 
 
 @pytest.mark.parametrize("rows, words", [
@@ -82,8 +90,8 @@ def test_rows_in_the_toml_file(tmp_path):
     path.write_text("[sensors]\nrows = [[1.0, 0, 0, 0, 0], [0, 1, 0, 0, 0], [0, 0, 0, 1, 0]]\n")
     assert load_config(path).sensors.rows == [[1.0, 0, 0, 0, 0], [0, 1, 0, 0, 0],
                                                [0, 0, 0, 1, 0]]
-    path.write_text("[sensors]\nrows = [[1.0, 0, 0, 0, 0]]\nkind = 'velocity'\n")
-    with pytest.raises(ConfigError, match="unknown key 'kind' in \\[sensors\\]"):
+    path.write_text("[sensors]\nrows = [[1.0, 0, 0, 0, 0]]\nkinds = 'velocity'\n")
+    with pytest.raises(ConfigError, match="unknown key 'kinds' in \\[sensors\\]"):
         load_config(path)
     # the row length follows the problem: the typical section has two modes
     path.write_text("[problem]\nname = 'typical_section'\n[sensors]\nrows = [[1.0, 0, 0]]\n")
@@ -119,9 +127,9 @@ def test_truth_lco_reads_the_given_rows(wing):
     kw = dict(V=1.0, duration=0.4, mode=1, deflection=0.01, dt=0.002)
     ref = truth_lco(wing, **kw)
     mixed = truth_lco(wing, **kw, sensor_rows=S @ np.asarray(PAPER_ROWS))
-    np.testing.assert_allclose(mixed["zm"], ref["zm"] @ S.T, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(mixed.zm, ref.zm @ S.T, rtol=1e-10, atol=1e-12)
     single = truth_lco(wing, **kw, sensor_rows=[PAPER_ROWS[1]])
-    np.testing.assert_allclose(single["zm"][:, 0], ref["zm"][:, 1], rtol=1e-10, atol=1e-14)
+    np.testing.assert_allclose(single.zm[:, 0], ref.zm[:, 1], rtol=1e-10, atol=1e-14)
 
 
 def test_closed_loop_with_mixed_rows_and_unmixed_controller_is_the_same_loop(wing):
@@ -130,18 +138,17 @@ def test_closed_loop_with_mixed_rows_and_unmixed_controller_is_the_same_loop(win
     K = control.ss([[-30.0]], [[0.005, -0.001]], [[0.3]], [[1e-3, -5e-4]])
     Kmix = control.ss(K.A, K.B @ np.linalg.inv(S), K.C, K.D @ np.linalg.inv(S))
     t = np.arange(0.0, 0.3, 0.002)
-    x0 = np.zeros(10)
-    x0[1] = 0.01
+    x0 = wing.displaced_state(1, 0.01)
     a = closed_loop_truth(wing, K, 1.2, t, x0, lambda tt: 1.0)
     b = closed_loop_truth(wing, Kmix, 1.2, t, x0, lambda tt: 1.0,
                           sensor_rows=S @ np.asarray(PAPER_ROWS))
-    assert np.isfinite(a["zm"]).all() and np.abs(a["v"]).max() > 0
-    np.testing.assert_allclose(b["v"], a["v"], rtol=1e-9, atol=1e-12)
-    np.testing.assert_allclose(b["zm"], a["zm"] @ S.T, rtol=1e-9, atol=1e-10)
+    assert np.isfinite(a.zm).all() and np.abs(a.v).max() > 0
+    np.testing.assert_allclose(b.v, a.v, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(b.zm, a.zm @ S.T, rtol=1e-9, atol=1e-10)
 
 
 def test_suppression_run_uses_the_configured_rows(wing):
-    """suppression_run reads cfg.sensors.rows (as run_pipeline's other stages do)."""
+    """The suppression run reads the configured rows (as the run's other stages do)."""
     base = load_config(updates={"suppression": {"settle": 0.15, "ramp": 0.05, "hold": 0.1,
                                                 "release": 0.05}})
     mixed = load_config(updates={"suppression": {"settle": 0.15, "ramp": 0.05, "hold": 0.1,
@@ -149,10 +156,13 @@ def test_suppression_run_uses_the_configured_rows(wing):
                                  "sensors.rows": (S @ np.asarray(PAPER_ROWS)).tolist()})
     K = control.ss([], [], [], [[3e-3, -1e-3]])
     Kmix = control.ss([], [], [], K.D @ np.linalg.inv(S))
-    a = suppression_run(wing, K, base, 1.1, dt=0.002, mode=1)
-    b = suppression_run(wing, Kmix, mixed, 1.1, dt=0.002, mode=1)
-    np.testing.assert_allclose(b["zm"], a["zm"] @ S.T, rtol=1e-9, atol=1e-10)
-    np.testing.assert_allclose(b["v"], a["v"], rtol=1e-9, atol=1e-12)
+    kw = dict(dt=0.002, mode=1, deflection=base.lco.initial_deflection)
+    a = suppression_run(wing, K, 1.1, base.suppression, sensor_rows=base.sensors.rows or None,
+                        **kw).simulation
+    b = suppression_run(wing, Kmix, 1.1, mixed.suppression,
+                        sensor_rows=mixed.sensors.rows or None, **kw).simulation
+    np.testing.assert_allclose(b.zm, a.zm @ S.T, rtol=1e-9, atol=1e-10)
+    np.testing.assert_allclose(b.v, a.v, rtol=1e-9, atol=1e-12)
 
 
 def test_sweep_parameter_reaches_the_configuration():

@@ -34,6 +34,7 @@ starts = 1
 max_outer = 1
 nslots = 2
 max_stab_rounds = 2
+stability_margin = 1e-4
 {sensors}
 [suppression]
 settle = 1.5
@@ -89,10 +90,10 @@ def test_swept_parameters_take_effect(swept):
         # the requested order, not the base file's 3
         assert r["controller_order"] == r["controller.order"]
         # the damping reached the truth: its flutter speed is that of the truth built
-        # directly with the same damping (same search as run_pipeline)
+        # directly with the same damping (same search as the run)
         truth = load_problem("seed_wing", [f"zeta_lateral={r['problem.set.zeta_lateral']}"])
         N = truth.n_modes
-        direct = find_flutter(truth, (0.05, 2.5), n_grid=61, max_refine=3,
+        direct = find_flutter(truth.state_matrix, (0.05, 2.5), n_grid=61, max_refine=3,
                               mode_states=[np.array([i, N + i]) for i in range(N)],
                               omega=truth.modal_structure().omega)
         np.testing.assert_allclose(r["Vf_truth"], direct.Vf, rtol=1e-12)
@@ -107,7 +108,7 @@ def test_swept_parameters_take_effect(swept):
 
 def test_swept_point_equals_a_direct_run(swept):
     """The same point run directly from a config file that spells the values out."""
-    from casflutter.pipeline import load_config, run_pipeline
+    from casflutter.pipeline import load_config, run
 
     folder, _, _, rows = swept
     r = rows[0]
@@ -117,9 +118,9 @@ def test_swept_point_equals_a_direct_run(swept):
                                                f"{r['problem.set.zeta_lateral']!r}}}",
                                    sensors=f"[sensors]\nrows = {r['sensors.rows']!r}"))
     cfg = load_config(path)
-    run = run_pipeline(cfg, write=False, quiet=True)
-    s = run.summary
-    _check_sensor_rows_reach_every_stage(run, cfg, np.asarray(r["sensors.rows"]))
+    result = run(cfg, write=False, quiet=True)
+    s = result.summary()
+    _check_sensor_rows_reach_every_stage(result, cfg, np.asarray(r["sensors.rows"]))
     expected = {
         "Vf_rom": s["flutter"]["V"], "freq_hz_rom": s["flutter"]["freq_hz"],
         "mode_rom": s["flutter"]["mode"], "Vf_truth": s["flutter_truth"]["V"],
@@ -144,41 +145,38 @@ def test_swept_point_equals_a_direct_run(swept):
     assert set(s["timings_s"]) == {k[len("time_"):] for k in r if k.startswith("time_")}
 
 
-def _check_sensor_rows_reach_every_stage(run, cfg, R):
+def _check_sensor_rows_reach_every_stage(result, cfg, R):
     """The configured rows R read every stage: Σs, the LFT (eq. 14) and the truth's LCO and
     suppression records equal R times the same quantities computed independently with one
     accelerometer per mode (identity rows)."""
     from casflutter.aeroelastic import AeroelasticSystem, build_lft
-    from casflutter.pipeline._suppression import (accelerometer_structure, closed_loop_truth,
-                                                  truth_lco)
+    from casflutter.truth import closed_loop_truth, truth_lco
 
-    ob = run.objects
-    truth, system, lft = ob["truth"], ob["system"], ob["lft"]
+    truth, system, lft = result.truth, result.system, result.lft
     np.testing.assert_array_equal(system.structure.Hs, R)
-    assert run.summary["n_sensors"] == lft.nmeas == R.shape[0]
-    eye = build_lft(AeroelasticSystem.from_parts(ob["realization"].sigma_f,
-                                                 accelerometer_structure(truth, np.eye(5)),
-                                                 warn_unstable=False), lft.Vf)
+    assert result.summary()["n_sensors"] == lft.nmeas == R.shape[0]
+    eye = build_lft(AeroelasticSystem.from_parts(
+        result.realization.sigma_f, truth.modal_structure().with_sensors(np.eye(5),
+                                                                         "acceleration"),
+        warn_unstable=False), lft.Vf)
     for name in ("C2", "D21", "D22"):
         np.testing.assert_allclose(getattr(lft, name), R @ getattr(eye, name), rtol=1e-12,
                                    atol=1e-12, err_msg=name)
-    crit = run.summary["flutter"]["mode"] - 1
-    dt = ob["identification"].model.dt
-    lt = ob["lco_truth"]
-    # the truth's LCO speed (recorded with the record when the run stores it)
-    V_lt = lt.get("V", ob["lco_speeds"]["V"])
-    acc = truth_lco(truth, V_lt, cfg.lco.duration, crit, cfg.lco.initial_deflection, dt=dt,
-                    sensor_rows=np.eye(5))["zm"]
-    np.testing.assert_allclose(lt["zm"], acc @ R.T, rtol=1e-10, atol=1e-12)
+    crit = result.summary()["flutter"]["mode"] - 1
+    dt = result.identification.model.dt
+    lt = result.lco.truth
+    acc = truth_lco(truth, lt.V, cfg.lco.duration, crit, cfg.lco.initial_deflection, dt=dt,
+                    sensor_rows=np.eye(5)).zm
+    np.testing.assert_allclose(lt.zm, acc @ R.T, rtol=1e-10, atol=1e-12)
     # suppression: open loop (gain 0) during the settling phase
-    sup = ob["suppression"]
-    n = int(np.sum(sup["timepts"] < cfg.suppression.settle)) - 1
-    x0 = np.zeros(10)
-    x0[crit] = cfg.lco.initial_deflection
+    sup = result.suppression
+    t = sup.simulation.timepts
+    n = int(np.sum(t < cfg.suppression.settle)) - 1
+    x0 = truth.displaced_state(crit, cfg.lco.initial_deflection)
     no_control = control.ss([], [], [], np.zeros((1, 5)))
-    open_acc = closed_loop_truth(truth, no_control, sup["V"], sup["timepts"][:n], x0,
-                                 lambda t: 0.0, sensor_rows=np.eye(5))["zm"]
-    np.testing.assert_allclose(sup["zm"][:n], open_acc @ R.T, rtol=1e-9, atol=1e-10)
+    open_acc = closed_loop_truth(truth, no_control, sup.V, t[:n], x0, lambda t: 0.0,
+                                 sensor_rows=np.eye(5)).zm
+    np.testing.assert_allclose(sup.simulation.zm[:n], open_acc @ R.T, rtol=1e-9, atol=1e-10)
 
 
 @pytest.mark.parametrize("name, words", [

@@ -76,8 +76,8 @@ def test_hopf_point_on_analytic_quadratic_family():
     A0q, A1q, A2q = quadratic_coefficients(lambda V: A0 + V * A1 + V * V * A2)
     np.testing.assert_allclose(A1q, A1, atol=1e-12)
     hp = hopf_point(A0, A1, A2, V_range=(0.01, 0.9), n_scan=11)
-    np.testing.assert_allclose(hp["Vf"], 0.5, rtol=1e-12)
-    np.testing.assert_allclose(hp["omega_f"], w, rtol=1e-12)
+    np.testing.assert_allclose(hp.Vf, 0.5, rtol=1e-12)
+    np.testing.assert_allclose(hp.omega_f, w, rtol=1e-12)
 
 
 @pytest.mark.parametrize("name", ["rho", "zeta", "EI"])

@@ -225,21 +225,20 @@ def test_dask_local_cluster_gives_the_same_results(tmp_path):
 
 
 def test_rom_flutter_evaluator_passes_the_pipeline_through(tmp_path):
-    pipeline = pytest.importorskip("casflutter.pipeline")
-    from casflutter.truth import load_problem
+    from casflutter.pipeline import config_path, load_config, run
 
     st = Study(name="rom", evaluator="rom_flutter",
-               parameters=(Parameter("V0", values=(1.8,)),),
-               settings={"problem": "typical_section", "n_grid": 61})
+               parameters=(Parameter("data.V0", values=(1.8,)),),
+               settings={"problem": "typical_section", "flutter.n_grid": 61})
     res = run_sweep(st, store=tmp_path / "r.jsonl", workers=0, progress=False)
     rec = next(iter(res.records().values()))
     assert rec["status"] == "ok", rec.get("error")
-    direct = pipeline.rom_flutter(load_problem("typical_section"),
-                                  pipeline.rom_settings("typical_section", V0=1.8, n_grid=61),
-                                  parametric=False)
+    cfg = load_config(config_path("typical_section", "flutter"),
+                      updates={"data.V0": 1.8, "flutter.n_grid": 61, "stages": ["frozen"]})
+    direct = run(cfg, quiet=True, write=False)
     out = rec["outputs"]
-    np.testing.assert_allclose(out["Vf_truth"], direct.truth.Vf, rtol=1e-12)
-    np.testing.assert_allclose(out["Vf_rom"], direct.rom.Vf, rtol=1e-9)
+    np.testing.assert_allclose(out["Vf_truth"], direct.flutter_truth.Vf, rtol=1e-12)
+    np.testing.assert_allclose(out["Vf_rom"], direct.flutter.Vf, rtol=1e-9)
     np.testing.assert_allclose(out["rom_error"], direct.rom_error, rtol=1e-6)
 
 

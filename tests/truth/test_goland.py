@@ -14,7 +14,7 @@ from scipy.special import hankel2
 
 from casflutter.errors import ConfigError
 from casflutter.truth import GolandParams, GolandWing, load_problem, theodorsen_T
-from casflutter.truth._flutter import find_flutter
+from casflutter.aeroelastic import find_flutter
 
 ROOT = Path(__file__).resolve().parents[2]
 with open(ROOT / "problems" / "goland" / "problem.toml", "rb") as _fh:
@@ -127,9 +127,9 @@ def wing():
 
 @pytest.fixture(scope="module")
 def flutter_jones(wing):
-    fp = find_flutter(wing, 1.0, 2.5, num=30)
+    fp = find_flutter(wing, (1.0, 2.5), n_grid=30)
     assert fp.found
-    return wing.airspeed(fp.V), fp.omega
+    return wing.airspeed(fp.Vf), fp.omega_f
 
 
 # ---- published values ----------------------------------------------------------------
@@ -173,9 +173,9 @@ def test_state_space_flutter_equals_independent_strip_determinant(flutter_jones)
 def test_flutter_at_rho_1_02():
     """The density pin: rho = 1.02 gives about 147 m/s (1.5%)."""
     m = GolandWing(GolandParams(rho=1.02))
-    fp = find_flutter(m, 1.0, 2.5, num=30)
+    fp = find_flutter(m, (1.0, 2.5), n_grid=30)
     ref = REF["flutter_rho_1_02"]
-    assert_allclose(m.airspeed(fp.V), ref["airspeed"], rtol=ref["rtol"])
+    assert_allclose(m.airspeed(fp.Vf), ref["airspeed"], rtol=ref["rtol"])
 
 
 def test_in_vacuo_frequencies(wing):
@@ -200,10 +200,11 @@ def test_uncoupled_frequencies_exact_beam_theory():
 
 def test_modes_converged():
     """More assumed modes move the flutter speed by less than 0.05%."""
-    f1 = find_flutter(GolandWing(), 1.0, 2.5, num=30)
-    f2 = find_flutter(GolandWing(GolandParams(n_bending=6, n_torsion=6)), 1.0, 2.5, num=30)
-    assert_allclose(f2.V, f1.V, rtol=5e-4)
-    assert_allclose(f2.omega, f1.omega, rtol=5e-4)
+    f1 = find_flutter(GolandWing(), (1.0, 2.5), n_grid=30)
+    f2 = find_flutter(GolandWing(GolandParams(n_bending=6, n_torsion=6)), (1.0, 2.5),
+                      n_grid=30)
+    assert_allclose(f2.Vf, f1.Vf, rtol=5e-4)
+    assert_allclose(f2.omega_f, f1.omega_f, rtol=5e-4)
 
 
 def test_speed_index_convention(wing):

@@ -19,7 +19,7 @@ from casflutter.cli import main
 from casflutter.errors import ConfigError
 from casflutter.truth import (PitchPlungeSection, TypicalSection, file_problem_names,
                               load_problem, problem_label)
-from casflutter.truth._flutter import find_flutter
+from casflutter.aeroelastic import find_flutter
 
 ROOT = Path(__file__).resolve().parents[2]
 NATA = ROOT / "problems" / "nata" / "problem.toml"
@@ -85,11 +85,11 @@ def test_nata_pitch_spring_is_the_readme_polynomial_times_alpha():
 
 def test_nata_linear_flutter_matches_hand_written_determinant():
     m = load_problem("nata")
-    fp = find_flutter(m, 2.0, 25.0, num=200)
+    fp = find_flutter(m, (2.0, 25.0), n_grid=200)
     assert fp.found
-    U, w = nata_flutter_determinant(fp.V, fp.omega)
-    assert fp.V == pytest.approx(U, rel=1e-9)
-    assert fp.omega == pytest.approx(w, rel=1e-9)
+    U, w = nata_flutter_determinant(fp.Vf, fp.omega_f)
+    assert fp.Vf == pytest.approx(U, rel=1e-9)
+    assert fp.omega_f == pytest.approx(w, rel=1e-9)
     # and the eigenvalues of the hand-written first-order system cross at the same speed
     def abscissa(U):
         M, C, K = nata_matrices(U)
@@ -97,7 +97,7 @@ def test_nata_linear_flutter_matches_hand_written_determinant():
         Amat = np.block([[np.zeros((2, 2)), np.eye(2)], [-Ainv @ K, -Ainv @ C]])
         return np.max(np.linalg.eigvals(Amat).real)
 
-    assert brentq(abscissa, 2.0, 25.0, xtol=1e-12) == pytest.approx(fp.V, rel=1e-9)
+    assert brentq(abscissa, 2.0, 25.0, xtol=1e-12) == pytest.approx(fp.Vf, rel=1e-9)
 
 
 def test_wagner_rig_reproduces_hodges_pierce_hp1():
@@ -110,12 +110,12 @@ def test_wagner_rig_reproduces_hodges_pierce_hp1():
         "m_heave": m, "m_wing": m, "x_alpha": 0.1, "I_alpha": 0.24 * m * b * b,
         "k_h": m * (0.4 * wth) ** 2, "c_h": 0.0, "c_alpha": 0.0,
         "k_alpha": [0.24 * m * b * b * wth ** 2]})
-    fr = find_flutter(rig, 5.0, 20.0, num=300)
-    ft = find_flutter(TypicalSection(), 1.0, 3.0, num=300)
-    assert fr.V / (b * wth) == pytest.approx(ft.V, rel=1e-8)
-    assert fr.omega / wth == pytest.approx(ft.omega, rel=1e-8)
-    assert fr.V / (b * wth) == pytest.approx(2.170, rel=5e-3)
-    assert fr.omega / wth == pytest.approx(0.644, rel=5e-3)
+    fr = find_flutter(rig, (5.0, 20.0), n_grid=300)
+    ft = find_flutter(TypicalSection(), (1.0, 3.0), n_grid=300)
+    assert fr.Vf / (b * wth) == pytest.approx(ft.Vf, rel=1e-8)
+    assert fr.omega_f / wth == pytest.approx(ft.omega_f, rel=1e-8)
+    assert fr.Vf / (b * wth) == pytest.approx(2.170, rel=5e-3)
+    assert fr.omega_f / wth == pytest.approx(0.644, rel=5e-3)
 
 
 def test_total_mass_matrix_is_the_published_one():

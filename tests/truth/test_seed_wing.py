@@ -13,13 +13,14 @@ from numpy.testing import assert_allclose
 from scipy.linalg import expm
 from scipy.optimize import brentq
 
-from casflutter.aeroelastic import AeroelasticSystem, dominant_frequency, find_flutter
-from casflutter.data import IOData, Record, chirp_excitation
+from casflutter.aeroelastic import AeroelasticSystem, find_flutter
+from casflutter.data import IOData, Record, chirp_excitation, dominant_frequency
 from casflutter.errors import ConfigError, DimensionError
-from casflutter.ident import identify
+from casflutter.ident import identify, identify_common_denominator
+from casflutter.pipeline import config_path, load_config
 from casflutter.realize import realize
 from casflutter.truth import (SEED_FREQUENCIES_HZ, SEED_SENSOR_ROWS, SeedWing, SeedWingParams,
-                              load_problem, problem_definition, problem_names)
+                              load_problem, problem_definition, problem_names, truth_records)
 
 REF = problem_definition("seed_wing")["reference"]
 PAPER = REF["paper"]
@@ -103,8 +104,8 @@ def test_in_vacuo_state_matrix_is_eq6(wing):
 
 def test_sensor_rows_and_tip_store_shapes(wing):
     ms = wing.modal_structure()
-    assert_allclose(ms.sensor_rows, PAPER["sensor_rows"], rtol=0, atol=0)
-    assert ms.sensor_rows.shape == (PAPER["n_sensors"], 5)
+    assert_allclose(ms.Hs, PAPER["sensor_rows"], rtol=0, atol=0)
+    assert ms.Hs.shape == (PAPER["n_sensors"], 5)
     sh = wing.strip_shapes()
     tip = sh["tip"]
     # Acc1 (vertical, acc1_offset aft of the elastic axis) and Acc2 (lateral) at the store
@@ -116,8 +117,8 @@ def test_sensor_rows_and_tip_store_shapes(wing):
         a = np.abs(sh[key])
         assert np.all(a[:, 0] <= 0.1 * np.max(a, axis=1) + 1e-15)
     # Acc2 is dominated by the lateral mode, Acc1 by bending and torsion (paper §IV)
-    assert np.argmax(np.abs(ms.sensor_rows[1])) == 1
-    assert abs(ms.sensor_rows[0, 1]) < 0.01 * np.max(np.abs(ms.sensor_rows[0]))
+    assert np.argmax(np.abs(ms.Hs[1])) == 1
+    assert abs(ms.Hs[0, 1]) < 0.01 * np.max(np.abs(ms.Hs[0]))
     ss = wing.statespace(V0)
     assert ss.noutputs == 5 + 2 and ss.ninputs == 1 + 5
     assert ss.nstates == 10 + 2 * wing.params.n_strips + 2  # [u, u', z1, z2, v, v']
@@ -337,12 +338,10 @@ def test_lco_above_flutter(wing):
     late = t >= 10.0
     amps = []
     for start in (0.05, 0.6):
-        x0 = np.zeros(10)
-        x0[1] = start
-        sim = wing.simulate(t, x0, V, rtol=1e-7, atol=1e-10)
+        sim = wing.simulate(t, wing.displaced_state(1, start), V, rtol=1e-7, atol=1e-10)
         assert sim.success
         amps.append(np.max(np.abs(sim.u[late, 1])))
-        acc = sim.uddot @ wing.modal_structure().sensor_rows.T  # accelerometers
+        acc = sim.uddot @ wing.modal_structure().Hs.T  # accelerometers
         f_hz, _, _ = dominant_frequency(t[late], acc[late, 1])
         assert abs(f_hz - PAPER["lco_frequency_hz"]) < TOL["lco_frequency_hz"]
     assert amps[0] > 0.05 and amps[1] < 0.6  # grew from below, decayed from above
@@ -351,14 +350,12 @@ def test_lco_above_flutter(wing):
 
 def test_linear_rom_route_reproduces_the_frozen_truth(wing):
     """The pipeline's linear ROM route (no coupling delay) is the frozen-aerodynamics truth."""
-    pipeline = pytest.importorskip("casflutter.pipeline")
-    s = pipeline.rom_settings("seed_wing")
-    assert s.V0 == V0
-    data = pipeline.truth_records(wing, s.V0, dt=s.dt, duration=s.duration, band=s.band,
-                                  amplitude=s.amplitude, taper=s.taper, flap=s.flap)
-    ident = pipeline.identify_common_denominator(data, s.na, s.nb)
+    cfg = load_config(config_path("seed_wing", "flutter"))
+    assert cfg.data.V0 == V0 and cfg.data.coupling_delay == 0
+    data = truth_records(wing, cfg.data)
+    ident = identify_common_denominator(data, cfg.rom.na, cfg.rom.nb)
     assert ident.stable
-    system = pipeline.rom_system(ident.model, pipeline.structure_of(wing))
+    system = AeroelasticSystem.from_parts(realize(ident.model).sigma_f, wing.modal_structure())
     res = find_flutter(system, (0.4, 1.6), n_grid=25)
     assert res.status == "flutter"
     assert res.flutter_mode + 1 == PAPER["flutter_mode"]
@@ -369,12 +366,8 @@ def _delayed_truth_records(wing):
     """The paper-route data: one chirp record per input (modes, flap), dt = 2 ms, 8 s,
     0.2-60 Hz, amplitude 0.01, BDF2 grid rates, forces one step behind the motion (a
     staggered CFD--CSD step; the paper's input delay r = 1)."""
-    pipeline = pytest.importorskip("casflutter.pipeline")
-    data = pipeline.truth_records(wing, V0, dt=0.002, duration=8.0, band=(0.2, 60.0),
-                                  amplitude=0.01)
-    recs = tuple(Record(np.vstack([np.zeros((1, 5)), r.y[:-1]]), r.u, r.v, r.name)
-                 for r in data.records)
-    return IOData(recs, data.dt)
+    return truth_records(wing, V0=V0, dt=0.002, duration=8.0, band=(0.2, 60.0),
+                         amplitude=0.01, coupling_delay=1)
 
 
 def test_paper_route_lands_on_the_papers_flutter_speed(wing):
@@ -383,7 +376,6 @@ def test_paper_route_lands_on_the_papers_flutter_speed(wing):
     This is the route ``casflutter run`` takes (one-step coupling delay); the calibrated
     ``modal_mass`` puts it on the paper's value.  The fit is < 1 % on modes 1, 3, 4, 5.
     """
-    pipeline = pytest.importorskip("casflutter.pipeline")
     # a light pull towards the stage-1 estimate: with one input per record the quadratic
     # coefficients are weakly excited and Ipopt otherwise creeps along a flat valley
     res_id = identify(_delayed_truth_records(wing), tuple(PAPER["orders"]), regularization=1e-6)
@@ -393,7 +385,7 @@ def test_paper_route_lands_on_the_papers_flutter_speed(wing):
     assert err[1] == np.max(err), err
     # Σf of the paper's order nf = 15 (Table I) by ERA and Tustin; ΣAE then has 25 states
     sigma_f = realize(res_id.model, PAPER["nf"]).sigma_f
-    system = AeroelasticSystem.from_parts(sigma_f, pipeline.structure_of(wing))
+    system = AeroelasticSystem.from_parts(sigma_f, wing.modal_structure())
     assert system.rom_stable
     assert system.n_states == PAPER["n_aeroelastic_states"]
     res = find_flutter(system, (0.6, 3.0), n_grid=49, max_refine=3)

@@ -16,7 +16,7 @@ from scipy.special import hankel2
 from casflutter.errors import ConfigError, DataError, DimensionError
 from casflutter.truth import (TypicalSection, TypicalSectionParams, load_problem,
                               strip_coefficients, theodorsen_T)
-from casflutter.truth._flutter import find_divergence, find_flutter
+from casflutter.aeroelastic import find_flutter
 
 ROOT = Path(__file__).resolve().parents[2]
 with open(ROOT / "problems" / "typical_section" / "problem.toml", "rb") as _fh:
@@ -82,19 +82,19 @@ def test_problem_definition_matches_defaults():
 
 def test_hp1_flutter_jones_matches_published():
     """HP-1 with Jones' Wagner approximation: V_F = 2.170, Omega/omega_theta = 0.644 (0.5%)."""
-    fp = find_flutter(TypicalSection(), 0.5, 3.0)
+    fp = find_flutter(TypicalSection(), (0.5, 3.0), n_grid=60)
     assert fp.found
     ref = REF["jones"]
-    assert_allclose(fp.V, ref["flutter_speed"], rtol=ref["rtol"])
-    assert_allclose(fp.omega, ref["flutter_frequency_ratio"], rtol=ref["rtol"])
+    assert_allclose(fp.Vf, ref["flutter_speed"], rtol=ref["rtol"])
+    assert_allclose(fp.omega_f, ref["flutter_frequency_ratio"], rtol=ref["rtol"])
 
 
 def test_state_space_flutter_equals_independent_jones_determinant():
     """The eigenvalue crossing equals the frequency-domain determinant with Jones' C(k)."""
     p = TypicalSectionParams()
-    fp = find_flutter(TypicalSection(p), 0.5, 3.0)
+    fp = find_flutter(TypicalSection(p), (0.5, 3.0), n_grid=60)
     V, w = flutter_determinant(p, C_jones, 2.2, 0.65)
-    assert_allclose([fp.V, fp.omega], [V, w], rtol=1e-7)
+    assert_allclose([fp.Vf, fp.omega_f], [V, w], rtol=1e-7)
 
 
 def test_theodorsen_determinant_matches_published():
@@ -110,7 +110,7 @@ def test_theodorsen_determinant_matches_published():
 def test_divergence_analytic():
     """A real eigenvalue crosses zero at V_D = sqrt(mu r^2 / (1 + 2a)) = 2.828."""
     m = TypicalSection()
-    VD = find_divergence(m, 2.6, 3.0)
+    VD = find_flutter(m, (0.5, 3.0), n_grid=60).divergence.V
     p = m.params
     assert_allclose(VD, np.sqrt(p.mu * p.r2 / (1 + 2 * p.a)), rtol=1e-9)
     assert_allclose(VD, REF["divergence"]["speed"], rtol=REF["divergence"]["rtol"])
@@ -130,7 +130,7 @@ def test_modal_structure_eq6():
     # e = a: uncoupled, omega = (sigma, 1)
     mu = TypicalSection(TypicalSectionParams(e=-0.2)).modal_structure()
     assert_allclose(mu.omega, [0.4, 1.0], rtol=1e-12)
-    As, Bs = ms.As_Bs()
+    As, Bs = ms.As, ms.Bs
     assert_allclose(np.sort(np.abs(np.linalg.eigvals(As).imag)),
                     np.sort(np.repeat(ms.omega, 2)), rtol=1e-12)
     assert_allclose(Bs[1, 0], ms.alpha)
@@ -221,9 +221,9 @@ def test_omega_theta_scales_time():
     """omega_theta only rescales time: same V_F, omega_F x omega_theta, same y."""
     s = 7.0
     m1, m7 = TypicalSection(), TypicalSection(TypicalSectionParams(omega_theta=s))
-    f1, f7 = find_flutter(m1, 0.5, 3.0), find_flutter(m7, 0.5, 3.0)
-    assert_allclose(f7.V, f1.V, rtol=1e-8)
-    assert_allclose(f7.omega, s * f1.omega, rtol=1e-8)
+    f1, f7 = find_flutter(m1, (0.5, 3.0), n_grid=60), find_flutter(m7, (0.5, 3.0), n_grid=60)
+    assert_allclose(f7.Vf, f1.Vf, rtol=1e-8)
+    assert_allclose(f7.omega_f, s * f1.omega_f, rtol=1e-8)
     t = np.arange(0, 40, 0.02)
     u = np.column_stack([np.sin(0.4 * t) * t / 40, 0.1 * np.cos(0.9 * t)])
     v = 0.01 * np.sin(0.3 * t)
@@ -263,7 +263,7 @@ def test_lco_amplitude_matches_describing_function():
     matches the describing-function (harmonic-balance) estimate within 2%."""
     kappa2 = 20.0
     base = TypicalSection()
-    VF = find_flutter(base, 0.5, 3.0).V
+    VF = find_flutter(base, (0.5, 3.0), n_grid=60).Vf
     V = 1.05 * VF
     m = base.with_updates(kappa2=kappa2)
     t = np.arange(0.0, 600.0, 0.1)
@@ -277,7 +277,7 @@ def test_lco_amplitude_matches_describing_function():
     # omega_theta' = sqrt(k_eff), sigma' = sigma / sqrt(k_eff), V' = V / sqrt(k_eff)
     def hb(keff):
         mk = base.with_updates(sigma=base.params.sigma / np.sqrt(keff))
-        return find_flutter(mk, 1.0, 3.0, num=20).V * np.sqrt(keff) - V
+        return find_flutter(mk, (1.0, 3.0), n_grid=20).Vf * np.sqrt(keff) - V
 
     keff = brentq(hb, 1.0, 1.3, xtol=1e-10)
     A_hb = np.sqrt((keff - 1) / (0.75 * kappa2))

@@ -1,7 +1,8 @@
 """``casflutter flutter``: truth, ROM and parametric-ROM flutter speeds of a problem.
 
-Runs :func:`casflutter.pipeline.rom_flutter` (the paper's ROM route at one speed with the V²
-scaling, and the parametric ROM interpolated in V) beside the full-order truth, prints the
+Runs the configuration ``problems/NAME/flutter.toml`` (:func:`casflutter.pipeline.run`: the
+paper's ROM route at one speed with the V² scaling, the truth with its aerodynamics frozen at
+that speed, and the parametric ROM interpolated in V) beside the full-order truth, prints the
 flutter and divergence speeds in the problem's own units (or writes JSON to stdout) and,
 with ``--figure PATH``, saves the V–g / V–f figure.
 """
@@ -11,6 +12,7 @@ from __future__ import annotations
 import json
 import math
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from ..._outputs import check_figure_path
@@ -73,19 +75,21 @@ def _block(res, truth, to_unit, fscale) -> dict | None:
             "message": res.message}
 
 
-def summarize(result, truth, problem: str) -> dict:
-    """The JSON document of ``casflutter flutter`` for a :class:`RomFlutterResult`."""
+def summarize(result, problem: str) -> dict:
+    """The JSON document of ``casflutter flutter`` for a :class:`casflutter.pipeline.RunResult`."""
+    truth = result.truth
     to_unit, _, vunit = _speed_conv(truth)
     fscale, funit = _freq_unit(truth)
-    rom = _block(result.rom, truth, to_unit, fscale)
-    rom["rom_stable"] = bool(result.rom_stable)
-    s = result.settings
+    rom_stable = bool(result.system.rom_stable)
+    rom = _block(result.flutter, truth, to_unit, fscale)
+    rom["rom_stable"] = rom_stable
+    parametric = None if result.parametric is None else result.parametric.flutter
     warn = []
-    if not result.rom_stable:
+    if not rom_stable:
         warn.append("the single-speed ROM is unstable on its own (ΣAE unstable at V = 0): "
                     "its crossings are not flutter onsets")
-    for key, r in (("truth", result.truth), ("rom", result.rom),
-                   ("parametric_rom", result.parametric)):
+    for key, r in (("truth", result.flutter_truth), ("rom", result.flutter),
+                   ("parametric_rom", parametric)):
         if r is not None and r.Vf is None:
             warn.append(f"{key}: {r.message}")
 
@@ -94,15 +98,15 @@ def summarize(result, truth, problem: str) -> dict:
 
     return {
         "problem": problem,
-        "truth": _block(result.truth, truth, to_unit, fscale),
+        "truth": _block(result.flutter_truth, truth, to_unit, fscale),
         "rom": rom,
-        "parametric_rom": _block(result.parametric, truth, to_unit, fscale),
-        "frozen_aero_truth": _block(result.frozen, truth, to_unit, fscale),
+        "parametric_rom": _block(parametric, truth, to_unit, fscale),
+        "frozen_aero_truth": _block(result.flutter_frozen, truth, to_unit, fscale),
         "units": {"V_flutter": vunit, "V_divergence": vunit, "omega_flutter": funit},
-        "rom_V0": to_unit(s.V0),
-        "V_range": [to_unit(v) for v in s.V_range],
-        "parametric_speeds": (None if result.parametric_rom is None
-                              else [to_unit(v) for v in result.parametric_rom.speeds]),
+        "rom_V0": to_unit(result.config.data.V0),
+        "V_range": [to_unit(v) for v in result.config.flutter.V_range],
+        "parametric_speeds": (None if result.parametric is None
+                              else [to_unit(v) for v in result.parametric.rom.speeds]),
         "relative_errors": {"rom": err(result.rom_error),
                             "rom_vs_frozen": err(result.identification_error),
                             "v2_scaling": err(result.scaling_error),
@@ -119,9 +123,9 @@ def _figure(result, path: str, omega_max: float, xlabel: str) -> None:
 
     from ...report import plot_vg_vf
 
-    panels = [("truth", result.truth), ("ROM at V0 (V² scaling)", result.rom)]
+    panels = [("truth", result.flutter_truth), ("ROM at V0 (V² scaling)", result.flutter)]
     if result.parametric is not None:
-        panels.append(("parametric ROM", result.parametric))
+        panels.append(("parametric ROM", result.parametric.flutter))
     fig, axes = plt.subplots(2, len(panels), sharex=True, figsize=(5.0 * len(panels), 6.5),
                              squeeze=False)
     for k, (title, res) in enumerate(panels):
@@ -151,27 +155,27 @@ def _fmt(x, unit="") -> str:
 
 def run(args) -> int:
     """Handler: run the route, print or write JSON, save the figure."""
-    from ...pipeline import rom_flutter, rom_settings
-    from ...truth import load_problem, problem_definition, problem_label
+    from ...pipeline import flutter_config, run as run_config
+    from ...truth import load_problem, parse_sets, problem_label
 
     fig_path = None                  # figures only where asked, checked before the work
     if args.figure is not None and args.figure.lower() != "none":
         fig_path = str(check_figure_path(args.figure, what="--figure"))
-    truth = load_problem(args.problem, args.sets)
+    changes = parse_sets(args.sets)
+    truth = load_problem(args.problem, changes)
     label = problem_label(args.problem)
-    # a problem file carries its own [rom] table (a built-in name's is read by rom_settings)
-    rom_table = dict(problem_definition(args.problem).get("rom", {})) \
-        if label != args.problem else {}
     _, from_unit, vunit = _speed_conv(truth)
-    over = {}
+    updates = {"problem.set": changes}
     if args.vrange is not None:
         lo, hi = args.vrange
-        over["V_range"] = (from_unit(lo), from_unit(hi))
+        updates["flutter.V_range"] = [from_unit(lo), from_unit(hi)]
     if args.v0 is not None:
-        over["V0"] = from_unit(args.v0)
-    settings = rom_settings(args.problem, **{**rom_table, **over})
-    result = rom_flutter(truth, settings, parametric=not args.no_parametric)
-    doc = summarize(result, truth, label)
+        updates["data.V0"] = from_unit(args.v0)
+    cfg = flutter_config(args.problem, updates=updates)
+    if args.no_parametric:
+        cfg = replace(cfg, stages=tuple(s for s in cfg.stages if s != "parametric"))
+    result = run_config(cfg, quiet=True, write=False)
+    doc = summarize(result, label)
     if fig_path is not None:
         Path(fig_path).parent.mkdir(parents=True, exist_ok=True)
         _figure(result, fig_path, float(truth.modal_structure().omega.max()),

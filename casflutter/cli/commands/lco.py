@@ -57,7 +57,6 @@ def run(args) -> int:
     from ...lco import (LCOSettings, default_vrange, lco_branch, rom_lco_branch,
                         speed_convention)
     from ...truth import load_problem, problem_label
-    from ...aeroelastic import ModalStructure
     from ...errors import ConfigError
 
     truth = load_problem(args.problem, args.sets)
@@ -78,7 +77,7 @@ def run(args) -> int:
         except FileNotFoundError:
             raise ConfigError(f"--rom {args.rom}: the file does not exist") from None
         ms = truth.modal_structure()
-        st = ModalStructure(ms.omega, ms.zeta, ms.alpha, Hs=ms.sensor_rows, sensor="displacement")
+        st = ms.with_sensors(kind="displacement")
         branch = rom_lco_branch(rom, st, vrange, settings, mode_names=ms.mode_names,
                                 sensor_names=ms.sensor_names, problem=f"{label} (ROM loop)",
                                 speed_scale=scale, speed_unit=unit, time_unit=ms.time_unit)

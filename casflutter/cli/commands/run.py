@@ -1,4 +1,5 @@
-"""``casflutter run``: the paper's study end to end on a problem (default: the seed wing)."""
+"""``casflutter run``: a study run of a configuration (default: the paper's study on the seed
+wing, ``problems/seed_wing/run.toml``)."""
 
 from __future__ import annotations
 
@@ -6,25 +7,31 @@ import json
 
 
 def _main(args) -> int:
-    from ...pipeline import load_config, run_pipeline
+    from ...pipeline import load_config, run
 
     cfg = load_config(args.config)   # validated before any work starts
-    res = run_pipeline(cfg, out_dir=args.out, seed=args.seed, quiet=args.quiet)
-    s = res.summary
-    fl, ft, c = s["flutter"], s["flutter_truth"], s["controller"]
+    res = run(cfg, out_dir=args.out, seed=args.seed, quiet=args.quiet)
+    s = res.summary()
+    fl, ft = s["flutter"], s["flutter_truth"]
     lines = [
         f"problem {s['problem']}: orders {tuple(s['orders'])}, {s['n_params']} parameters, "
         f"nf = {s['nf']}, ns = {s['ns']}, nae = {s['nae']}",
         "ROM fit error per mode [%]: " + ", ".join(f"{e:.3f}" for e in s["fit_error_percent"]),
         f"flutter (ROM):   V = {fl['V']}, {fl['freq_hz']} Hz, mode {fl['mode']}",
         f"flutter (truth): V = {ft['V']}, {ft['freq_hz']} Hz, mode {ft['mode']}",
-        f"LCO: {s['lco']['freq_hz']} Hz ({s['lco']['kind']})",
-        f"controller order {c['order']}: verified gamma = {c['gamma']}, small-gain V in "
-        f"{c['small_gain_V']}, exact stable V in {c['stable_V']}",
-        f"suppression: attenuation {s['suppression']['attenuation_percent']} %, LCO returns "
-        f"on release: {s['suppression']['lco_returns']}",
-        f"total {s['timings_s']['total']:.1f} s; outputs in {res.out_dir}/",
     ]
+    if s["lco"] is not None:
+        lines.append(f"LCO: {s['lco']['freq_hz']} Hz ({s['lco']['kind']})")
+    if s["controller"] is not None:
+        c = s["controller"]
+        lines.append(f"controller order {c['order']}: verified gamma = {c['gamma']}, small-gain "
+                     f"V in {c['small_gain_V']}, exact stable V in {c['stable_V']}")
+    if s["suppression"] is not None:
+        lines.append(f"suppression: attenuation {s['suppression']['attenuation_percent']} %, LCO "
+                     f"returns on release: {s['suppression']['lco_returns']}")
+    if res.interval_ok is not None or res.closed_loop is not None:
+        lines.append(f"checks passed: {res.success}")
+    lines.append(f"total {s['timings_s']['total']:.1f} s; outputs in {res.out_dir}/")
     if args.json:
         print(json.dumps(s, indent=2))
     elif not args.quiet:

@@ -1,7 +1,8 @@
-"""Issue 4, "A flutter check": an order-2 controller through the flap of the typical section,
-designed on the ROM's LFT at the ROM's flutter speed Vf.
+"""The flutter check (``problems/typical_section/flutter_check.toml``, a configuration of the
+study run): an order-2 controller through the flap of the typical section, designed on the
+ROM's LFT at the ROM's flutter speed Vf.
 
-Targets (issue): the verified exact stable interval of V contains [0.5 Vf, 1.2 Vf]; above the
+Targets: the verified exact stable interval of V contains [0.5 Vf, 1.2 Vf]; above the
 open-loop flutter speed (1.1 Vf) the open loop grows and the closed loop decays, on the ROM
 loop and on the truth.  Every number is checked against an independent computation:
 
@@ -23,31 +24,39 @@ import pytest
 from numpy.testing import assert_allclose
 
 from casflutter.errors import ConfigError
-from casflutter.pipeline._flutter_check import (FlutterCheckSettings, flutter_check,
-                                                flutter_check_settings, truth_loop_matrix)
-from casflutter.truth import TypicalSection, problem_definition
+from casflutter.pipeline import config_path, load_config, run
+from casflutter.truth import TypicalSection, problem_definition, truth_loop_matrix
 
 #: the slow check: five design plants and up to 20 minimax solves
-FULL = dict(speed_factors=(0.5, 1.0, 1.1, 1.2, 1.25), max_outer=20)
+FULL = {"controller.speeds": [0.5, 1.0, 1.1, 1.2, 1.25], "controller.max_outer": 20}
+
+
+def flutter_check_settings(**updates):
+    """The flutter-check configuration with dotted-path changes."""
+    return load_config(config_path("typical_section", "flutter_check"), updates=updates)
+
+
+def flutter_check(cfg=None):
+    return run(cfg or flutter_check_settings(), quiet=True, write=False)
 
 
 def _check_rom_and_truth_flutter(res):
     ref = problem_definition("typical_section")["reference"]["jones"]
     assert_allclose(res.Vf_truth, ref["flutter_speed"], rtol=ref["rtol"])
-    V0, Vf = res.v0_history[-1]
-    assert abs(Vf - V0) <= res.settings.v0_rtol * Vf
+    V0, Vf = res.identification_history[-1]
+    assert abs(Vf - V0) <= res.config.rom.v0_rtol * Vf
     # the first ROM (V0 = 1.8) is 4 % off; at the fixed point it is the truth at Vf
-    assert abs(res.v0_history[0][1] / res.Vf_truth - 1) > 0.03
+    assert abs(res.identification_history[0][1] / res.Vf_truth - 1) > 0.03
     assert_allclose(res.Vf, res.Vf_truth, rtol=2e-3)
     assert res.identification.relative_residual < 1e-10
 
 
 def _check_verification(res):
     ver, syn = res.verification, res.synthesis
-    assert res.controller.nstates == res.settings.order == 2
+    assert res.controller.nstates == res.config.controller.order == 2
     assert ver.stable and np.isfinite(ver.gamma)
     # the verified γ of the nominal plant is the synthesis's own γ for that plant
-    i = list(res.settings.speed_factors).index(1.0)
+    i = list(res.config.controller.speeds).index(1.0)
     assert_allclose(ver.gamma, syn.gammas[i], rtol=1e-6)
     assert_allclose(ver.small_gain_dV[1], 1.0 / ver.gamma, rtol=1e-12)
     # small gain is a certificate inside the exact interval
@@ -71,9 +80,9 @@ def _check_dense_sweep(res):
 
 
 def _check_simulations(res):
-    rom, tru = res.rom_simulation, res.truth_simulation
-    assert_allclose(rom.V, res.settings.sim_factor * res.Vf)
-    assert_allclose(tru.V, res.settings.sim_factor * res.Vf_truth)
+    rom, tru = res.closed_loop.rom_simulation, res.closed_loop.truth_simulation
+    assert_allclose(rom.V, res.config.closed_loop.speed_factor * res.Vf)
+    assert_allclose(tru.V, res.config.closed_loop.speed_factor * res.Vf_truth)
     for sim, tol in ((rom, 5e-3), (tru, 1e-3)):
         assert sim.open_eig_rate > 0 > sim.closed_eig_rate
         assert sim.grows_open_decays_closed, sim.model
@@ -91,11 +100,11 @@ def _check_targets(res):
     _check_dense_sweep(res)
     _check_simulations(res)
     assert res.success
-    tsw = res.truth_sweep
+    tsw = res.closed_loop.truth_sweep
     a, b = tsw.stable_V
-    assert a < res.Vf_truth < res.truth_simulation.V < b
-    kw = dict(actuator_omega=res.settings.actuator_omega,
-              actuator_zeta=res.settings.actuator_zeta)
+    assert a < res.Vf_truth < res.closed_loop.truth_simulation.V < b
+    kw = dict(actuator_omega=res.config.closed_loop.actuator_omega,
+              actuator_zeta=res.config.closed_loop.actuator_zeta)
     for edge in (a, b):
         if tsw.V[0] < edge < tsw.V[-1]:
             A = truth_loop_matrix(TypicalSection(), res.controller, edge, **kw)
@@ -108,8 +117,8 @@ def _check_targets(res):
 def _check_truth_interval(res):
     """Past the issue: the truth's closed loop is stable on the same multiples of its own
     flutter speed as the ROM's verified interval must cover."""
-    a, b = res.truth_sweep.stable_V
-    lo, hi = res.settings.required
+    a, b = res.closed_loop.truth_sweep.stable_V
+    lo, hi = res.config.verify.required
     assert a <= lo * res.Vf_truth and b >= hi * res.Vf_truth, (a, b)
 
 
@@ -118,7 +127,7 @@ def test_flutter_check():
     0.5, 1 and 1.2 Vf, six minimax solves; about 15 s).  One test function, not a module
     fixture shared by several: under ``pytest -n 2`` a shared fixture would be computed once
     per worker.  Measured: truth closed loop stable on (0.02, 1.2413) x Vf_truth."""
-    res = flutter_check(TypicalSection())
+    res = flutter_check()
     _check_rom_and_truth_flutter(res)
     _check_verification(res)
     _check_targets(res)
@@ -139,19 +148,19 @@ def test_truth_loop_matrix_without_controller_is_the_truth():
 
 
 def test_settings_validation():
-    with pytest.raises(ConfigError, match="valid: V0, v0_iterations"):
-        flutter_check_settings(V00=2.0)
+    with pytest.raises(ConfigError, match="unknown key 'V00' in \\[data\\]; allowed: V0"):
+        flutter_check_settings(**{"data.V00": 2.0})
     with pytest.raises(ConfigError, match="containing 1.0"):
-        FlutterCheckSettings(speed_factors=(0.5, 1.2))
-    with pytest.raises(ConfigError, match="sim_factor > 1"):
-        FlutterCheckSettings(sim_factor=0.9)
+        flutter_check_settings(**{"controller.speeds": [0.5, 1.2]})
+    with pytest.raises(ConfigError, match="closed_loop.speed_factor = 0.9: must be > 1"):
+        flutter_check_settings(**{"closed_loop.speed_factor": 0.9})
     s = flutter_check_settings()
-    assert s.order == 2 and s.required == (0.5, 1.2)
+    assert s.controller.order == 2 and s.verify.required == (0.5, 1.2)
 
 
 @pytest.fixture(scope="module")
 def full():
-    return flutter_check(TypicalSection(), flutter_check_settings(**FULL))
+    return flutter_check(flutter_check_settings(**FULL))
 
 
 @pytest.mark.slow

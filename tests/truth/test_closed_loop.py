@@ -1,11 +1,11 @@
-"""Truth-side simulations of the run: the sampled-data closed loop against the truth's own
-integrator, and the gain schedule."""
+"""The truth in closed loop: the sampled-data loop against the truth's own integrator, the
+gain schedule, and the linear loop."""
 
 import control
 import numpy as np
 import pytest
 
-from casflutter.pipeline._suppression import closed_loop_truth, gain_schedule
+from casflutter.truth import closed_loop_truth, gain_schedule
 from casflutter.truth import load_problem
 
 
@@ -24,16 +24,15 @@ def test_open_loop_matches_truth_simulate(wing):
     reproduce the truth's own adaptive integration (DOP853)."""
     V, dt = 1.0, 0.002
     t = np.arange(0.0, 1.0, dt)
-    x0 = np.zeros(10)
-    x0[1] = 0.05
+    x0 = wing.displaced_state(1, 0.05)
     K = control.ss([[-1.0]], [[1.0, 1.0]], [[1.0]], [[0.0, 0.0]])
     cl = closed_loop_truth(wing, K, V, t, x0, lambda tt: 0.0)
     ref = wing.simulate(t, x0, V)
-    Hs = np.asarray(wing.modal_structure().sensor_rows)
+    Hs = np.asarray(wing.modal_structure().Hs)
     zm_ref = ref.uddot @ Hs.T
-    err = np.abs(cl["zm"] - zm_ref).max() / np.abs(zm_ref).max()
+    err = np.abs(cl.zm - zm_ref).max() / np.abs(zm_ref).max()
     assert err < 1e-5
-    np.testing.assert_array_equal(cl["v"], 0.0)
+    np.testing.assert_array_equal(cl.v, 0.0)
 
 
 def test_flap_dynamics_linearisation_is_state_matrix(wing):

@@ -1,0 +1,410 @@
+"""The typed result of a study run, one field per stage, and its JSON summary."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+import control
+import numpy as np
+
+from ..aeroelastic import (AeroelasticLFT, AeroelasticSystem, FlutterResult, LoopSimulation,
+                           ParametricSystem)
+from ..data import IOData
+from ..design import SynthesisResult
+from ..ident import CommonDenominatorResult, FitReport, IdentificationResult
+from ..realize import ParametricROM, Realization
+from ..truth import AeroelasticTruth, SuppressionResult, TruthLco, TruthLoopSweep
+from ..verify import SpeedSweep, VerificationReport
+from ._config import RunConfig
+
+__all__ = ["RunResult", "LcoResult", "ParametricResult", "SimulationCheck",
+           "ClosedLoopChecks"]
+
+
+@dataclass(frozen=True)
+class LcoResult:
+    """The LCO stage (paper Fig. 9).
+
+    Attributes
+    ----------
+    rom : LoopSimulation
+        The nonlinear ROM in the loop with Σs at ``V``.
+    truth : TruthLco
+        The truth's own response a little above its own flutter speed.
+    V : float
+        Speed of the ROM simulation: ``lco.speed_factor`` times ``V_hopf_exact_order``.
+    V_hopf_exact_order : float
+        Hopf speed of the ROM realised at its exact order (the nonlinear ROM carries its full
+        linear part; a truncated Σf has another Hopf point).
+    flutter_exact_order : FlutterResult
+        The flutter search of that exact-order loop.
+    """
+
+    rom: LoopSimulation
+    truth: TruthLco
+    V: float
+    V_hopf_exact_order: float
+    flutter_exact_order: FlutterResult
+
+
+@dataclass(frozen=True)
+class ParametricResult:
+    """The parametric-ROM stage.
+
+    Attributes
+    ----------
+    rom : ParametricROM
+        Common-denominator ROMs at several speeds, interpolated in V.
+    system : ParametricSystem
+        Its ΣAE(V).
+    flutter : FlutterResult
+        Its flutter search.
+    """
+
+    rom: ParametricROM
+    system: ParametricSystem
+    flutter: FlutterResult
+
+
+@dataclass(frozen=True)
+class SimulationCheck:
+    """Open- and closed-loop simulation at one speed above flutter.
+
+    Attributes
+    ----------
+    model : str
+        ``"rom"`` or ``"truth"``.
+    V : float
+        Speed index.
+    timepts : ndarray
+        Sample times.
+    open_loop, closed_loop : ndarray, shape (K, m)
+        Sensor records.
+    open_rate, closed_rate : float
+        Envelope growth rates (largest over the sensors, second half of the record)
+        [1 / time unit].
+    open_eig_rate, closed_eig_rate : float
+        Spectral abscissae of the linear open and closed loops at ``V``.
+    """
+
+    model: str
+    V: float
+    timepts: np.ndarray
+    open_loop: np.ndarray
+    closed_loop: np.ndarray
+    open_rate: float
+    closed_rate: float
+    open_eig_rate: float
+    closed_eig_rate: float
+
+    @property
+    def grows_open_decays_closed(self) -> bool:
+        """The open loop grows and the closed loop decays (rates and amplitudes)."""
+        n = self.timepts.size
+        first, last = slice(0, n // 4), slice(3 * n // 4, n)
+
+        def amp(X, sl):
+            return float(np.max(np.abs(X[sl])))
+
+        return bool(self.open_rate > 0 and self.closed_rate < 0
+                    and amp(self.open_loop, last) > amp(self.open_loop, first)
+                    and amp(self.closed_loop, last) < amp(self.closed_loop, first))
+
+
+@dataclass(frozen=True)
+class ClosedLoopChecks:
+    """The closed-loop stage: the loops above flutter and the truth's closed-loop sweep.
+
+    Attributes
+    ----------
+    truth_sweep : TruthLoopSweep
+        The truth's linear loop with the controller and the actuator over speed.
+    rom_simulation, truth_simulation : SimulationCheck
+        Open and closed loop above each model's flutter speed.
+    """
+
+    truth_sweep: TruthLoopSweep
+    rom_simulation: SimulationCheck
+    truth_simulation: SimulationCheck
+
+
+def _jsonable(x: Any):
+    """Plain JSON values: floats (non-finite as ``None``), ints, lists, dicts."""
+    if isinstance(x, dict):
+        return {k: _jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, (np.floating, float)):
+        return None if not np.isfinite(x) else float(x)
+    if isinstance(x, (np.integer,)):
+        return int(x)
+    if isinstance(x, np.ndarray):
+        return _jsonable(x.tolist())
+    return x
+
+
+def _pair(t):
+    return None if t is None else [float(t[0]), float(t[1])]
+
+
+def _flutter_summary(res: FlutterResult | None) -> dict | None:
+    if res is None:
+        return None
+    if res.flutter is None:
+        return {"V": None, "freq_hz": None, "mode": None, "status": res.status}
+    mode = res.flutter_mode
+    return {"V": float(res.Vf), "freq_hz": float(res.omega_f) / (2 * np.pi),
+            "mode": None if mode is None or mode < 0 else int(mode) + 1, "status": res.status}
+
+
+def _rel(a, b):
+    return None if a is None or b is None else float(a / b - 1.0)
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """Everything a study run produced, one typed field per stage (``None``: not run).
+
+    Attributes
+    ----------
+    config : RunConfig
+        The configuration.
+    truth : AeroelasticTruth
+        The truth simulator.
+    data : IOData
+        The chirp records of the last identification.
+    identification : IdentificationResult or CommonDenominatorResult
+        The ROM (``.model``).
+    identification_history : tuple of (float, float)
+        ``(V0, Vf_ROM)`` of every identification (more than one with ``rom.v0_iterations``).
+    fit : FitReport
+        Free-run fit of the ROM on its records (paper Fig. 7).
+    realization : Realization
+        Σf by ERA and Tustin (eq. 5).
+    system : AeroelasticSystem
+        ΣAE(V) (eq. 8-9).
+    flutter, flutter_truth : FlutterResult
+        Flutter searches of the ROM and of the truth.
+    flutter_frozen : FlutterResult or None
+        Of the truth with its aerodynamics frozen at ``V0`` (stage ``frozen``).
+    parametric : ParametricResult or None
+        Stage ``parametric``.
+    lco : LcoResult or None
+        Stage ``lco``.
+    lft : AeroelasticLFT or None
+        LFT at the ROM's Vf (eq. 14; stage ``controller``).
+    synthesis : SynthesisResult or None
+        The fixed-order synthesis.
+    controller : control.StateSpace or None
+        ``K`` from the sensors to the flap (``v = K zm``).
+    verification : VerificationReport or None
+        γ and the speed intervals (eq. 10-16).
+    rom_sweep : SpeedSweep or None
+        Dense eigenvalue sweep of the ROM loop (``verify.sweep``).
+    closed_loop : ClosedLoopChecks or None
+        Stage ``closed_loop``.
+    suppression : SuppressionResult or None
+        Stage ``suppression`` (paper Fig. 11).
+    timings : mapping
+        Seconds per stage and ``"total"``.
+    out_dir : Path or None
+        Where the files were written.
+    files : mapping
+        Name -> path of every file written.
+    """
+
+    config: RunConfig
+    truth: AeroelasticTruth
+    data: IOData
+    identification: IdentificationResult | CommonDenominatorResult
+    identification_history: tuple
+    fit: FitReport
+    realization: Realization
+    system: AeroelasticSystem
+    flutter: FlutterResult
+    flutter_truth: FlutterResult
+    flutter_frozen: FlutterResult | None = None
+    parametric: ParametricResult | None = None
+    lco: LcoResult | None = None
+    lft: AeroelasticLFT | None = None
+    synthesis: SynthesisResult | None = None
+    controller: control.StateSpace | None = None
+    verification: VerificationReport | None = None
+    rom_sweep: SpeedSweep | None = None
+    closed_loop: ClosedLoopChecks | None = None
+    suppression: SuppressionResult | None = None
+    timings: Mapping[str, float] = field(default_factory=dict)
+    out_dir: Path | None = None
+    files: Mapping[str, Path] = field(default_factory=dict)
+
+    # ------------------------------------------------------------------ flutter speeds
+    @property
+    def Vf(self) -> float | None:
+        """The ROM's flutter speed index (the LFT's nominal speed)."""
+        return self.flutter.Vf
+
+    @property
+    def Vf_truth(self) -> float | None:
+        """The truth's flutter speed index."""
+        return self.flutter_truth.Vf
+
+    @property
+    def rom_error(self) -> float | None:
+        """``(Vf_rom - Vf_truth) / Vf_truth``."""
+        return _rel(self.flutter.Vf, self.flutter_truth.Vf)
+
+    @property
+    def scaling_error(self) -> float | None:
+        """``(Vf_frozen - Vf_truth) / Vf_truth``: the error the V² scaling alone causes."""
+        return None if self.flutter_frozen is None else _rel(self.flutter_frozen.Vf,
+                                                             self.flutter_truth.Vf)
+
+    @property
+    def identification_error(self) -> float | None:
+        """``(Vf_rom - Vf_frozen) / Vf_frozen``: what identification and Tustin add."""
+        return None if self.flutter_frozen is None else _rel(self.flutter.Vf,
+                                                             self.flutter_frozen.Vf)
+
+    @property
+    def parametric_error(self) -> float | None:
+        """``(Vf_parametric - Vf_truth) / Vf_truth``."""
+        return None if self.parametric is None else _rel(self.parametric.flutter.Vf,
+                                                         self.flutter_truth.Vf)
+
+    def explanation(self) -> str:
+        """The ROM's flutter-speed error and its cause, in words.
+
+        Returns
+        -------
+        str
+        """
+        def pct(x):
+            return "n/a" if x is None else f"{100 * x:+.3f}%"
+        text = (f"ROM identified at V0 = {self.config.data.V0:g}: Vf error "
+                f"{pct(self.rom_error)} vs the truth.")
+        if self.flutter_frozen is not None:
+            text += (f" The V² scaling of ΣAE freezes the aerodynamic time scale (reduced "
+                     f"frequency, Wagner lag rates, apparent mass and damping) at V0; the truth "
+                     f"with its aerodynamics frozen at V0 flutters at "
+                     f"{pct(self.scaling_error)}, so the scaling explains the error up to "
+                     f"{pct(self.identification_error)} from identification and Tustin.")
+        if self.parametric is not None:
+            text += (f" Parametric ROM ({len(self.parametric.rom.speeds)} speeds): "
+                     f"{pct(self.parametric_error)}.")
+        return text
+
+    # ------------------------------------------------------------------ verification
+    @property
+    def gamma(self) -> float | None:
+        """Verified ``‖T_w̄z‖∞`` of the nominal loop (eq. 16)."""
+        return None if self.verification is None else float(self.verification.gamma)
+
+    @property
+    def required_V(self) -> tuple | None:
+        """``verify.required`` times Vf (``None`` without a target)."""
+        req = self.config.verify.required
+        if not req or self.Vf is None:
+            return None
+        return (req[0] * self.Vf, req[1] * self.Vf)
+
+    @property
+    def interval_ok(self) -> bool | None:
+        """The verified exact stable interval contains :attr:`required_V` (``None`` without a
+        target or a verification)."""
+        if self.required_V is None or self.verification is None:
+            return None
+        ex = self.verification.exact_V
+        lo, hi = self.required_V
+        return bool(self.verification.stable and ex is not None and ex[0] <= lo
+                    and ex[1] >= hi)
+
+    @property
+    def success(self) -> bool:
+        """Every check that ran passed: the interval target, and both closed-loop
+        simulations grow open loop and decay closed loop."""
+        ok = self.interval_ok is not False
+        if self.closed_loop is not None:
+            ok = ok and self.closed_loop.rom_simulation.grows_open_decays_closed \
+                and self.closed_loop.truth_simulation.grows_open_decays_closed
+        return bool(ok)
+
+    # ------------------------------------------------------------------ summary
+    def summary(self) -> dict:
+        """The measured numbers as plain JSON values (``summary.json``).
+
+        Returns
+        -------
+        dict
+            ``problem``, ``V0``, ``n_sensors``, ``orders``, ``n_params``,
+            ``fit_error_percent``, ``nf``, ``ns``, ``nae``, ``flutter``, ``flutter_truth``,
+            ``lco``, ``controller``, ``suppression`` (``None`` when the stage did not run),
+            ``timings_s``, ``seed``; and, for the stages that ran, ``v0_history``,
+            ``flutter_frozen``, ``flutter_parametric``, ``verification`` and
+            ``closed_loop``.
+        """
+        cfg, model = self.config, self.identification.model
+        out = {
+            "problem": cfg.problem.name,
+            "V0": cfg.data.V0,
+            "n_sensors": int(self.system.structure.n_sensors),
+            "orders": list(model.orders.as_tuple()),
+            "n_params": model.n_params,
+            "fit_error_percent": list(self.fit.error_percent),
+            "nf": self.realization.order,
+            "ns": 2 * model.n_modes,
+            "nae": int(self.system.state_matrix(0.0).shape[0]),
+            "flutter": _flutter_summary(self.flutter),
+            "flutter_truth": _flutter_summary(self.flutter_truth),
+            "lco": self._lco_summary(),
+            "controller": self._controller_summary(),
+            "suppression": None if self.suppression is None else {
+                "attenuation_percent": self.suppression.attenuation_percent,
+                "lco_returns": self.suppression.lco_returns, "V": self.suppression.V},
+            "timings_s": dict(self.timings),
+            "seed": cfg.seed,
+        }
+        if cfg.rom.v0_iterations > 1:
+            out["v0_history"] = [list(map(float, p)) for p in self.identification_history]
+        if self.flutter_frozen is not None:
+            out["flutter_frozen"] = _flutter_summary(self.flutter_frozen)
+        if self.parametric is not None:
+            out["flutter_parametric"] = _flutter_summary(self.parametric.flutter)
+        if self.verification is not None and cfg.verify.required:
+            ver = self.verification
+            out["verification"] = {
+                "gamma_delta": float(ver.hinf_delta.gamma),
+                "small_gain_V_delta": _pair(ver.small_gain_V_delta),
+                "required_V": _pair(self.required_V), "interval_ok": self.interval_ok,
+                "synthesis_gammas": [float(g) for g in self.synthesis.gammas],
+                "synthesis_converged": bool(self.synthesis.converged),
+                "success": self.success}
+        if self.closed_loop is not None:
+            cl = self.closed_loop
+            out["closed_loop"] = {
+                "truth_stable_V": _pair(cl.truth_sweep.stable_V),
+                "simulations": {s.model: {"V": s.V, "open_rate": s.open_rate,
+                                          "closed_rate": s.closed_rate,
+                                          "open_eig_rate": s.open_eig_rate,
+                                          "closed_eig_rate": s.closed_eig_rate}
+                                for s in (cl.rom_simulation, cl.truth_simulation)}}
+        return _jsonable(out)
+
+    def _lco_summary(self) -> dict | None:
+        if self.lco is None:
+            return None
+        sim, tr = self.lco.rom, self.lco.truth
+        sens = sim.sensors if sim.sensors is not None else sim.modes
+        return {"V": self.lco.V, "V_hopf_exact_order": self.lco.V_hopf_exact_order,
+                "freq_hz": sens.frequency_hz, "amplitude": list(sens.amplitude),
+                "kind": sens.kind, "truth_V": tr.V, "truth_freq_hz": tr.freq_hz,
+                "truth_amplitude": list(tr.amplitude), "truth_kind": tr.kind}
+
+    def _controller_summary(self) -> dict | None:
+        if self.verification is None:
+            return None
+        ver = self.verification
+        return {"order": self.synthesis.order, "gamma": ver.gamma,
+                "small_gain_V": _pair(ver.small_gain_V), "stable_V": _pair(ver.exact_V),
+                "stable": bool(ver.stable)}

@@ -1,0 +1,418 @@
+"""A truth simulator in closed loop with a controller: the wind tunnel of the paper's §IV.
+
+- :func:`closed_loop_truth` — the sampled-data loop of the nonlinear truth, a controller
+  ``K`` (ZOH at the sample time) and a second-order flap actuator, with a gain schedule
+  ``g(t)`` on the controller output (paper Fig. 11 ramps it 0 -> 1);
+- :func:`suppression_run` — paper Fig. 11: the LCO develops, the gain ramps, holds and is
+  released; the attenuation of the dominant sensor;
+- :func:`truth_loop_matrix` / :func:`truth_loop_sweep` — the truth's *linear* loop with the
+  controller and the actuator, and its spectral abscissa over a range of speeds with the
+  closed-loop stable interval around the flutter speed.
+
+Controllers follow the convention of eq. 14: the flap command is ``v_c = +K zm``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import control
+import numpy as np
+from scipy.optimize import brentq
+
+from .._linalg import spectral_abscissa
+from ..errors import CasflutterError, ConfigError
+
+__all__ = ["TruthLoopSimulation", "closed_loop_truth", "gain_schedule", "SuppressionSettings",
+           "SuppressionResult", "suppression_run", "truth_loop_matrix", "TruthLoopSweep",
+           "truth_loop_sweep"]
+
+
+def _sensor_rows(truth, rows) -> np.ndarray:
+    """``Hs`` of a truth: ``rows`` if given (checked), else the truth's own."""
+    return truth.modal_structure().with_sensors(rows).Hs
+
+
+@dataclass(frozen=True)
+class TruthLoopSimulation:
+    """Record of :func:`closed_loop_truth` (NaN after a blow-up).
+
+    Attributes
+    ----------
+    timepts : ndarray, shape (K,)
+        Sample times.
+    zm : ndarray, shape (K, n_sensors)
+        Sensor readings.
+    v : ndarray, shape (K,)
+        Flap angle (actuator output).
+    gain : ndarray, shape (K,)
+        Gain schedule ``g(t_k)``.
+    """
+
+    timepts: np.ndarray
+    zm: np.ndarray
+    v: np.ndarray
+    gain: np.ndarray
+
+
+def gain_schedule(settle: float, ramp: float, hold: float) -> Callable[[float], float]:
+    """g(t): 0 for ``t < settle``, linear to 1 over ``ramp``, 1 for ``hold``, then 0.
+
+    Parameters
+    ----------
+    settle, ramp, hold : float
+        Durations of the open loop, of the ramp and of the full gain.
+
+    Returns
+    -------
+    callable
+        ``g(t) -> float``.
+    """
+    t_on, t_full, t_off = settle, settle + ramp, settle + ramp + hold
+
+    def g(t: float) -> float:
+        if t < t_on or t >= t_off:
+            return 0.0
+        if t < t_full:
+            return (t - t_on) / ramp
+        return 1.0
+
+    return g
+
+
+def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain, *,
+                      actuator_omega: float = 2 * np.pi * 40.0, actuator_zeta: float = 0.7,
+                      substeps: int = 4, sensor: str = "acceleration",
+                      kick: tuple[float, int, float] | None = None,
+                      sensor_rows=None) -> TruthLoopSimulation:
+    """Sampled-data closed loop of the nonlinear truth with the controller ``K``.
+
+    At every sample ``t_k`` the sensors are read, the controller (ZOH discretisation at the
+    sample time) updates, and the flap command ``v_c = g(t_k) K zm`` is held until
+    ``t_{k+1}``; the flap follows a second-order actuator (our choice, the paper gives none),
+    which supplies the flap rate and acceleration the aerodynamics need.  The truth is
+    integrated by classical Runge--Kutta with ``substeps`` steps per sample.
+
+    Parameters
+    ----------
+    truth : AeroelasticTruth
+        The simulator (its :meth:`flap_dynamics`).
+    K : control.StateSpace
+        Continuous controller from the sensors to the flap command.
+    V : float
+        Speed index.
+    timepts : array_like, shape (K,)
+        Uniform sample times.
+    x0 : array_like
+        Initial state: ``[u, u']`` (flow at rest, e.g. :meth:`displaced_state`) or the full
+        state.
+    gain : callable
+        ``g(t)`` multiplying the controller output.
+    actuator_omega, actuator_zeta : float
+        Natural frequency [rad per time unit] and damping ratio of the flap actuator.
+    substeps : int
+        Runge--Kutta steps per sample.
+    sensor : {"acceleration", "displacement"}
+        ``zm = Hs u''`` (the paper's accelerometers) or ``zm = Hs u``.
+    kick : (float, int, float), optional
+        ``(time, mode, deflection)``: a modal deflection added at that time (a tap on the
+        wing, as the tunnel's turbulence would give), so that a released flutter can restart
+        from a quiet wing.
+    sensor_rows : array_like, shape (n_sensors, N), optional
+        ``Hs`` (default: the truth's own).
+
+    Returns
+    -------
+    TruthLoopSimulation
+        Stopped (NaN from there on) when the state blows up.
+    """
+    if sensor not in ("acceleration", "displacement"):
+        raise ConfigError(f"sensor={sensor!r}: use 'acceleration' or 'displacement'")
+    t = np.asarray(timepts, dtype=float)
+    dt = float(t[1] - t[0])
+    f = truth.flap_dynamics(V)
+    Hs = _sensor_rows(truth, sensor_rows)
+    N = truth.n_modes
+    Kd = control.sample_system(K, dt, method="zoh") if K.nstates else K
+    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (Kd.A, Kd.B, Kd.C, Kd.D))
+    nk = Ak.shape[0] if K.nstates else 0
+    nx = truth.state_matrix(V).shape[0]
+    s = np.zeros(nx)
+    x0 = np.asarray(x0, dtype=float).ravel()
+    s[:x0.size] = x0  # [u, u'] (flow at rest) or the full state
+    xa = np.zeros(2)  # actuator: v, v'
+    xk = np.zeros(nk)
+    wa2, ca = actuator_omega ** 2, 2 * actuator_zeta * actuator_omega
+    h = dt / substeps
+    n = t.size
+    ZM = np.full((n, Hs.shape[0]), np.nan)
+    Vf = np.zeros(n)
+    G = np.zeros(n)
+
+    def deriv(s_, xa_, vc):
+        vdd = wa2 * (vc - xa_[0]) - ca * xa_[1]
+        ds, _ = f(s_, xa_[0], xa_[1], vdd)
+        return ds, np.array([xa_[1], vdd])
+
+    vc = 0.0  # command held over the current sample interval
+    kicked = kick is None
+    for k in range(n):
+        if not kicked and t[k] >= kick[0]:
+            s[:2 * N] += truth.displaced_state(kick[1], kick[2])
+            kicked = True
+        vdd_now = wa2 * (vc - xa[0]) - ca * xa[1]
+        _, acc = f(s, xa[0], xa[1], vdd_now)
+        zm = Hs @ (acc if sensor == "acceleration" else s[:Hs.shape[1]])
+        if not np.all(np.isfinite(zm)) or np.abs(s).max() > 1e6:
+            break
+        ZM[k], Vf[k], G[k] = zm, xa[0], gain(t[k])
+        vc = G[k] * float((Ck @ xk + Dk @ zm)[0]) if nk else G[k] * float((Dk @ zm)[0])
+        if nk:
+            xk = Ak @ xk + Bk @ zm
+        if k == n - 1:
+            break
+        for _ in range(substeps):
+            k1s, k1a = deriv(s, xa, vc)
+            k2s, k2a = deriv(s + 0.5 * h * k1s, xa + 0.5 * h * k1a, vc)
+            k3s, k3a = deriv(s + 0.5 * h * k2s, xa + 0.5 * h * k2a, vc)
+            k4s, k4a = deriv(s + h * k3s, xa + h * k3a, vc)
+            s = s + h / 6 * (k1s + 2 * k2s + 2 * k3s + k4s)
+            xa = xa + h / 6 * (k1a + 2 * k2a + 2 * k3a + k4a)
+    return TruthLoopSimulation(t, ZM, Vf, G)
+
+
+@dataclass(frozen=True)
+class SuppressionSettings:
+    """The gain-ramp run of paper Fig. 11 (times in the problem's time unit)."""
+
+    speed_factor: float = 1.05
+    """Run at ``speed_factor`` times the truth's own flutter speed (where the wing itself has
+    an LCO)."""
+    settle: float = 10.0
+    """Open loop: the LCO develops."""
+    ramp: float = 5.0
+    """The controller gain rises linearly from 0 to 1."""
+    hold: float = 10.0
+    """Full gain."""
+    release: float = 10.0
+    """Open loop again, after a tap on the wing: the LCO returns."""
+
+    def __post_init__(self):
+        for name in ("speed_factor", "settle", "ramp", "hold", "release"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+                raise ConfigError(f"{name} = {value!r}: must be > 0")
+
+
+@dataclass(frozen=True)
+class SuppressionResult:
+    """Outcome of :func:`suppression_run`.
+
+    Attributes
+    ----------
+    V : float
+        Speed index of the run.
+    simulation : TruthLoopSimulation
+        The closed-loop record.
+    attenuation_percent : float or None
+        ``100 (1 - rms_closed / rms_open)`` of the dominant sensor (``None`` when the open
+        loop is at rest).
+    open_loop_rms, closed_loop_rms, released_rms : tuple of float
+        RMS per sensor over the last third of the settling phase, of the hold and of the
+        release.
+    lco_returns : bool
+        After the release the dominant sensor climbs back above half its open-loop RMS.
+    dominant_sensor : int
+        The sensor with the largest open-loop RMS.
+    """
+
+    V: float
+    simulation: TruthLoopSimulation
+    attenuation_percent: float | None
+    open_loop_rms: tuple
+    closed_loop_rms: tuple
+    released_rms: tuple
+    lco_returns: bool
+    dominant_sensor: int
+
+
+def suppression_run(truth, K: control.StateSpace, V_flutter: float,
+                    settings: SuppressionSettings | None = None, *, dt: float, mode: int,
+                    deflection: float, sensor_rows=None,
+                    sensor: str = "acceleration") -> SuppressionResult:
+    """Paper Fig. 11 on the truth: the LCO develops, the gain ramps 0 -> 1, holds, is released.
+
+    The attenuation compares the RMS of the dominant sensor over the last third of the
+    hold with its RMS over the last third of the settling phase (open-loop LCO);
+    ``lco_returns`` checks that after the release (the wing is tapped with the initial
+    deflection at that moment) the amplitude climbs back above half the open-loop LCO.
+
+    Parameters
+    ----------
+    truth : AeroelasticTruth
+        The simulator.
+    K : control.StateSpace
+        Controller from the accelerometers to the flap command.
+    V_flutter : float
+        The truth's flutter speed index; the run is at ``settings.speed_factor`` times it.
+    settings : SuppressionSettings, optional
+        Durations and speed factor.
+    dt : float
+        Sample time of the loop.
+    mode : int
+        0-based mode deflected at the start and at the release.
+    deflection : float
+        Its deflection.
+    sensor_rows : array_like, optional
+        Sensor rows ``Hs`` (default: the truth's own).
+    sensor : {"acceleration", "displacement"}
+        What the sensors read (:func:`closed_loop_truth`).
+
+    Returns
+    -------
+    SuppressionResult
+
+    Raises
+    ------
+    CasflutterError
+        The closed-loop simulation blew up.
+    """
+    sp = settings or SuppressionSettings()
+    V = V_flutter * sp.speed_factor
+    T = sp.settle + sp.ramp + sp.hold + sp.release
+    t = np.arange(0.0, T, dt)
+    g = gain_schedule(sp.settle, sp.ramp, sp.hold)
+    t_release = sp.settle + sp.ramp + sp.hold
+    sim = closed_loop_truth(truth, K, V, t, truth.displaced_state(mode, deflection), g,
+                            kick=(t_release, mode, deflection), sensor_rows=sensor_rows,
+                            sensor=sensor)
+    zm = sim.zm
+    if not np.all(np.isfinite(zm)):
+        raise CasflutterError(f"the closed-loop truth simulation at V = {V:.4f} blew up")
+
+    def rms(a, b):
+        sel = (t >= a) & (t < b)
+        return np.sqrt(np.mean(zm[sel] ** 2, axis=0))
+
+    open_rms = rms(sp.settle * 2 / 3, sp.settle)
+    dom = int(np.argmax(open_rms))
+    t_full = sp.settle + sp.ramp
+    closed_rms = rms(t_full + sp.hold * 2 / 3, t_full + sp.hold)
+    after = rms(T - sp.release / 3, T)
+    att = 100.0 * (1.0 - closed_rms[dom] / open_rms[dom]) if open_rms[dom] > 0 else None
+    return SuppressionResult(V=float(V), simulation=sim,
+                             attenuation_percent=None if att is None else float(att),
+                             open_loop_rms=tuple(map(float, open_rms)),
+                             closed_loop_rms=tuple(map(float, closed_rms)),
+                             released_rms=tuple(map(float, after)),
+                             lco_returns=bool(after[dom] > 0.5 * open_rms[dom]),
+                             dominant_sensor=dom)
+
+
+def truth_loop_matrix(truth, K: control.StateSpace, V: float, *, actuator_omega: float,
+                      actuator_zeta: float = 0.7, sensor_rows=None) -> np.ndarray:
+    """State matrix of the truth's linear loop with the flap command ``v_c = K zm``.
+
+    The truth's :meth:`statespace` with the flap behind the actuator, read by displacement
+    sensors ``zm = Hs u``, closed by ``K`` from ``zm`` to ``v_c`` (positive feedback, the
+    ``control.hinfsyn`` convention of eq. 14).  States ``[x_truth, x_actuator, x_K]``.
+
+    Parameters
+    ----------
+    truth : AeroelasticTruth
+        The simulator.
+    K : control.StateSpace
+        Controller from the sensors to the flap command.
+    V : float
+        Speed index.
+    actuator_omega, actuator_zeta : float
+        The flap actuator.
+    sensor_rows : array_like, optional
+        ``Hs`` (default: the truth's own).
+
+    Returns
+    -------
+    ndarray
+    """
+    G = truth.statespace(V, actuator_omega=actuator_omega, actuator_zeta=actuator_zeta)
+    A, B = np.asarray(G.A), np.asarray(G.B)[:, :1]
+    Hs = _sensor_rows(truth, sensor_rows)
+    C = np.zeros((Hs.shape[0], A.shape[0]))
+    C[:, :truth.n_modes] = Hs
+    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in
+                      (K.A, K.B, K.C, K.D))
+    if K.nstates == 0:
+        return A + B @ Dk @ C
+    return np.block([[A + B @ Dk @ C, B @ Ck], [Bk @ C, Ak]])
+
+
+@dataclass(frozen=True)
+class TruthLoopSweep:
+    """The truth's linear loop with the controller over a grid of speed indices.
+
+    Attributes
+    ----------
+    V : ndarray
+        Speed indices.
+    open_abscissa, closed_abscissa : ndarray
+        Spectral abscissae of the open loop (flap at rest) and of the closed loop
+        (controller + actuator).
+    stable_V : tuple of float or None
+        Closed-loop stable interval containing the truth's flutter speed (edges refined by
+        root bracketing; a grid end is reported where the loop is still stable); ``None``
+        when the closed loop is unstable there.
+    """
+
+    V: np.ndarray
+    open_abscissa: np.ndarray
+    closed_abscissa: np.ndarray
+    stable_V: tuple | None
+
+
+def truth_loop_sweep(truth, K: control.StateSpace, V_flutter: float, V, *,
+                     actuator_omega: float, actuator_zeta: float = 0.7,
+                     sensor_rows=None) -> TruthLoopSweep:
+    """Open- and closed-loop spectral abscissae of the truth's linear loop on a grid of V.
+
+    Parameters
+    ----------
+    truth : AeroelasticTruth
+        The simulator.
+    K : control.StateSpace
+        Controller from the (displacement) sensors to the flap command.
+    V_flutter : float
+        The truth's flutter speed index: the stable interval reported is the one around it.
+    V : array_like
+        Increasing speed indices.
+    actuator_omega, actuator_zeta : float
+        The flap actuator.
+    sensor_rows : array_like, optional
+        ``Hs`` (default: the truth's own).
+
+    Returns
+    -------
+    TruthLoopSweep
+    """
+    kw = dict(actuator_omega=actuator_omega, actuator_zeta=actuator_zeta,
+              sensor_rows=sensor_rows)
+    V = np.asarray(V, dtype=float)
+    ol = np.array([spectral_abscissa(truth.state_matrix(v)) for v in V])
+
+    def cl_fun(v):
+        return spectral_abscissa(truth_loop_matrix(truth, K, v, **kw))
+
+    cl = np.array([cl_fun(v) for v in V])
+    i = int(np.argmin(np.abs(V - V_flutter)))
+    stable_V = None
+    if cl[i] < 0:
+        lo = i
+        while lo > 0 and cl[lo - 1] < 0:
+            lo -= 1
+        hi = i
+        while hi < V.size - 1 and cl[hi + 1] < 0:
+            hi += 1
+        a = V[0] if lo == 0 else brentq(cl_fun, V[lo - 1], V[lo], xtol=1e-10)
+        b = V[-1] if hi == V.size - 1 else brentq(cl_fun, V[hi], V[hi + 1], xtol=1e-10)
+        stable_V = (float(a), float(b))
+    return TruthLoopSweep(V, ol, cl, stable_V)

@@ -1,0 +1,142 @@
+"""Chirp records of a truth simulator: the paper's CFD runs (§IV.A) on a stand-in.
+
+The paper drives a full-order CFD solver with band-limited chirps on the modal
+displacements and records the generalised aerodynamic forces ``y``.  Here a truth simulator
+plays the CFD solver: one record per input channel (each modal displacement, then the flap),
+that channel following :func:`casflutter.data.chirp_motion` and the others at rest.
+
+Grid velocities.  A CFD solver advances in time steps and computes the grid velocity and
+acceleration of prescribed motion from the displacement samples by backward differences;
+its force samples are therefore a *causal* function of the displacement samples.  The
+truth's :meth:`~casflutter.truth.AeroelasticTruth.aero_forces` with exact derivatives would
+make the sampled map non-causal (the apparent-mass term ``u''(t_k)`` needs future samples),
+and every causal discrete model fitted to such data by least squares places poles outside
+the unit circle to imitate the phase lead.  The records therefore use second-order
+backward-difference (BDF2) derivatives (:func:`casflutter.data.backward_derivatives`), as a
+second-order implicit CFD code would; the resulting ``O((omega dt)^2)`` derivative error is
+part of the ROM error.
+
+Coupling delay.  In a loosely coupled CFD time march the flow of step ``k`` sees the grid of
+step ``k - 1``: the force lags the motion by one sample, the reason for the paper's input
+delay ``r = 1``.  :attr:`RecordSettings.coupling_delay` delays the forces by that many samples.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from .._settings import finite_numbers
+from ..data import IOData, Record, backward_derivatives, check_band, chirp_motion
+from ..errors import ConfigError
+
+__all__ = ["RecordSettings", "truth_records"]
+
+
+@dataclass(frozen=True)
+class RecordSettings:
+    """How the chirp records of a truth are taken (defaults: the paper's §IV.A records of the
+    seed wing, without coupling delay).
+
+    Speeds are speed indices of the problem; times in its time unit.
+    """
+
+    V0: float = 0.69
+    """Speed index at which the records are taken (Table I: 0.69)."""
+    dt: float = 0.002
+    """Sampling time."""
+    duration: float = 8.0
+    """Length of each record (at least 200 samples)."""
+    band: tuple = (0.2, 60.0)
+    """Chirp band ``(f_low, f_high)`` [cycles per time unit], below the Nyquist frequency."""
+    amplitude: float = 0.01
+    """Chirp amplitude of each modal displacement [per unit modal coordinate] / the flap
+    [rad]; the linear aerodynamics make it a scale only."""
+    taper: float = 0.1
+    """Raised-cosine taper fraction at each end of a record, in (0, 0.5]."""
+    flap: bool = True
+    """Also record the flap input ``v`` (the ROM then has the input ``v``)."""
+    coupling_delay: int = 0
+    """Samples between a motion and the force it produces (module docstring): 1 models the
+    loosely coupled CFD time march of the paper."""
+
+    def __post_init__(self):
+        for name in ("V0", "dt", "duration", "amplitude"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                    or not math.isfinite(value) or not value > 0:
+                raise ConfigError(f"{name} = {value!r}: must be > 0")
+            object.__setattr__(self, name, float(value))
+        band = finite_numbers("band", self.band, 2, what="[f_low, f_high] in Hz")
+        check_band(band, self.dt)
+        object.__setattr__(self, "band", band)
+        if self.duration / self.dt < 200:
+            raise ConfigError(f"duration / dt = {self.duration / self.dt:.0f} samples: at least "
+                              "200 are needed; lengthen duration or lower dt")
+        if not 0.0 < self.taper <= 0.5:
+            raise ConfigError(f"taper = {self.taper!r}: must lie in (0, 0.5]")
+        d = self.coupling_delay
+        if isinstance(d, bool) or not isinstance(d, int) or d < 0:
+            raise ConfigError(f"coupling_delay = {d!r}: must be an integer >= 0")
+        if d >= self.n_samples:
+            raise ConfigError(f"coupling_delay = {d} is not shorter than the record "
+                              f"({self.n_samples} samples)")
+
+    @property
+    def n_samples(self) -> int:
+        """Samples per record, ``round(duration / dt)``."""
+        return int(round(self.duration / self.dt))
+
+
+def truth_records(truth, settings: RecordSettings | None = None, **changes) -> IOData:
+    """Chirp records of a truth simulator at the speed index ``settings.V0``.
+
+    One record per input channel (each modal displacement, then the flap): that channel
+    follows :func:`casflutter.data.chirp_motion`, the others are held at zero, and the
+    forces ``y`` come from ``truth.aero_forces`` with BDF2 grid velocities, delayed by
+    ``coupling_delay`` samples (module docstring).
+
+    Parameters
+    ----------
+    truth : casflutter.truth.AeroelasticTruth
+        The simulator.
+    settings : RecordSettings, optional
+        Default :class:`RecordSettings()`.
+    **changes
+        Fields of :class:`RecordSettings` changed on top of ``settings`` (``V0=2.0``).
+
+    Returns
+    -------
+    IOData
+        ``N`` (or ``N + 1`` with the flap) records of ``round(duration / dt)`` samples;
+        ``meta`` holds ``V``, ``band`` and ``derivatives``.
+
+    Raises
+    ------
+    ConfigError
+        An invalid setting (named), e.g. a band above the Nyquist frequency.
+    """
+    s = replace(settings or RecordSettings(), **changes) if changes else (
+        settings or RecordSettings())
+    N = truth.n_modes
+    K, dt = s.n_samples, s.dt
+    t = np.arange(K) * dt
+    chirp, _, _ = chirp_motion(t, s.band, s.amplitude, s.taper)
+    names = truth.modal_structure().mode_names
+    n_in = N + (1 if s.flap else 0)
+    recs = []
+    for j in range(n_in):
+        w = np.zeros((K, N + 1))
+        w[:, j] = chirp
+        d1, d2 = backward_derivatives(w, dt)
+        y = truth.aero_forces(t, w[:, :N], w[:, N], s.V0, udot=d1[:, :N], uddot=d2[:, :N],
+                              vdot=d1[:, N], vddot=d2[:, N])
+        if s.coupling_delay:
+            y = np.vstack([np.zeros((s.coupling_delay, N)), y[:-s.coupling_delay]])
+        label = names[j] if j < N else "flap"
+        recs.append(Record(y, w[:, :N], w[:, N] if s.flap else None, name=f"chirp {label}"))
+    return IOData(tuple(recs), dt, output_names=tuple(f"y[{n}]" for n in names),
+                  u_names=tuple(f"u[{n}]" for n in names), v_name="v",
+                  meta={"V": float(s.V0), "band": tuple(s.band), "derivatives": "BDF2"})

@@ -1,0 +1,131 @@
+"""One driver, ``run(config) -> RunResult``: the shipped configurations (the paper's study on
+the seed wing and the flutter check on the typical section) run through it with a typed
+result per stage, and the configuration's tables are the stages' own settings classes."""
+
+import json
+from dataclasses import fields
+
+import control
+import pytest
+
+from casflutter._settings import field_names, settings_as
+from casflutter.aeroelastic import AeroelasticLFT, AeroelasticSystem, FlutterResult
+from casflutter.data import IOData
+from casflutter.design import SynthesisOptions, SynthesisResult
+from casflutter.ident import (CommonDenominatorResult, IdentificationResult,
+                              IdentificationSettings)
+from casflutter.pipeline import (ClosedLoopChecks, ControllerSettings, DataSection, LcoResult,
+                                 RomSection, RunResult, config_path, default_config_path,
+                                 load_config, run)
+from casflutter.realize import Realization
+from casflutter.truth import RecordSettings, SuppressionResult, SuppressionSettings
+from casflutter.verify import SpeedSweep, VerificationReport
+
+#: the keys of summary.json of ``casflutter run`` (the report, sweeps and scripts read them)
+SUMMARY_KEYS = {"problem", "V0", "n_sensors", "orders", "n_params", "fit_error_percent", "nf",
+                "ns", "nae", "flutter", "flutter_truth", "lco", "controller", "suppression",
+                "timings_s", "seed"}
+
+#: the seed wing's study, cut to a few seconds per stage (a poor controller, a whole run)
+STUDY_SMALL = {"data.duration": 4.0, "flutter.n_grid": 61, "lco.duration": 1.0,
+               "controller.order": 1, "controller.max_outer": 1, "controller.nslots": 2,
+               "controller.max_stab_rounds": 2,
+               "suppression": {"settle": 1.5, "ramp": 0.5, "hold": 1.5, "release": 1.0}}
+#: the flutter check, with short simulations and sweeps
+CHECK_SMALL = {"data.duration": 150.0, "controller.max_outer": 1, "closed_loop.duration": 30.0,
+               "closed_loop.n_sweep": 40, "verify.n_sweep": 61, "flutter.n_grid": 121}
+
+
+@pytest.fixture(scope="module")
+def study():
+    return run(load_config(default_config_path(), updates=STUDY_SMALL), quiet=True,
+               write=False)
+
+
+@pytest.fixture(scope="module")
+def check():
+    return run(load_config(config_path("typical_section", "flutter_check"),
+                           updates=CHECK_SMALL), quiet=True, write=False)
+
+
+def test_the_study_has_a_typed_field_per_stage(study):
+    r = study
+    assert isinstance(r, RunResult) and r.config.stages == ("lco", "controller", "suppression")
+    assert isinstance(r.data, IOData) and isinstance(r.identification, IdentificationResult)
+    assert isinstance(r.realization, Realization) and isinstance(r.system, AeroelasticSystem)
+    assert isinstance(r.flutter, FlutterResult) and isinstance(r.flutter_truth, FlutterResult)
+    assert isinstance(r.lco, LcoResult) and isinstance(r.lft, AeroelasticLFT)
+    assert isinstance(r.synthesis, SynthesisResult)
+    assert isinstance(r.controller, control.StateSpace)
+    assert isinstance(r.verification, VerificationReport)
+    assert isinstance(r.suppression, SuppressionResult)
+    assert r.closed_loop is None and r.parametric is None and r.flutter_frozen is None
+    # the stages read one another's results: the LFT sits at the ROM's flutter speed, the
+    # LCO a little above the exact-order Hopf point, the suppression above the truth's
+    assert r.lft.Vf == r.flutter.Vf
+    assert r.lco.V == pytest.approx(r.config.lco.speed_factor * r.lco.V_hopf_exact_order)
+    assert r.suppression.V == pytest.approx(r.config.suppression.speed_factor * r.Vf_truth)
+    assert r.controller.nstates == r.config.controller.order == 1
+
+
+def test_summary_keeps_the_keys_of_summary_json(study):
+    s = study.summary()
+    assert set(s) == SUMMARY_KEYS
+    json.dumps(s, allow_nan=False)   # plain JSON values, no NaN
+    assert s["flutter"]["V"] == study.flutter.Vf
+    assert s["controller"]["stable_V"] == list(study.verification.exact_V)
+    assert s["suppression"]["attenuation_percent"] == study.suppression.attenuation_percent
+    assert set(s["timings_s"]) == {"data", "rom", "realize", "structure", "flutter", "lco",
+                                   "lft", "controller", "verify", "suppression", "total"}
+
+
+def test_the_flutter_check_is_a_configuration_of_the_same_driver(check):
+    r = check
+    assert r.config.stages == ("controller", "closed_loop")
+    assert isinstance(r.identification, CommonDenominatorResult)
+    assert isinstance(r.closed_loop, ClosedLoopChecks) and isinstance(r.rom_sweep, SpeedSweep)
+    assert r.lco is None and r.suppression is None
+    # identified again at the ROM's own flutter speed until the two agree
+    V0, Vf = r.identification_history[-1]
+    assert len(r.identification_history) > 1 and abs(Vf - V0) <= r.config.rom.v0_rtol * Vf
+    assert r.config.data.V0 == r.identification_history[0][0]
+    s = r.summary()
+    assert SUMMARY_KEYS <= set(s) and s["lco"] is None and s["suppression"] is None
+    assert {"v0_history", "verification", "closed_loop"} <= set(s)
+    assert s["verification"]["interval_ok"] == r.interval_ok
+    json.dumps(s, allow_nan=False)
+
+
+@pytest.mark.parametrize("section, stage_class", [
+    (ControllerSettings, SynthesisOptions), (RomSection, IdentificationSettings),
+    (DataSection, RecordSettings)])
+def test_every_field_of_a_stages_settings_is_a_configuration_key(section, stage_class):
+    """The sections extend the stages' own classes: a field the stage adds is a key at once,
+    with the stage's default and the stage's own check."""
+    keys = field_names(section)
+    for f in fields(stage_class):
+        assert f.name in keys
+    assert settings_as(section(), stage_class) == stage_class(
+        **({"coupling_delay": 1} if stage_class is RecordSettings else {}))
+
+
+def test_a_configured_value_reaches_the_stage():
+    cfg = load_config(updates={"controller.polish_rank": 0, "controller.tol": 1e-4,
+                               "rom.shooting_interval": 20, "data.taper": 0.2,
+                               "suppression.hold": 3.0})
+    opts = settings_as(cfg.controller, SynthesisOptions)
+    assert (opts.polish_rank, opts.tol) == (0, 1e-4)
+    assert settings_as(cfg.rom, IdentificationSettings).shooting_interval == 20
+    assert settings_as(cfg.data, RecordSettings).taper == 0.2
+    assert isinstance(cfg.suppression, SuppressionSettings) and cfg.suppression.hold == 3.0
+
+
+def test_the_rom_route_needs_no_controller():
+    """Without a stage that needs the ROM's flutter speed, a range without flutter is a
+    result (``no_crossing``), not an error."""
+    cfg = load_config(config_path("typical_section", "flutter"),
+                      updates={"stages": [], "data.duration": 100.0, "flutter.n_grid": 41,
+                               "flutter.V_range": [0.5, 1.5]})
+    r = run(cfg, quiet=True, write=False)
+    assert r.flutter.status == "no_crossing" and r.Vf is None and r.verification is None
+    assert r.summary()["controller"] is None and "Vf error n/a" in r.explanation()
