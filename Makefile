@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test test-all bench clean docs
+.PHONY: demo test test-all bench clean docs wheel
 
 # single-threaded BLAS: the same seed gives the same numbers (threaded reductions reorder
 # floating-point sums, and the nonconvex synthesis can end in another local optimum)
@@ -38,8 +38,12 @@ $(DOCS_STAMP): pyproject.toml $(STAMP)
 docs: $(DOCS_STAMP)
 	CASFLUTTER_DOCS_QUICK=1 MPLBACKEND=Agg $(VENV)/bin/sphinx-build -W --keep-going -b html docs docs/_build/html
 
+# the wheel (LICENSE, py.typed and the problem definitions inside) in dist/
+wheel: $(STAMP)
+	$(PY) -m pip wheel --no-deps --quiet -w dist .
+
 bench: $(STAMP)
 	$(VENV)/bin/casflutter bench identify --out bench-identify.json
 
 clean:
-	rm -rf build *.egg-info .pytest_cache casflutter-run docs/_build docs/auto_examples docs/generated docs/sg_execution_times.rst
+	rm -rf build dist *.egg-info .pytest_cache casflutter-run docs/_build docs/auto_examples docs/generated docs/sg_execution_times.rst

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import importlib
 
+from . import _logging  # noqa: F401 - the package logger's NullHandler
 from .errors import (CasflutterError, ConfigError, ConvergenceError, DataError,  # noqa: F401
                      DimensionError, OrderError, SynthesisError)
 

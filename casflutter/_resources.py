@@ -34,10 +34,12 @@ def read_toml(path, what: str = "file") -> dict:
     Raises
     ------
     ConfigError
-        If the file does not exist or is not valid TOML; ``what`` names it in the message
-        (``"study file"``, ``"configuration file"`` ...).
+        If the file does not exist, is a folder, is not UTF-8 text or not valid TOML;
+        ``what`` names it in the message (``"study file"``, ``"configuration file"`` ...).
     """
     path = Path(path)
+    if path.is_dir():
+        raise ConfigError(f"{what} {path} is a folder; give the TOML file inside it")
     if not path.is_file():
         raise ConfigError(f"{what} {path} not found: the file does not exist")
     try:
@@ -45,3 +47,8 @@ def read_toml(path, what: str = "file") -> dict:
             return tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{what} {path} is not valid TOML ({exc})") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{what} {path} is not a UTF-8 text file ({exc.reason} at byte "
+                          f"{exc.start}); give a TOML text file") from None
+    except OSError as exc:
+        raise ConfigError(f"{what} {path} cannot be read ({exc.strerror or exc})") from None

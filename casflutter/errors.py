@@ -14,6 +14,8 @@ __all__ = [
     "ConfigError",
     "ConvergenceError",
     "SynthesisError",
+    "OutputError",
+    "StoreLockedError",
 ]
 
 
@@ -61,3 +63,12 @@ class SynthesisError(CasflutterError, RuntimeError):
         super().__init__(message)
         self.best_spectral_abscissa = best_spectral_abscissa
         self.result = result
+
+
+class OutputError(CasflutterError, OSError):
+    """An output file or folder that cannot be created or written; checked before any work
+    starts (``casflutter._outputs.check_output_path``)."""
+
+
+class StoreLockedError(CasflutterError, RuntimeError):
+    """A sweep store that another running sweep holds (its lock file is taken)."""

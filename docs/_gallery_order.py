@@ -6,6 +6,7 @@ ORDER = (
     "plot_f16_identification.py",
     "plot_typical_section_flutter.py",
     "plot_goland_wing.py",
+    "plot_goland_rfa.py",
     "plot_lco_branches.py",
     "plot_compleib_synthesis.py",
     "plot_seed_wing_pipeline.py",

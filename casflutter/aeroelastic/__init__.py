@@ -7,12 +7,16 @@
   continuity, V–g / V–f data, flutter (Hopf) and divergence speeds.
 - :func:`simulate_loop` — the nonlinear discrete ROM in feedback with Σs (paper Fig. 9).
 - :func:`build_lft` — the uncertainty LFT of eq. 10-15 (Lemmas 1-2).
+- :class:`RFASystem` — ΣAE(U) in the airspeed from a rational-function approximation of
+  Q(ik), and :func:`pk_flutter`, the p-k flutter solution on a Q(ik) table.
 """
 
 from ._flutter import Crossing, FlutterResult, find_flutter, origin_modes
 from ._lft import AeroelasticLFT, build_lft
 from ._loop import (AeroelasticLoop, AeroelasticSystem, ParametricSystem, aeroelastic_loop,
                     split_sigma_f)
+from ._pk import PKResult, pk_flutter
+from ._rfa_system import RFASystem
 from ._simulate import LoopSimulation, simulate_loop
 from ._tracking import EigenTracking, eig_sorted_by_reference, track_eigenvalues
 
@@ -21,6 +25,6 @@ __all__ = [
     "split_sigma_f",
     "EigenTracking", "track_eigenvalues", "eig_sorted_by_reference",
     "Crossing", "FlutterResult", "find_flutter", "origin_modes",
-    "AeroelasticLFT", "build_lft",
+    "AeroelasticLFT", "build_lft", "RFASystem", "PKResult", "pk_flutter",
     "LoopSimulation", "simulate_loop",
 ]

@@ -1,10 +1,12 @@
-"""Input--output records, their loaders (CSV, NPZ, MATLAB), excitation signals and the
-analysis of response records (decay, LCO, divergence)."""
+"""Input--output records, their loaders (CSV, NPZ, MATLAB), excitation signals, the
+analysis of response records (decay, LCO, divergence), and tables of frequency-domain
+generalised aerodynamic forces Q(ik) with their files."""
 
+from ._gaf import GAFTable, load_gaf
 from ._records import IOData, Record
 from ._response import ResponseAnalysis, analyze_response, dominant_frequency, envelope_growth_rate
 from ._signals import backward_derivatives, check_band, chirp_excitation, chirp_motion
 
 __all__ = ["IOData", "Record", "chirp_excitation", "chirp_motion", "backward_derivatives",
            "check_band", "ResponseAnalysis", "analyze_response", "envelope_growth_rate",
-           "dominant_frequency"]
+           "dominant_frequency", "GAFTable", "load_gaf"]

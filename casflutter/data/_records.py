@@ -1,8 +1,15 @@
-"""Input--output records for identification: modal displacements u, flap v, forces y."""
+"""Input--output records for identification: modal displacements u, flap v, forces y.
+
+Every loader (:meth:`IOData.from_npz`, :meth:`IOData.from_csv`, :meth:`IOData.from_mat`) and
+:class:`Record` itself turn a file or an array that cannot be used into a
+:class:`~casflutter.errors.DataError` naming the file or signal, what is wrong and what to
+do; no other exception comes out of them for bad input.
+"""
 
 from __future__ import annotations
 
 import csv
+import logging
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Sequence
@@ -13,6 +20,8 @@ from ..errors import DataError
 
 __all__ = ["Record", "IOData"]
 
+_log = logging.getLogger(__name__)
+
 
 def _check_finite(name: str, arr: np.ndarray, record: str) -> None:
     bad = ~np.isfinite(arr)
@@ -20,6 +29,50 @@ def _check_finite(name: str, arr: np.ndarray, record: str) -> None:
         idx = np.argwhere(bad)[0]
         raise DataError(f"record {record!r}: signal {name} has {int(bad.sum())} NaN/inf "
                         f"value(s), first at sample {int(idx[0])}; remove or interpolate them")
+
+
+def _real_array(name: str, value, record: str) -> np.ndarray:
+    """``value`` as a float array, refusing what would silently change its meaning: ragged
+    nesting, text, objects, complex numbers, dates, no samples."""
+    try:
+        arr = np.asarray(value)
+    except (ValueError, TypeError) as exc:  # ragged nesting (NumPy >= 1.24 refuses it)
+        raise DataError(f"record {record!r}: signal {name} is not a rectangular array "
+                        f"({exc}); give a (samples, channels) array with rows of equal "
+                        "length") from None
+    kind = arr.dtype.kind
+    if kind == "O":
+        try:
+            arr = arr.astype(float)
+        except (ValueError, TypeError):
+            try:
+                arr = arr.astype(complex)
+            except (ValueError, TypeError):
+                raise DataError(f"record {record!r}: signal {name} holds Python objects "
+                                "(ragged rows, text or None) that are not numbers; give a "
+                                "numeric (samples, channels) array") from None
+        kind = arr.dtype.kind
+    if kind == "c":
+        raise DataError(f"record {record!r}: signal {name} is complex; the records are real "
+                        "time series -- pass the real part (np.real) if the imaginary part "
+                        "is rounding noise")
+    if kind in "USV":
+        raise DataError(f"record {record!r}: signal {name} holds text (dtype {arr.dtype}), "
+                        "not numbers; convert it, e.g. np.asarray(x, dtype=float)")
+    if kind in "mM":
+        raise DataError(f"record {record!r}: signal {name} holds dates or durations (dtype "
+                        f"{arr.dtype}); give the sampled values, with the sampling time as dt")
+    if kind not in "biuf":
+        raise DataError(f"record {record!r}: signal {name} has dtype {arr.dtype}, not a "
+                        "number type")
+    arr = arr.astype(float)
+    if arr.ndim == 0:
+        raise DataError(f"record {record!r}: signal {name} is a single number; give one "
+                        "value per sample")
+    if arr.shape[0] == 0:
+        raise DataError(f"record {record!r}: signal {name} has no samples (shape "
+                        f"{arr.shape}); give at least one sample per channel")
+    return arr
 
 
 @dataclass(frozen=True)
@@ -44,17 +97,22 @@ class Record:
     name: str = "record"
 
     def __post_init__(self):
-        y = np.asarray(self.y, dtype=float)
+        y = _real_array("y", self.y, self.name)
         if y.ndim == 1:
             y = y[:, None]
-        if y.ndim != 2:
-            raise DataError(f"record {self.name!r}: y must be (samples, outputs), got {y.shape}")
+        if y.ndim != 2 or y.shape[1] == 0:
+            raise DataError(f"record {self.name!r}: y must be (samples, outputs) with at least "
+                            f"one output, got shape {y.shape}")
         K = y.shape[0]
         _check_finite("y", y, self.name)
         object.__setattr__(self, "y", y)
         if self.u is not None:
-            u = np.asarray(self.u, dtype=float)
+            u = _real_array("u", self.u, self.name)
             u = u[:, None] if u.ndim == 1 else u
+            if u.ndim != 2:
+                raise DataError(f"record {self.name!r}: u must be (samples, modal inputs), got "
+                                f"shape {u.shape}; reshape it to 2-D (e.g. u.reshape(len(u), "
+                                "-1)) if the extra axes are singletons")
             if u.shape[0] != K:
                 raise DataError(f"record {self.name!r}: length mismatch, u has {u.shape[0]} "
                                 f"samples and y has {K}; trim them to a common length")
@@ -65,7 +123,7 @@ class Record:
             _check_finite("u", u, self.name)
             object.__setattr__(self, "u", u)
         if self.v is not None:
-            v = np.asarray(self.v, dtype=float)
+            v = _real_array("v", self.v, self.name)
             if v.ndim == 2 and 1 in v.shape:
                 v = v.ravel()
             if v.ndim != 1:
@@ -116,14 +174,25 @@ class IOData:
     meta: dict = field(default_factory=dict, compare=False)
 
     def __post_init__(self):
-        recs = tuple(self.records)
+        try:
+            recs = tuple(self.records)
+        except TypeError:
+            raise DataError(f"records must be a sequence of Record, got "
+                            f"{type(self.records).__name__}") from None
         if not recs:
             raise DataError("IOData needs at least one record")
+        for r in recs:
+            if not isinstance(r, Record):
+                raise DataError(f"records must be Record objects, got {type(r).__name__}; "
+                                "use IOData.from_arrays(y, u, v, dt) for arrays")
         object.__setattr__(self, "records", recs)
+        if isinstance(self.dt, (bool, np.bool_, str, bytes)) or np.iscomplexobj(self.dt):
+            raise DataError(f"sampling time dt={self.dt!r} is not a real number of seconds")
         try:
             dt = float(self.dt)
         except (TypeError, ValueError):
-            raise DataError(f"sampling time dt={self.dt!r} is not a number") from None
+            raise DataError(f"sampling time dt={self.dt!r} is not a number; give the "
+                            "sampling time in seconds") from None
         if not np.isfinite(dt) or dt <= 0:
             raise DataError(f"sampling time dt={self.dt!r} must be a positive number of seconds")
         object.__setattr__(self, "dt", dt)
@@ -150,7 +219,14 @@ class IOData:
     @classmethod
     def from_arrays(cls, y, u=None, v=None, dt: float = 1.0, name: str = "record",
                     **kw) -> "IOData":
-        """One record from arrays ``y (K, N)``, ``u (K, N)``, ``v (K,)``."""
+        """One record from arrays ``y (K, N)``, ``u (K, N)``, ``v (K,)``.
+
+        Raises
+        ------
+        DataError
+            Arrays that :class:`Record` refuses (ragged, text, complex, wrong shapes,
+            NaN/inf, lengths that differ) or a ``dt`` that is not a positive number.
+        """
         return cls((Record(y, u, v, name),), dt, **kw)
 
     @classmethod
@@ -158,26 +234,38 @@ class IOData:
         """Load from an ``.npz`` with arrays ``y`` and optionally ``u``, ``v``, ``dt``.
 
         Several records: ``y_0, u_0, v_0, y_1, ...`` (suffix ``_<index>``).
+
+        Raises
+        ------
+        DataError
+            A missing file, a folder, a file that is not an ``.npz`` archive (empty, a
+            single ``.npy``, another zip, truncated or random bytes), object (pickled)
+            arrays, a ``dt`` that is not one positive number, or records that
+            :class:`Record` refuses; the message names the file.
         """
-        path = Path(path)
-        with np.load(path, allow_pickle=False) as z:
-            keys = set(z.files)
-            if dt is None:
-                if "dt" not in keys:
-                    raise DataError(f"{path}: no 'dt' array in the file; pass dt=")
-                dt = float(np.asarray(z["dt"]).ravel()[0])
+        path = _input_file(path, ".npz")
+        arrays = _read_npz(path)
+        if dt is None:
+            if "dt" not in arrays:
+                raise DataError(f"{path}: no 'dt' array in the file; save it with "
+                                "np.savez(..., dt=...) or pass dt=")
+            dt = _scalar(arrays["dt"], f"{path}: 'dt'", "the sampling time in seconds")
+        keys = set(arrays)
+        try:
             if "y" in keys:
-                recs = [Record(z["y"], z["u"] if "u" in keys else None,
-                               z["v"] if "v" in keys else None, path.stem)]
+                recs = [Record(arrays["y"], arrays.get("u"), arrays.get("v"), path.stem)]
             else:
                 idx = sorted(int(k[2:]) for k in keys if k.startswith("y_") and k[2:].isdigit())
                 if not idx:
-                    raise DataError(f"{path}: no 'y' (or 'y_0', 'y_1', ...) array; keys are "
-                                    f"{sorted(keys)}")
-                recs = [Record(z[f"y_{i}"], z[f"u_{i}"] if f"u_{i}" in keys else None,
-                               z[f"v_{i}"] if f"v_{i}" in keys else None, f"{path.stem}[{i}]")
-                        for i in idx]
-        return cls(tuple(recs), dt)
+                    raise DataError(f"no 'y' (or 'y_0', 'y_1', ...) array; the arrays are "
+                                    f"{sorted(keys)}; save the outputs as y")
+                recs = [Record(arrays[f"y_{i}"], arrays.get(f"u_{i}"), arrays.get(f"v_{i}"),
+                               f"{path.stem}[{i}]") for i in idx]
+            out = cls(tuple(recs), dt)
+        except DataError as exc:
+            raise DataError(f"{path}: {exc}") from None
+        _log.debug("read %d record(s) from %s", len(out.records), path)
+        return out
 
     def to_npz(self, path) -> None:
         """Write in the format read by :meth:`from_npz`."""
@@ -205,43 +293,86 @@ class IOData:
             Column of time stamps, from which ``dt`` is taken (must be uniform).
         dt : float, optional
             Sampling time when there is no time column.
+
+        Raises
+        ------
+        DataError
+            A missing file, a folder, a file that is not UTF-8 text, no header, no data rows,
+            rows with a different number of fields than the header, non-numeric entries
+            (row and column named), missing or repeated columns, a time column that is not
+            increasing and uniform, or records that :class:`Record` refuses.
         """
-        path = Path(path)
-        with open(path, newline="") as fh:
-            reader = csv.reader(fh)
-            try:
-                header = [h.strip() for h in next(reader)]
-            except StopIteration:
-                raise DataError(f"{path}: empty file") from None
-            rows = [row for row in reader if row]
+        path = _input_file(path, ".csv")
+        y = [y] if isinstance(y, str) else [str(c) for c in (y or [])]
+        u = [u] if isinstance(u, str) else ([str(c) for c in u] if u else None)
+        if not y:
+            raise DataError(f"{path}: no output column given; pass y=[names] (--y on the "
+                            "command line)")
+        try:
+            with open(path, newline="", encoding="utf-8-sig") as fh:
+                reader = csv.reader(fh)
+                try:
+                    header = [h.strip() for h in next(reader)]
+                except StopIteration:
+                    raise DataError(f"{path}: empty file; the first row must name the "
+                                    "columns") from None
+                rows = [(reader.line_num, row) for row in reader if any(c.strip() for c in row)]
+        except UnicodeDecodeError as exc:
+            raise DataError(f"{path}: not a UTF-8 text file ({exc.reason} at byte "
+                            f"{exc.start}); export the data as CSV text") from None
+        except csv.Error as exc:
+            raise DataError(f"{path}: not a readable CSV file ({exc}); export the data as "
+                            "CSV text") from None
         want = list(y) + list(u or []) + ([v] if v else []) + ([time] if time and dt is None else [])
         missing = [c for c in want if c not in header]
         if missing:
             raise DataError(f"{path}: column(s) {missing} not in the header {header}")
-        try:
-            table = np.array([[float(x) for x in row] for row in rows], dtype=float)
-        except ValueError as exc:
-            raise DataError(f"{path}: non-numeric entry ({exc})") from None
+        repeated = sorted({c for c in want if header.count(c) > 1})
+        if repeated:
+            raise DataError(f"{path}: column(s) {repeated} appear more than once in the header; "
+                            "rename them so that each name is unique")
+        if not rows:
+            raise DataError(f"{path}: the header names the columns but there are no data rows")
+        table = np.empty((len(rows), len(header)))
+        for i, (line, row) in enumerate(rows):
+            if len(row) != len(header):
+                raise DataError(f"{path}: line {line} has {len(row)} fields but the header has "
+                                f"{len(header)}; fix the row or the header")
+            for j, x in enumerate(row):
+                try:
+                    table[i, j] = float(x)
+                except ValueError:
+                    raise DataError(f"{path}: line {line}, column {header[j]!r}: {x!r} is not a "
+                                    "number; fix or remove the entry") from None
         col = {name: table[:, header.index(name)] for name in header}
         if dt is None:
             if not time or time not in col:
                 raise DataError(f"{path}: give dt= or a time column")
+            if len(rows) < 2:
+                raise DataError(f"{path}: one data row: the time column {time!r} cannot give "
+                                "the sampling time; pass dt=")
             steps = np.diff(col[time])
             dt = float(np.median(steps))
+            if not np.all(np.isfinite(steps)) or not dt > 0:
+                raise DataError(f"{path}: time column {time!r} is not increasing; sort the "
+                                "rows by time or pass dt=")
             if not np.allclose(steps, dt, rtol=1e-6, atol=1e-12):
                 raise DataError(f"{path}: time column {time!r} is not uniformly sampled "
                                 f"(steps from {steps.min():g} to {steps.max():g}); resample first")
         Y = np.column_stack([col[c] for c in y])
         U = np.column_stack([col[c] for c in u]) if u else None
         V = col[v] if v else None
-        return cls((Record(Y, U, V, path.stem),), dt, output_names=tuple(y),
-                   u_names=tuple(u or ()), v_name=v or "v")
+        try:
+            return cls((Record(Y, U, V, path.stem),), dt, output_names=tuple(y),
+                       u_names=tuple(u or ()), v_name=v or "v")
+        except DataError as exc:
+            raise DataError(f"{path}: {exc}") from None
 
     @classmethod
     def from_mat(cls, path, *, y: str, u: str | None = None, v: str | None = None,
                  dt: float | str | None = None, fs: str | None = None,
                  output_names: Sequence[str] = ()) -> "IOData":
-        """Load a MATLAB ``.mat`` file (``scipy.io.loadmat``).
+        """Load a MATLAB ``.mat`` file (``scipy.io.loadmat``, formats v4 to v7).
 
         Parameters
         ----------
@@ -252,34 +383,42 @@ class IOData:
             Sampling time, or the name of a variable holding it.
         fs : str, optional
             Name of a variable holding the sampling *frequency* (``dt = 1/fs``), e.g. ``"Fs"``.
-        """
-        from scipy.io import loadmat
 
-        path = Path(path)
-        try:
-            mat = loadmat(path)
-        except (OSError, ValueError) as exc:
-            raise DataError(f"{path}: cannot read as a .mat file ({exc})") from None
+        Raises
+        ------
+        DataError
+            A missing file, a folder, a file that is not a MAT-file (or a v7.3/HDF5 one,
+            which scipy does not read), no variables, a missing variable (the message lists
+            the variables), a variable that is text, a cell array, a struct or more than
+            2-D, a sampling time or frequency that is not one positive number, or records
+            that :class:`Record` refuses.
+        """
+        path = _input_file(path, ".mat")
+        mat = _read_mat(path)
+        variables = sorted(k for k in mat if not k.startswith("__"))
+        if not variables:
+            raise DataError(f"{path}: the MAT-file holds no variables; save y, u/v and the "
+                            "sampling time (or frequency) in it")
 
         def get(name):
             if name not in mat:
-                keys = sorted(k for k in mat if not k.startswith("__"))
-                raise DataError(f"{path}: no variable {name!r}; variables are {keys}")
-            arr = np.asarray(mat[name], dtype=float)
-            if arr.ndim == 2 and arr.shape[0] < arr.shape[1]:
-                arr = arr.T
-            return arr
+                raise DataError(f"{path}: no variable {name!r}; variables are {variables}")
+            return _mat_matrix(path, name, mat[name])
 
         if fs is not None:
-            dt = 1.0 / float(get(fs).ravel()[0])
+            f = _scalar(get(fs), f"{path}: sampling frequency {fs!r}", "a frequency in Hz")
+            dt = 1.0 / f
         elif isinstance(dt, str):
-            dt = float(get(dt).ravel()[0])
+            dt = _scalar(get(dt), f"{path}: sampling time {dt!r}", "the sampling time in seconds")
         if dt is None:
             raise DataError(f"{path}: give dt= (seconds or a variable name) or fs=")
         Y = get(y)
         U = get(u) if u else None
         V = get(v).ravel() if v else None
-        return cls((Record(Y, U, V, path.stem),), dt, output_names=tuple(output_names))
+        try:
+            return cls((Record(Y, U, V, path.stem),), dt, output_names=tuple(output_names))
+        except DataError as exc:
+            raise DataError(f"{path}: {exc}") from None
 
     # -- access ---------------------------------------------------------------------
     @property
@@ -349,3 +488,132 @@ class IOData:
             b.append(Record(r.y[k:], cut(r.u, slice(k, None)), cut(r.v, slice(k, None)), r.name))
         kw = dict(output_names=self.output_names, u_names=self.u_names, v_name=self.v_name)
         return IOData(tuple(a), self.dt, **kw), IOData(tuple(b), self.dt, **kw)
+
+
+# ---------------------------------------------------------------------------- file readers
+
+def _input_file(path, suffix: str) -> Path:
+    """``path`` as a Path that names an existing file (not a folder)."""
+    try:
+        path = Path(path)
+    except TypeError:
+        raise DataError(f"data file {path!r} is not a path; give a file name") from None
+    if path.is_dir():
+        raise DataError(f"{path} is a folder, not a {suffix} file; give the file inside it")
+    if not path.exists():
+        raise DataError(f"{path}: file not found; check the name and the folder")
+    return path
+
+
+def _scalar(value, what: str, meaning: str) -> float:
+    """One finite positive number from an array, a MATLAB variable or a number."""
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError):
+        raise DataError(f"{what} is not a number; give {meaning}") from None
+    if arr.dtype.kind not in "biuf" or isinstance(value, (bool, np.bool_)):
+        raise DataError(f"{what} is not a real number (dtype {arr.dtype}); give {meaning}")
+    if arr.size != 1:
+        raise DataError(f"{what} must hold one number, got shape {arr.shape}; give {meaning}")
+    x = float(arr.reshape(()))
+    if not np.isfinite(x) or x <= 0:
+        raise DataError(f"{what} = {x:g}; it must be a positive finite number ({meaning})")
+    return x
+
+
+def _read_npz(path: Path) -> dict[str, np.ndarray]:
+    """Every array of an ``.npz`` archive, or a DataError that says what the file is."""
+    with open(path, "rb") as fh:
+        head = fh.read(6)
+    if not head:
+        raise DataError(f"{path}: empty file (0 bytes); write it with np.savez(path, y=..., "
+                        "u=..., dt=...)")
+    if head == b"\x93NUMPY":
+        raise DataError(f"{path}: a single .npy array, not an .npz archive; save the arrays "
+                        "with np.savez(path, y=..., u=..., dt=...)")
+    if not head.startswith(b"PK"):
+        raise DataError(f"{path}: not an .npz archive (no zip signature); save the arrays "
+                        "with np.savez(path, y=..., u=..., dt=...)")
+    arrays: dict[str, np.ndarray] = {}
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            members = [n for n in z.zip.namelist() if n.endswith(".npy")]
+            if not members:
+                raise DataError(f"{path}: a zip archive without .npy arrays (members "
+                                f"{z.zip.namelist()[:8]}), not an .npz; save the arrays with "
+                                "np.savez(path, y=..., u=..., dt=...)")
+            for key in z.files:
+                if f"{key}.npy" in members or key in members:
+                    arrays[key] = z[key]
+    except DataError:
+        raise
+    except ValueError as exc:
+        if "pickle" in str(exc):
+            raise DataError(f"{path}: holds object (pickled) arrays, which are not read for "
+                            "safety; save plain numeric arrays (np.savez with float "
+                            "arrays)") from None
+        raise DataError(f"{path}: cannot be read as an .npz archive ({exc}); the file may be "
+                        "truncated or corrupt -- write it again with np.savez") from None
+    except Exception as exc:  # noqa: BLE001 - any failure to parse the file is bad data
+        raise DataError(f"{path}: cannot be read as an .npz archive ({type(exc).__name__}: "
+                        f"{exc}); the file may be truncated or corrupt -- write it again "
+                        "with np.savez") from None
+    return arrays
+
+
+def _read_mat(path: Path) -> dict:
+    """``scipy.io.loadmat`` of ``path``, or a DataError that says what the file is."""
+    from scipy.io import loadmat
+
+    with open(path, "rb") as fh:
+        head = fh.read(128)
+    if not head:
+        raise DataError(f"{path}: empty file (0 bytes); save the variables from MATLAB with "
+                        "save(file, ..., '-v7')")
+    if len(head) == 128 and head[124:128] in (b"\x00\x02IM", b"\x02\x00MI"):
+        raise DataError(f"{path}: a MATLAB v7.3 (HDF5) file, which scipy cannot read; save it "
+                        "again with save(file, ..., '-v7'), or read it with h5py and call "
+                        "IOData.from_arrays")
+    try:
+        return loadmat(path)
+    except NotImplementedError as exc:  # v7.3 detected by scipy
+        raise DataError(f"{path}: a MATLAB v7.3 (HDF5) file, which scipy cannot read ({exc}); "
+                        "save it again with save(file, ..., '-v7')") from None
+    except Exception as exc:  # noqa: BLE001 - any failure to parse the file is bad data
+        raise DataError(f"{path}: cannot be read as a MAT-file ({type(exc).__name__}: {exc}); "
+                        "the file may be truncated or not a MAT-file -- save it again from "
+                        "MATLAB with save(file, ..., '-v7')") from None
+
+
+def _mat_matrix(path: Path, name: str, value) -> np.ndarray:
+    """A numeric MATLAB variable as a float array, samples along the first axis."""
+    import scipy.sparse
+
+    if scipy.sparse.issparse(value):
+        value = value.toarray()
+    arr = np.asarray(value)
+    if arr.dtype.names:
+        raise DataError(f"{path}: variable {name!r} is a struct (fields "
+                        f"{list(arr.dtype.names)}); save the numeric field as its own variable "
+                        "and name that one")
+    if arr.dtype.kind in "USa":
+        raise DataError(f"{path}: variable {name!r} holds text, not numbers; name a numeric "
+                        "matrix")
+    if arr.dtype.kind == "O":
+        raise DataError(f"{path}: variable {name!r} is a cell array or an object; save the "
+                        "numbers as a plain matrix (cell2mat in MATLAB) and name that one")
+    if arr.dtype.kind == "c":
+        raise DataError(f"{path}: variable {name!r} is complex; the records are real time "
+                        "series -- save real(...) if the imaginary part is rounding noise")
+    if arr.dtype.kind not in "biuf":
+        raise DataError(f"{path}: variable {name!r} has MATLAB type {arr.dtype}, not a "
+                        "numeric matrix")
+    if arr.size == 0:
+        raise DataError(f"{path}: variable {name!r} is empty (size {arr.shape})")
+    if arr.ndim > 2:
+        raise DataError(f"{path}: variable {name!r} is {arr.ndim}-D (size {arr.shape}); give "
+                        "a samples-by-channels matrix")
+    arr = arr.astype(float)
+    if arr.ndim == 2 and arr.shape[0] < arr.shape[1]:
+        arr = arr.T
+    return arr

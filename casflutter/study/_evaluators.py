@@ -49,6 +49,7 @@ from ..errors import ConfigError
 from ._hopf import truth_hopf
 from ._pipeline_eval import (PIPELINE_OUTPUTS, ROM_FLUTTER_OUTPUTS, pipeline_check,
                              pipeline_evaluator, rom_flutter_check, rom_flutter_evaluator)
+from ._spec import check_setting
 from ._truth_point import load_truth
 
 __all__ = ["Evaluator", "register_evaluator", "get_evaluator", "evaluator_names",
@@ -221,8 +222,18 @@ def truth_flutter_evaluator(params: Mapping[str, Any],
 
 def _truth_flutter_check(params: Mapping[str, Any], settings: Mapping[str, Any]) -> None:
     """Pre-flight check of :func:`truth_flutter_evaluator`: the problem, its parameter names and
-    values, the option names (builds the truth, no flutter search)."""
-    load_truth(params, settings)
+    values, the option names and values (builds the truth, no flutter search)."""
+    _, options = load_truth(params, settings)
+    v_min = check_setting(options, "V_min", 0.02, low=0.0)
+    v_max = check_setting(options, "V_max", 4.0, positive=True)
+    if not v_min < v_max:
+        raise ConfigError(f"V_min = {v_min:g} must be below V_max = {v_max:g}")
+    check_setting(options, "n_grid", 81, integer=True, low=3)
+    if options.get("lco_speed_ratio") is not None:
+        check_setting(options, "lco_speed_ratio", None, positive=True)
+    check_setting(options, "lco_time", 600.0, positive=True)
+    check_setting(options, "lco_samples", 6001, integer=True, low=8)
+    check_setting(options, "lco_x0", 0.01)
 
 
 # --------------------------------------------------------------------------- synthesis
@@ -288,11 +299,16 @@ def _synthesis_check(params: Mapping[str, Any], settings: Mapping[str, Any]) -> 
     if isinstance(order, bool) or not isinstance(order, (int, float)) or order < 0 \
             or int(order) != order:
         raise ConfigError(f"order = {order!r}: a non-negative integer")
+    check_setting(merged, "starts", 2, integer=True, low=1)
+    check_setting(merged, "seed", 0, integer=True, low=0)
+    if merged.get("time_limit") is not None:
+        check_setting(merged, "time_limit", None, positive=True)
 
 
 register_evaluator("truth_flutter", truth_flutter_evaluator,
                    outputs=("flutter_status", "Vf", "omega_f", "frequency_hz", "flutter_mode",
-                            "divergence_V", "n_crossings", "flutter_time", "lco_amplitude"),
+                            "divergence_V", "n_crossings", "flutter_time", "lco_amplitude",
+                            "lco_settling", "lco_V"),
                    description="truth flutter speed/frequency/divergence (and LCO amplitude)",
                    modules=("casflutter.truth", "casflutter.aeroelastic"),
                    check=_truth_flutter_check)

@@ -1,16 +1,24 @@
 """Run a study: local worker processes (default) or a Dask distributed cluster, resumable.
 
 Every finished point is appended to the :class:`PointStore` the moment its result arrives,
-so an interrupted sweep (Ctrl-C, a killed driver or worker) resumes without recomputing or
-losing a point.  An evaluator that raises gives a ``"failed"`` record with the error text
-and the sweep goes on; when a worker process dies, a fresh pool retries the lost points,
-and if a worker dies again the remaining points run one at a time, so that the point that
-kills its worker is identified and recorded as failed.
+so an interrupted sweep (Ctrl-C, SIGTERM, a killed driver or worker) resumes without
+recomputing or losing a point.  An evaluator that raises gives a ``"failed"`` record with
+the error text and the sweep goes on (the next run computes the failed points again unless
+told not to); when a worker process dies, a fresh pool retries the lost points, and if a
+worker dies again the remaining points run one at a time, so that the point that kills its
+worker is identified and recorded as failed.
+
+Ctrl-C and SIGTERM stop the worker processes (none is left running) and re-raise
+:class:`KeyboardInterrupt`; a sweep holds its store's lock, so a second sweep on the same
+store refuses to start.  Progress goes to the logger ``casflutter.study._runner``.
 """
 
 from __future__ import annotations
 
+import logging
+import numbers
 import os
+import signal
 import socket
 import sys
 import time
@@ -22,9 +30,13 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import Any, Mapping
 
+from .._interrupt import sigterm_raises
+from .._logging import PROGRESS, PROGRESS_END
 from ..errors import ConfigError
 from ._spec import Study
 from ._store import PointStore
+
+_log = logging.getLogger(__name__)
 
 __all__ = ["SweepResult", "Progress", "run_sweep", "evaluate_point"]
 
@@ -71,6 +83,13 @@ def _preflight(study: Study, todo: Mapping[str, Mapping[str, Any]]) -> None:
     from ._evaluators import get_evaluator  # noqa: PLC0415
 
     ev = get_evaluator(study.evaluator)
+    if ev.outputs and study.outputs:
+        unknown = [o for o in study.outputs if not _known_output(o, ev.outputs)]
+        if unknown:
+            raise ConfigError(f"study {study.name!r}: outputs {unknown} are not outputs of the "
+                              f"evaluator {study.evaluator!r} (it returns "
+                              f"{', '.join(ev.outputs)}); fix [study] outputs -- no point "
+                              "was run")
     if ev.check is None or not todo:
         return
     settings = study.resolved_settings()
@@ -87,11 +106,46 @@ def _preflight(study: Study, todo: Mapping[str, Mapping[str, Any]]) -> None:
                               "the study file ([parameters] / [settings])") from None
 
 
+def _known_output(name: str, declared) -> bool:
+    """A declared output, or one of a declared family (``lco_amplitude_<coordinate>``,
+    ``time_<stage>``)."""
+    return name in declared or any(name.startswith(d + "_") for d in declared) \
+        or name.startswith("time_")
+
+
 def _warm(evaluator: str) -> None:
     """Worker initializer: import the evaluator's modules before the first point."""
     from ._evaluators import get_evaluator  # noqa: PLC0415
 
     get_evaluator(evaluator).warm_up()
+
+
+def _worker_init(evaluator: str) -> None:
+    """Initializer of a local worker process: Ctrl-C in the terminal reaches the whole
+    process group, but only the driver acts on it (it stops the workers); then warm up."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _warm(evaluator)
+
+
+def _stop_pool(ex: ProcessPoolExecutor, timeout: float = 5.0) -> None:
+    """Cancel what is queued and stop the worker processes now (the points they are
+    computing are lost and will be computed by the next run); none is left running."""
+    procs = list((getattr(ex, "_processes", None) or {}).values())
+    ex.shutdown(wait=False, cancel_futures=True)
+    for proc in procs:
+        try:
+            proc.terminate()
+        except (OSError, ValueError, AttributeError):
+            pass
+    deadline = time.monotonic() + timeout
+    for proc in procs:
+        try:
+            proc.join(max(0.0, deadline - time.monotonic()))
+            if proc.is_alive():
+                proc.kill()
+                proc.join(timeout)
+        except (OSError, ValueError, AssertionError, AttributeError):
+            pass
 
 
 def _ready(_: int = 0) -> int:
@@ -108,19 +162,21 @@ def _start_workers(ex: ProcessPoolExecutor, workers: int, timeout: float = 120.0
 
 
 class Progress:
-    """A one-line progress report on stderr: points done, failed, left, elapsed, ETA.
+    """A one-line progress report: points done, failed, left, elapsed, ETA.
 
-    On a terminal the line is redrawn in place; otherwise a line is printed at most every
-    ``interval`` seconds and once at the end.
+    The line goes to the logger ``casflutter.study._runner`` (INFO, marked as progress so
+    that the command line redraws it in place on a terminal), at most every ``interval``
+    seconds and once at the end; with ``stream`` it is written there instead.
     """
 
     def __init__(self, total: int, *, skipped: int = 0, enabled: bool = True,
-                 stream=None, interval: float = 2.0) -> None:
+                 stream=None, interval: float | None = None) -> None:
         self.total, self.skipped = total, skipped
         self.done = self.failed = 0
         self.enabled = enabled
-        self.stream = stream if stream is not None else sys.stderr
-        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.stream = stream
+        if interval is None:  # redraw often on a terminal, rarely into a log file
+            interval = 0.2 if bool(getattr(sys.stderr, "isatty", lambda: False)()) else 2.0
         self.interval = interval
         self.t0 = time.perf_counter()
         self._last = -1e300
@@ -146,8 +202,15 @@ class Progress:
                 f"({self.skipped} resumed), {self.failed} failed, {self.left} left, "
                 f"{el:.1f} s{eta}")
 
+    def _emit(self, final: bool) -> None:
+        if self.stream is not None:
+            self.stream.write(self.line() + "\n")
+            self.stream.flush()
+        elif _log.isEnabledFor(logging.INFO):
+            _log.info(self.line(), extra=PROGRESS_END if final else PROGRESS)
+
     def update(self, record: Mapping[str, Any] | None = None, *, force: bool = False) -> None:
-        """Count one finished record and redraw."""
+        """Count one finished record and report (at most every ``interval`` seconds)."""
         if record is not None:
             if self._t_first is None:
                 self._t_first = time.perf_counter()
@@ -156,22 +219,14 @@ class Progress:
         if not self.enabled:
             return
         now = time.perf_counter()
-        if self.tty:
-            self.stream.write("\r" + self.line())
-            self.stream.flush()
-        elif force or now - self._last >= self.interval:
-            self.stream.write(self.line() + "\n")
-            self.stream.flush()
+        if force or now - self._last >= self.interval:
+            self._emit(final=False)
             self._last = now
 
     def close(self) -> None:
         """Final line."""
         if self.enabled:
-            if self.tty:
-                self.stream.write("\r" + self.line() + "\n")
-            else:
-                self.stream.write(self.line() + "\n")
-            self.stream.flush()
+            self._emit(final=True)
 
 
 @dataclass(frozen=True)
@@ -270,8 +325,9 @@ def _run_local(study, todo, store, progress, workers, max_points, state) -> None
     remaining = dict(todo)
     while remaining:
         t_start = time.perf_counter()
-        ex = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_warm,
+        ex = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init,
                                  initargs=(study.evaluator,))
+        stopped = False
         try:
             # start and warm every worker before timing the work
             _start_workers(ex, workers)
@@ -289,19 +345,18 @@ def _run_local(study, todo, store, progress, workers, max_points, state) -> None
                     continue
                 remaining.pop(k)
                 if _finish(rec, store, progress, state, max_points):
-                    for f in futs:
-                        f.cancel()
+                    _stop_pool(ex)  # max_points reached: the running points are not waited for
+                    stopped = True
                     break
             state["wall"] += time.perf_counter() - t_work
-        except KeyboardInterrupt:
+        except KeyboardInterrupt:  # Ctrl-C or SIGTERM: no worker may outlive the driver
             state["interrupted"] = True
-            procs = list((getattr(ex, "_processes", None) or {}).values())
-            ex.shutdown(wait=False, cancel_futures=True)
-            for proc in procs:  # stop the points still running (their results are lost)
-                proc.terminate()
+            _stop_pool(ex)
+            stopped = True
             raise
         finally:
-            ex.shutdown(wait=not state["interrupted"], cancel_futures=True)
+            if not stopped:
+                ex.shutdown(wait=True, cancel_futures=True)
         if state["interrupted"] or not broken:
             break
         state["restarts"] += 1
@@ -321,8 +376,8 @@ def _run_one_by_one(study, remaining, store, progress, settings, ctx, max_points
     try:
         for k, p in list(remaining.items()):
             if ex is None:
-                ex = ProcessPoolExecutor(max_workers=1, mp_context=ctx, initializer=_warm,
-                                         initargs=(study.evaluator,))
+                ex = ProcessPoolExecutor(max_workers=1, mp_context=ctx,
+                                         initializer=_worker_init, initargs=(study.evaluator,))
             try:
                 rec = ex.submit(evaluate_point, study.evaluator, p, settings, k).result()
             except BrokenProcessPool as exc:
@@ -332,6 +387,12 @@ def _run_one_by_one(study, remaining, store, progress, settings, ctx, max_points
             remaining.pop(k)
             if _finish(rec, store, progress, state, max_points):
                 return
+    except KeyboardInterrupt:
+        state["interrupted"] = True
+        if ex is not None:
+            _stop_pool(ex)
+            ex = None
+        raise
     finally:
         if ex is not None:
             ex.shutdown(wait=True)
@@ -377,8 +438,20 @@ def _run_dask(study, todo, store, progress, scheduler, max_points, state) -> Non
             client.close()
 
 
+def _check_counts(workers, max_points) -> None:
+    if workers is not None and (isinstance(workers, bool)
+                                or not isinstance(workers, numbers.Integral) or workers < 0):
+        raise ConfigError(f"workers = {workers!r}: give 0 (run in this process) or a positive "
+                          "number of worker processes")
+    if max_points is not None and (isinstance(max_points, bool)
+                                   or not isinstance(max_points, numbers.Integral)
+                                   or max_points < 0):
+        raise ConfigError(f"max_points = {max_points!r}: give a number of points >= 0 (0 "
+                          "computes nothing), or leave it out for all")
+
+
 def run_sweep(study: Study, *, store: str | Path | None = None, workers: int | None = None,
-              scheduler=None, progress: bool = True, retry_failed: bool = False,
+              scheduler=None, progress: bool = True, retry_failed: bool = True,
               max_points: int | None = None) -> SweepResult:
     """Run (or resume) a study and store every finished point.
 
@@ -394,11 +467,13 @@ def run_sweep(study: Study, *, store: str | Path | None = None, workers: int | N
         Dask scheduler address ``tcp://HOST:PORT`` (or a client); default
         ``study.scheduler``.  When given, ``workers`` is ignored.
     progress : bool
-        Show the progress line on stderr.
+        Report progress (logger ``casflutter.study._runner``, INFO).
     retry_failed : bool
-        Compute the points stored as failed again.
+        Compute the points stored as failed again (default); ``False`` keeps their failed
+        records and counts them as done.
     max_points : int, optional
-        Stop after this many points (the run is then ``interrupted``; run again to resume).
+        Stop after this many points (the run is then ``interrupted``; run again to resume);
+        ``0`` computes nothing.
 
     Returns
     -------
@@ -407,11 +482,17 @@ def run_sweep(study: Study, *, store: str | Path | None = None, workers: int | N
     Raises
     ------
     ConfigError
-        A point that the evaluator's pre-flight check (:attr:`Evaluator.check`, e.g. the
-        ``pipeline`` evaluator's configuration validation) rejects: every point is checked
-        before any is submitted, and nothing runs.
+        ``workers`` or ``max_points`` that is not a non-negative integer; study outputs that
+        the evaluator does not return; a point that the evaluator's pre-flight check
+        (:attr:`Evaluator.check`, e.g. the ``pipeline`` evaluator's configuration
+        validation) rejects: every point is checked before any is submitted, and nothing
+        runs.
+    StoreLockedError
+        Another sweep is running on the same store.
     KeyboardInterrupt
-        Re-raised after Ctrl-C; every point finished before it is stored.
+        Re-raised after Ctrl-C or SIGTERM (:class:`casflutter._interrupt.Terminated`, when
+        the application has not set its own SIGTERM handler); the worker processes are
+        stopped and every point finished before it is stored.
 
     Notes
     -----
@@ -420,14 +501,28 @@ def run_sweep(study: Study, *, store: str | Path | None = None, workers: int | N
     ``if __name__ == "__main__":`` (otherwise every worker runs the sweep again and
     Python stops it with a ``RuntimeError`` about bootstrapping).
     """
+    _check_counts(workers, max_points)
     store_path = Path(store) if store is not None else default_store_path(study)
     pstore = PointStore(store_path)
+    with pstore.lock(), sigterm_raises(only_if_default=True):
+        return _run_locked(study, pstore, workers, scheduler, progress, retry_failed,
+                           max_points)
+
+
+def _run_locked(study, pstore, workers, scheduler, progress, retry_failed,
+                max_points) -> SweepResult:
     points = study.points()
     keyed = {study.key(p): p for p in points}
     finished = pstore.finished_keys(include_failed=not retry_failed)
+    if pstore.skipped_lines:
+        _log.warning("store %s: %d line(s) that are not readable records were skipped (torn "
+                     "by a kill, or not UTF-8 JSON); their points, if any, are computed again",
+                     pstore.path, pstore.skipped_lines)
     todo = {k: p for k, p in keyed.items() if k not in finished}
     n_resumed = len(keyed) - len(todo)
     _preflight(study, todo)
+    if max_points == 0:
+        todo = {}
     prog = Progress(len(keyed), skipped=n_resumed, enabled=progress)
     state = {"startup": 0.0, "wall": 0.0, "work": 0.0, "computed": 0, "restarts": 0,
              "interrupted": False}
@@ -465,9 +560,12 @@ def run_sweep(study: Study, *, store: str | Path | None = None, workers: int | N
     recs = pstore.records()
     in_design = [recs[k] for k in keyed if k in recs]
     n_left = len(keyed) - len(in_design)
+    n_failed = sum(r.get("status") != "ok" for r in in_design)
+    if n_failed:
+        _log.debug("study %s: %d failed point(s) in %s", study.name, n_failed, pstore.path)
     return SweepResult(
-        study=study, store=store_path, n_points=len(keyed), n_resumed=n_resumed,
-        n_computed=state["computed"], n_failed=sum(r.get("status") != "ok" for r in in_design),
+        study=study, store=pstore.path, n_points=len(keyed), n_resumed=n_resumed,
+        n_computed=state["computed"], n_failed=n_failed,
         n_left=n_left, interrupted=bool(state["interrupted"] or n_left > 0), executor=executor,
         wall_time=state["wall"], startup_time=state["startup"], work_time=state["work"],
         worker_restarts=state["restarts"])

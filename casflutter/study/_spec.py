@@ -24,10 +24,12 @@ A study file is TOML::
 
 from __future__ import annotations
 
+import datetime
 import hashlib
 import itertools
 import json
 import math
+import numbers
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
@@ -37,7 +39,7 @@ import numpy as np
 from .._resources import read_toml
 from ..errors import ConfigError
 
-__all__ = ["Parameter", "Study", "load_study", "point_key"]
+__all__ = ["Parameter", "Study", "load_study", "point_key", "check_setting"]
 
 _DESIGNS = ("grid", "lhs")
 
@@ -53,6 +55,79 @@ def _jsonable(value: Any) -> Any:
     if isinstance(value, (list, tuple)):
         return [_jsonable(v) for v in value]
     return value
+
+
+def _is_int(value) -> bool:
+    return (not isinstance(value, bool) and isinstance(value, numbers.Integral)) or (
+        isinstance(value, float) and value.is_integer())
+
+
+def _is_real(value) -> bool:
+    return not isinstance(value, bool) and isinstance(value, numbers.Real)
+
+
+def _integer(value, what: str, minimum: int | None = None) -> int:
+    """An integer field of the study file (``16`` or ``16.0``), or a ConfigError."""
+    if not _is_int(value) or (minimum is not None and value < minimum):
+        more = f" >= {minimum}" if minimum is not None else ""
+        raise ConfigError(f"{what} = {value!r}: give an integer{more}")
+    return int(value)
+
+
+def check_setting(settings: Mapping[str, Any], key: str, default: Any, *,
+                  integer: bool = False, low: float | None = None, high: float | None = None,
+                  positive: bool = False) -> float | int:
+    """A numeric evaluator setting (or swept value) checked before any point runs: the
+    pre-flight checks of the evaluators call it.
+
+    Parameters
+    ----------
+    settings : mapping
+        The point's merged settings and parameters.
+    key : str
+        The setting; ``default`` when absent.
+    integer, low, high, positive
+        The type and range allowed.
+
+    Returns
+    -------
+    float or int
+
+    Raises
+    ------
+    ConfigError
+        Names the key, its value and what is allowed.
+    """
+    value = settings.get(key, default)
+    ok = _is_int(value) if integer else (_is_real(value) and math.isfinite(float(value)))
+    if ok:
+        v = float(value)
+        ok = (low is None or v >= low) and (high is None or v <= high) and (not positive or v > 0)
+    if not ok:
+        rng = "".join([" > 0" if positive else "", f" >= {low:g}" if low is not None else "",
+                       f" <= {high:g}" if high is not None else ""])
+        raise ConfigError(f"{key} = {value!r}: give {'an integer' if integer else 'a finite number'}"
+                          f"{rng}")
+    return int(value) if integer else float(value)
+
+
+def _check_value(value, what: str) -> None:
+    """A parameter or setting value that can be hashed into a point key and stored as JSON:
+    text, a finite number, a boolean, or lists and tables of them."""
+    if isinstance(value, Mapping):
+        for k, v in value.items():
+            _check_value(v, f"{what}.{k}")
+    elif isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            _check_value(v, f"{what}[{i}]")
+    elif isinstance(value, (datetime.date, datetime.time)):
+        raise ConfigError(f"{what} = {value!r}: a TOML date or time is not a usable value; "
+                          "quote it to pass it as text")
+    elif _is_real(value) and not math.isfinite(float(value)):
+        raise ConfigError(f"{what} = {value!r}: not a finite number; give a finite value")
+    elif not (isinstance(value, (str, bool, numbers.Real)) or value is None):
+        raise ConfigError(f"{what} = {value!r}: give text, a number, a boolean, or a list "
+                          "or table of them")
 
 
 def point_key(evaluator: str, settings: Mapping[str, Any], params: Mapping[str, Any]) -> str:
@@ -96,16 +171,37 @@ class Parameter:
     integer: bool = False
 
     def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise ConfigError(f"parameter name {self.name!r}: give a non-empty name")
         if self.values is not None:
+            if isinstance(self.values, (str, bytes)) or not hasattr(self.values, "__len__"):
+                raise ConfigError(f"parameter {self.name!r}: values = {self.values!r} is not a "
+                                  "list of values")
             if len(self.values) == 0:
                 raise ConfigError(f"parameter {self.name!r}: the list of values is empty")
+            for i, v in enumerate(self.values):
+                _check_value(v, f"parameter {self.name!r} value {i + 1}")
             return
         if self.low is None or self.high is None:
             raise ConfigError(f"parameter {self.name!r}: give a list of values or a table "
                               "{low = ..., high = ..., num = ...}")
+        for key in ("low", "high"):
+            v = getattr(self, key)
+            if not _is_real(v) or not math.isfinite(float(v)):
+                raise ConfigError(f"parameter {self.name!r}: {key} = {v!r} must be a finite "
+                                  "number")
+        if not _is_int(self.num):
+            raise ConfigError(f"parameter {self.name!r}: num = {self.num!r} must be an integer "
+                              ">= 1")
+        if not isinstance(self.integer, bool):
+            raise ConfigError(f"parameter {self.name!r}: integer = {self.integer!r} must be "
+                              "true or false")
         if not float(self.high) >= float(self.low):
             raise ConfigError(f"parameter {self.name!r}: need high >= low, got "
                               f"low={self.low}, high={self.high}")
+        if self.integer and math.floor(float(self.high)) < math.ceil(float(self.low)):
+            raise ConfigError(f"parameter {self.name!r}: no integer between low={self.low} and "
+                              f"high={self.high}")
         if self.scale not in ("linear", "log"):
             raise ConfigError(f"parameter {self.name!r}: scale must be 'linear' or 'log', got "
                               f"{self.scale!r}")
@@ -128,10 +224,12 @@ class Parameter:
                 raise ConfigError(f"parameter {name!r}: unknown key(s) {sorted(bad)}; allowed: "
                                   f"{sorted(allowed)}")
             vals = spec.get("values")
+            if vals is not None and not isinstance(vals, list):
+                raise ConfigError(f"parameter {name!r}: values = {vals!r} must be a list")
             return cls(name, values=None if vals is None else tuple(vals), low=spec.get("low"),
-                       high=spec.get("high"), num=int(spec.get("num", 5)),
+                       high=spec.get("high"), num=spec.get("num", 5),
                        scale=str(spec.get("scale", "linear")),
-                       integer=bool(spec.get("integer", False)))
+                       integer=spec.get("integer", False))
         raise ConfigError(f"parameter {name!r}: {spec!r} is neither a list of values nor a "
                           "{low, high, num} table")
 
@@ -209,6 +307,27 @@ class Study:
     base_dir: str = "."
 
     def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name.strip() or self.name in (".", "..") \
+                or any(c in self.name for c in "/\\\0"):
+            raise ConfigError(f"study name {self.name!r} names the output files: give a "
+                              "non-empty name without '/' or '\\'")
+        if not isinstance(self.evaluator, str) or not self.evaluator:
+            raise ConfigError(f"evaluator = {self.evaluator!r}: give a registered name or "
+                              "'package.module:function'")
+        _integer(self.samples, "samples", 1)
+        _integer(self.seed, "seed", 0)
+        _integer(self.workers, "workers", 0)
+        if isinstance(self.outputs, (str, bytes)) or not all(
+                isinstance(o, str) and o for o in self.outputs):
+            raise ConfigError(f"outputs = {self.outputs!r}: give a list of output names, e.g. "
+                              'outputs = ["Vf"]')
+        if self.scheduler is not None and not isinstance(self.scheduler, str):
+            raise ConfigError(f"scheduler = {self.scheduler!r}: give the address as text, "
+                              "e.g. \"tcp://host:8786\"")
+        if not isinstance(self.settings, Mapping):
+            raise ConfigError(f"settings must be a table, got {type(self.settings).__name__}")
+        for k, v in self.settings.items():
+            _check_value(v, f"[settings] {k}")
         if self.design not in _DESIGNS:
             raise ConfigError(f"design must be one of {_DESIGNS}, got {self.design!r}")
         if not self.parameters:
@@ -273,12 +392,21 @@ class Study:
             raise ConfigError(f"unknown key(s) {sorted(bad)} in [study]; allowed: {sorted(allowed)}")
         if "evaluator" not in st:
             raise ConfigError("[study] needs evaluator = \"NAME\" (e.g. \"truth_flutter\")")
+        for table in ("study", "settings", "parameters"):
+            if not isinstance(data.get(table, {}), Mapping):
+                raise ConfigError(f"[{table}] must be a table of keys, got "
+                                  f"{type(data[table]).__name__}")
+        outputs = st.get("outputs", ())
+        if not isinstance(outputs, (list, tuple)):
+            raise ConfigError(f"outputs = {outputs!r}: give a list of output names, e.g. "
+                              'outputs = ["Vf"]')
         params = tuple(Parameter.from_toml(k, v) for k, v in data.get("parameters", {}).items())
-        return cls(name=str(st.get("name", name)), evaluator=str(st["evaluator"]),
+        return cls(name=str(st.get("name", name)), evaluator=st["evaluator"],
                    parameters=params, settings=dict(data.get("settings", {})),
-                   design=str(st.get("design", "grid")), samples=int(st.get("samples", 16)),
-                   seed=int(st.get("seed", 0)), outputs=tuple(st.get("outputs", ())),
-                   workers=int(st.get("workers", 2)),
+                   design=str(st.get("design", "grid")),
+                   samples=_integer(st.get("samples", 16), "samples", 1),
+                   seed=_integer(st.get("seed", 0), "seed", 0), outputs=tuple(outputs),
+                   workers=_integer(st.get("workers", 2), "workers", 0),
                    scheduler=st.get("scheduler") or None, base_dir=str(base_dir))
 
 
@@ -292,5 +420,8 @@ def load_study(path: str | Path) -> Study:
     """
     path = Path(path)
     data = read_toml(path, "study file")
-    return Study.from_dict(data, name=path.stem, base_dir=path.resolve().parent)
+    try:
+        return Study.from_dict(data, name=path.stem, base_dir=path.resolve().parent)
+    except ConfigError as exc:
+        raise ConfigError(f"study file {path}: {exc}") from None
 

@@ -33,12 +33,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import brentq
+from scipy.special import hankel2
 
-from ._aero import JONES_B, strip_coefficients
+from ..errors import ConfigError
+from ._aero import JONES_B, jones_C, strip_coefficients
 from ._base import AeroelasticTruth, AeroMatrices
 from ._params import ChordGeometryMixin, ParamsMixin, require
 
-__all__ = ["GolandParams", "GolandWing", "clamped_free_roots"]
+__all__ = ["GolandParams", "GolandWing", "clamped_free_roots", "theodorsen_C"]
 
 _NQUAD = 200
 
@@ -104,6 +106,28 @@ def clamped_free_roots(n: int) -> np.ndarray:
     f = lambda x: np.cos(x) + 1.0 / np.cosh(x)  # same roots, well scaled
     return np.array([brentq(f, (r - 1) * np.pi + 0.3, r * np.pi, xtol=1e-14)
                      for r in range(1, n + 1)])
+
+
+def theodorsen_C(k) -> np.ndarray:
+    """Theodorsen's function ``C(k) = H1(k) / (H1(k) + i H0(k))`` (exact, Hankel functions).
+
+    Parameters
+    ----------
+    k : array_like
+        Reduced frequencies ``omega b / U >= 0``; ``C(0) = 1``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Complex ``C(k)``, shaped like ``k``; ``H0, H1`` are the Hankel functions of the
+        second kind (``scipy.special.hankel2``).
+    """
+    k = np.asarray(k, dtype=float)
+    out = np.ones(k.shape, dtype=complex)
+    pos = k > 0
+    H1, H0 = hankel2(1, k[pos]), hankel2(0, k[pos])
+    out[pos] = H1 / (H1 + 1j * H0)
+    return out
 
 
 def _bending_shapes(y: np.ndarray, L: float, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -264,3 +288,63 @@ class GolandWing(AeroelasticTruth):
                 "sensor_units": ("m", "rad", "m", "m"),
                 "time_unit": "s",
                 "speed_index": "V = U / (b omega_ref), omega_ref = (pi/2L) sqrt(GJ/I)"}
+
+    # frequency domain ---------------------------------------------------------------
+    def generalized_aero_forces(self, k, *, theodorsen: str = "exact") -> np.ndarray:
+        """Strip-theory generalised aerodynamic forces ``Q(ik)`` on the in-vacuo modes.
+
+        For harmonic motion ``u = Re(u_hat e^{i omega t})``, flap ``v = Re(v_hat e^{i omega t})``
+        at reduced frequency ``k = omega b / U``, the generalised forces of eq. (6) are
+        ``y = Re(Q(ik) [u_hat; v_hat] e^{i omega t})``: the same normalisation as
+        :meth:`aero_forces` (``y = Phi^T f / (rho U^2 L)``), so that the modal equations are
+
+            u'' + 2 zeta omega u' + omega^2 u = alpha V^2 Q(ik) [u; v],   alpha V^2 = rho U^2 / m,
+
+        with ``V = U / (b omega_ref)`` the speed index.  ``Q`` depends on ``k`` only (not on
+        ``U`` or ``rho``).  The assembly is that of :meth:`aero_matrices` (same assumed modes,
+        strips and flap) with Theodorsen's circulation function ``C(k)`` in place of the Jones
+        lag states.
+
+        Parameters
+        ----------
+        k : array_like
+            Reduced frequencies ``omega b / U >= 0``, shape ``(nk,)``.
+        theodorsen : {"exact", "jones"}
+            ``"exact"``: :func:`theodorsen_C` (Hankel functions); ``"jones"``: R. T. Jones'
+            two-lag approximation, which reproduces the frequency response of the truth's own
+            state space (:meth:`state_matrix`).
+
+        Returns
+        -------
+        numpy.ndarray
+            Complex, shape ``(nk, N, N + 1)``: columns are the N modes (in the order of
+            :meth:`modal_structure`) and the flap (last column, per radian).
+
+        Raises
+        ------
+        ConfigError
+            ``theodorsen`` not one of the two names, or ``k`` negative or not finite.
+        """
+        kk = np.atleast_1d(np.asarray(k, dtype=float))
+        if kk.ndim != 1 or not np.all(np.isfinite(kk)) or np.any(kk < 0):
+            raise ConfigError(f"reduced frequencies k must be a 1-D array of finite values >= 0, "
+                              f"got {np.asarray(k)!r}")
+        if theodorsen == "exact":
+            Ck = theodorsen_C(kk)
+        elif theodorsen == "jones":
+            Ck = jones_C(kk)
+        else:
+            raise ConfigError(f"theodorsen={theodorsen!r}: use 'exact' or 'jones'")
+        V = 1.0
+        U, b = self.airspeed(V), self.params.b
+        am = self.aero_matrices(V)
+        Phi = self._Phi
+        N = Phi.shape[1]
+        out = np.empty((kk.size, N, N + 1), dtype=complex)
+        for n, (kn, Cn) in enumerate(zip(kk, Ck)):
+            s = 1j * kn * U / b
+            Fx = am.Kx + s * am.Cx + s * s * am.Mx + Cn * am.W @ (am.Gx + s * am.Gx1)
+            Fv = am.Fv + s * am.Fv1 + s * s * am.Fv2 + Cn * am.W @ (am.Gv + s * am.Gv1)
+            out[n, :, :N] = Phi.T @ Fx @ Phi
+            out[n, :, N] = Phi.T @ Fv
+        return out / (self.alpha * V * V)

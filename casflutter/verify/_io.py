@@ -65,12 +65,22 @@ def _mat(d: dict, key: str, shape: tuple[int, int] | None = None) -> np.ndarray:
     raw = d.get(key)
     if raw is None and shape is not None:
         return np.zeros(shape)
+    if isinstance(raw, (str, bool, dict)):
+        raise DataError(f"matrix {key!r} must be a list of rows of numbers, got "
+                        f"{type(raw).__name__} {raw!r:.40}")
     try:
         M = np.asarray(raw if raw is not None else [], dtype=float)
     except (TypeError, ValueError) as exc:
-        raise DataError(f"matrix {key!r} is not numeric: {exc}") from None
+        raise DataError(f"matrix {key!r} is not numeric ({exc}); give a list of rows of "
+                        "numbers of equal length") from None
     if f"shape_{key}" in d:
-        M = M.reshape(tuple(int(s) for s in d[f"shape_{key}"]))
+        dims = d[f"shape_{key}"]
+        if not (isinstance(dims, list) and len(dims) == 2
+                and all(isinstance(n, int) and not isinstance(n, bool) and n >= 0 for n in dims)
+                and dims[0] * dims[1] == M.size):
+            raise DataError(f"shape_{key} = {dims!r} must be two non-negative integers whose "
+                            f"product is the {M.size} entries of {key!r}")
+        M = M.reshape(tuple(dims))
     elif shape is not None and M.size == 0:
         M = np.zeros(shape)
     elif M.ndim == 1 and M.size:
@@ -168,8 +178,9 @@ def _opt_int(d: dict, key: str) -> int | None:
     v = d.get(key)
     if v is None:
         return None
-    if isinstance(v, bool) or not float(v).is_integer():
-        raise DataError(f"{key!r} must be an integer, got {v!r}")
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) \
+            or not float(v).is_integer() or v < 0:
+        raise DataError(f"{key!r} must be a non-negative integer, got {v!r}")
     return int(v)
 
 
@@ -177,6 +188,8 @@ def _opt_float(d: dict, key: str) -> float | None:
     v = d.get(key)
     if v is None:
         return None
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise DataError(f"{key!r} must be a number, got {v!r}")
     v = float(v)
     if not math.isfinite(v):
         raise DataError(f"{key!r} must be finite, got {v!r}")
@@ -202,8 +215,17 @@ def _read(path: str | os.PathLike) -> dict:
             return json.load(fh)
     except FileNotFoundError:
         raise DataError(f"file not found: {path}") from None
+    except IsADirectoryError:
+        raise DataError(f"{path} is a folder; give the JSON file inside it") from None
+    except UnicodeDecodeError as exc:
+        raise DataError(f"{path} is not a UTF-8 text file ({exc.reason} at byte {exc.start}); "
+                        "give a JSON file") from None
     except json.JSONDecodeError as exc:
         raise DataError(f"{path} is not valid JSON: {exc}") from None
+    except RecursionError:
+        raise DataError(f"{path}: JSON nested too deeply to be a plant or controller") from None
+    except OSError as exc:
+        raise DataError(f"{path} cannot be read ({exc.strerror or exc})") from None
 
 
 def load_plant(path: str | os.PathLike) -> PlantData:

@@ -78,12 +78,13 @@ class VerificationReport:
         return self.hinf.gamma
 
     def to_dict(self) -> dict:
-        """JSON-serialisable summary (``inf``/``nan`` become strings)."""
+        """JSON-serialisable summary; a non-finite number (the infinite γ of an unstable
+        loop, an unbounded interval end) becomes ``None`` (``null``: strict JSON)."""
         def num(x):
             if x is None:
                 return None
             x = float(x)
-            return x if math.isfinite(x) else str(x)
+            return x if math.isfinite(x) else None
 
         def pair(t):
             return None if t is None else [num(t[0]), num(t[1])]

@@ -61,9 +61,12 @@ def test_failures_are_recorded_and_do_not_stop_the_sweep(tmp_path):
     assert recs[3.0]["error"] == "ValueError: x = 3.0 is not allowed here"
     assert "ValueError" in recs[3.0]["traceback"]
     assert all(recs[x]["outputs"]["y"] == x * x for x in recs if x not in (3.0, 5.0))
-    # resuming skips failures unless asked; retry_failed recomputes only them
+    # resuming recomputes only the failed points (they fail again here); keeping them
+    # (retry_failed=False) counts them as done
     again = run_sweep(st, store=res.store, workers=0, progress=False)
-    assert (again.n_resumed, again.n_computed) == (8, 0)
+    assert (again.n_resumed, again.n_computed, again.n_failed) == (6, 2, 2)
+    kept = run_sweep(st, store=res.store, workers=0, progress=False, retry_failed=False)
+    assert (kept.n_resumed, kept.n_computed, kept.n_failed) == (8, 0, 2)
     st_ok = _square_study(8)
     assert st_ok.key({"x": 3.0}) != st.key({"x": 3.0})  # settings are part of the key
     prog = Progress(10, skipped=4, stream=buf, interval=0.0)

@@ -12,6 +12,8 @@ measured in the worker (start-up of the worker processes reported separately).
 from __future__ import annotations
 
 import json
+import logging
+import math
 import os
 import platform
 import statistics
@@ -19,7 +21,12 @@ import tempfile
 import time
 from pathlib import Path
 
+from ..._outputs import check_output_path
+from ...errors import CasflutterError, ConfigError
+
 __all__ = ["register", "run", "bench_study"]
+
+_log = logging.getLogger(__name__)
 
 
 def bench_study(points: int, lco_time: float, seed: int = 0):
@@ -57,7 +64,8 @@ def _one(study, store_dir: Path, tag: str, i: int, **kw) -> dict:
     store = store_dir / f"{tag}_{i}.jsonl"
     res = run_sweep(study, store=store, progress=False, **kw)
     if res.n_left:
-        raise RuntimeError(f"{tag}: {res.n_left} points left")
+        raise CasflutterError(f"bench sweep, {tag}: {res.n_left} points were not computed; rerun "
+                          "(a worker or the cluster was lost)")
     workers = kw.get("workers") or 2
     work = res.work_time
     return {"wall_time": res.wall_time, "startup_time": res.startup_time, "work_time": work,
@@ -81,7 +89,13 @@ def _summary(runs: list[dict], workers: int, points: int) -> dict:
 
 
 def run(args) -> int:
-    """Handler: run the benchmark and write the JSON."""
+    """Handler: run the benchmark and write the JSON (the output file is checked first)."""
+    for name, value in (("--points", args.points), ("--repeats", args.repeats)):
+        if value < 1:
+            raise ConfigError(f"{name} {value}: give a positive number")
+    if not (math.isfinite(args.lco_time) and args.lco_time > 0):
+        raise ConfigError(f"--lco-time {args.lco_time}: give a positive number of time units")
+    check_output_path(args.out, what="--out", suffixes=(".json",))
     study = bench_study(args.points, args.lco_time)
     out: dict = {"benchmark": "sweep", "points": args.points, "repeats": args.repeats,
                  "study": "typical_section LHS (a, sigma, mu, zeta), truth_flutter + LCO at 1.1 Vf",
@@ -96,8 +110,9 @@ def run(args) -> int:
         for w in (1, 2):
             runs = [_one(study, tmp, f"local{w}", i, workers=w) for i in range(args.repeats)]
             out[f"local_{w}_workers"] = _summary(runs, w, args.points)
-            print(f"local, {w} worker(s): wall {out[f'local_{w}_workers']['wall_time']:.2f} s, "
-                  f"overhead {out[f'local_{w}_workers']['overhead_percent']:.2f} %")
+            _log.info("local, %d worker(s): wall %.2f s, overhead %.2f %%", w,
+                      out[f"local_{w}_workers"]["wall_time"],
+                      out[f"local_{w}_workers"]["overhead_percent"])
         out["speedup_2_vs_1"] = (out["local_1_workers"]["wall_time"]
                                  / out["local_2_workers"]["wall_time"])
         if not args.no_dask:
@@ -114,8 +129,8 @@ def run(args) -> int:
             out["dask_2_workers"]["cluster_start_time"] = cluster_start
             out["speedup_dask2_vs_1"] = (out["local_1_workers"]["wall_time"]
                                          / out["dask_2_workers"]["wall_time"])
-            print(f"dask, 2 workers: wall {out['dask_2_workers']['wall_time']:.2f} s, "
-                  f"overhead {out['dask_2_workers']['overhead_percent']:.2f} %")
+            _log.info("dask, 2 workers: wall %.2f s, overhead %.2f %%",
+                      out["dask_2_workers"]["wall_time"], out["dask_2_workers"]["overhead_percent"])
     print(f"speed-up 2 vs 1 local workers: {out['speedup_2_vs_1']:.2f}")
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     with open(args.out, "w") as fh:

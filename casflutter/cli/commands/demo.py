@@ -3,13 +3,22 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+
+from ...errors import ConfigError
 
 
 def _main(args) -> int:
     from ...ident import identify, paper_parameter_count, random_hwl_model, synthetic_data
     from ...realize import realize
 
+    if args.seed < 0:
+        raise ConfigError(f"--seed {args.seed}: give an integer >= 0")
+    if not (math.isfinite(args.noise) and 0 <= args.noise < 1):
+        raise ConfigError(f"--noise {args.noise}: give the relative output noise as a number "
+                          "in [0, 1), e.g. 0.02")
     orders = (3, 1, 1, 1, 2, 2)
     truth = random_hwl_model(5, orders, seed=args.seed)
     data = synthetic_data(truth, 4000, seed=args.seed + 1, noise=args.noise)

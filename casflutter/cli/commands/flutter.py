@@ -3,8 +3,8 @@
 Runs the configuration ``problems/NAME/flutter.toml`` (:func:`casflutter.pipeline.run`: the
 paper's ROM route at one speed with the V² scaling, the truth with its aerodynamics frozen at
 that speed, and the parametric ROM interpolated in V) beside the full-order truth, prints the
-flutter and divergence speeds in the problem's own units (or writes JSON to stdout) and
-saves the V–g / V–f figure.
+flutter and divergence speeds in the problem's own units (or writes JSON to stdout) and,
+with ``--figure PATH``, saves the V–g / V–f figure.
 """
 
 from __future__ import annotations
@@ -13,6 +13,9 @@ import json
 import math
 import sys
 from dataclasses import replace
+from pathlib import Path
+
+from ..._outputs import check_figure_path
 
 __all__ = ["register", "run", "summarize"]
 
@@ -36,8 +39,8 @@ def register(subparsers) -> None:
     p.add_argument("--no-parametric", action="store_true",
                    help="skip the parametric ROM (its block is then null)")
     p.add_argument("--figure", default=None, metavar="PATH",
-                   help="where to save the V-g/V-f figure (default PROBLEM_flutter.png; "
-                        "'none' to skip)")
+                   help="save the V-g/V-f figure to PATH (.png, .pdf, .svg ...; checked "
+                        "before the work); default: no figure")
     p.add_argument("--json", action="store_true", help="write the result as JSON to stdout")
     p.set_defaults(func=run)
 
@@ -155,6 +158,9 @@ def run(args) -> int:
     from ...pipeline import flutter_config, run as run_config
     from ...truth import load_problem, parse_sets, problem_label
 
+    fig_path = None                  # figures only where asked, checked before the work
+    if args.figure is not None and args.figure.lower() != "none":
+        fig_path = str(check_figure_path(args.figure, what="--figure"))
     changes = parse_sets(args.sets)
     truth = load_problem(args.problem, changes)
     label = problem_label(args.problem)
@@ -170,8 +176,8 @@ def run(args) -> int:
         cfg = replace(cfg, stages=tuple(s for s in cfg.stages if s != "parametric"))
     result = run_config(cfg, quiet=True, write=False)
     doc = summarize(result, label)
-    fig_path = args.figure if args.figure is not None else f"{label}_flutter.png"
-    if fig_path.lower() != "none":
+    if fig_path is not None:
+        Path(fig_path).parent.mkdir(parents=True, exist_ok=True)
         _figure(result, fig_path, float(truth.modal_structure().omega.max()),
                 "speed index " + truth.modal_structure().speed_index.split(",")[0])
         doc["figure"] = fig_path

@@ -33,7 +33,6 @@ synthesis is differentiated (:func:`casflutter.study.gamma_sensitivity`)::
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 __all__ = ["register", "run"]
 
@@ -59,6 +58,52 @@ def register(subparsers) -> None:
                    help="compare with finite differences of the flutter speed")
     p.add_argument("--json", action="store_true", help="machine-readable output")
     p.set_defaults(func=run)
+
+
+def _number(table: str, key: str, value, *, low=None, high=None, integer=False,
+            positive=False) -> float | int:
+    """A numeric entry of the config file, checked (type, finite, range) with a message that
+    names the table and key."""
+    import math  # noqa: PLC0415
+
+    from ...errors import ConfigError  # noqa: PLC0415
+
+    ok = not isinstance(value, bool) and isinstance(value, (int, float))
+    if ok and integer:
+        ok = float(value).is_integer()
+    if ok:
+        v = float(value)
+        ok = math.isfinite(v) and (low is None or v >= low) and (high is None or v <= high) \
+            and (not positive or v > 0)
+    if not ok:
+        kind = "an integer" if integer else "a finite number"
+        rng = "".join([" > 0" if positive else "", f" >= {low}" if low is not None else "",
+                       f" <= {high}" if high is not None else ""])
+        raise ConfigError(f"[{table}] {key} = {value!r}: give {kind}{rng}")
+    return int(value) if integer else float(value)
+
+
+def _check_sensitivity(sec: dict, params: dict) -> None:
+    """Types and ranges of the ``[sensitivity]`` and ``[params]`` entries."""
+    from ...errors import ConfigError  # noqa: PLC0415
+
+    if "problem" in sec and not isinstance(sec["problem"], str):
+        raise ConfigError(f"[sensitivity] problem = {sec['problem']!r}: give a problem name")
+    v_min = _number("sensitivity", "V_min", sec.get("V_min", 0.02), low=0.0)
+    v_max = _number("sensitivity", "V_max", sec.get("V_max", 4.0), low=0.0)
+    if not v_min < v_max:
+        raise ConfigError(f"[sensitivity] V_min = {v_min} must be below V_max = {v_max}")
+    _number("sensitivity", "n_grid", sec.get("n_grid", 81), low=3, integer=True)
+    _number("sensitivity", "rel_step", sec.get("rel_step", 1e-6), positive=True, high=0.1)
+    if not isinstance(sec.get("check", False), bool):
+        raise ConfigError(f"[sensitivity] check = {sec['check']!r}: give true or false")
+    names = sec.get("parameters")
+    if names is not None and (not isinstance(names, list)
+                              or not all(isinstance(n, str) for n in names)):
+        raise ConfigError(f"[sensitivity] parameters = {names!r}: give a list of parameter "
+                          'names, e.g. ["mu", "zeta"]')
+    for k, v in params.items():
+        _number("params", k, v)
 
 
 def _config(args) -> tuple[dict, dict]:
@@ -97,6 +142,7 @@ def _config(args) -> tuple[dict, dict]:
         sec["method"] = args.method
     if sec.get("method", "eigen") not in ("eigen", "nlp"):
         raise ConfigError(f"method must be 'eigen' or 'nlp', got {sec['method']!r}")
+    _check_sensitivity(sec, params)
     return sec, params
 
 
@@ -114,19 +160,23 @@ def _gamma(cfg: dict, args) -> int:
     if bad or not {"plant", "nmeas", "ncon"} <= set(g):
         raise ConfigError(f"[gamma] needs plant, nmeas, ncon (optional order, starts, seed, "
                           f"rel_step, tol); unknown: {sorted(bad)}")
+    params = {k: _number("params", k, v) for k, v in cfg.get("params", {}).items()}
+    nmeas = _number("gamma", "nmeas", g["nmeas"], low=1, integer=True)
+    ncon = _number("gamma", "ncon", g["ncon"], low=1, integer=True)
+    order = _number("gamma", "order", g.get("order", 0), low=0, integer=True)
+    starts = _number("gamma", "starts", g.get("starts", 2), low=1, integer=True)
+    seed = _number("gamma", "seed", g.get("seed", 0), low=0, integer=True)
+    tol = _number("gamma", "tol", g.get("tol", 1e-6), positive=True)
+    rel_step = _number("gamma", "rel_step", g.get("rel_step", 1e-6), positive=True, high=0.1)
     mod, _, attr = str(g["plant"]).partition(":")
     try:
         plant_fn = getattr(importlib.import_module(mod), attr)
     except (ImportError, AttributeError, ValueError) as exc:
         raise ConfigError(f"[gamma] plant {g['plant']!r} cannot be imported ({exc}); give "
                           "'package.module:function'") from None
-    params = {k: float(v) for k, v in cfg.get("params", {}).items()}
-    nmeas, ncon = int(g["nmeas"]), int(g["ncon"])
-    res = synthesize(plant_fn(params), nmeas, ncon, int(g.get("order", 0)),
-                     starts=int(g.get("starts", 2)), seed=int(g.get("seed", 0)),
-                     options={"tol": float(g.get("tol", 1e-6))})
-    gs = gamma_sensitivity(plant_fn, params, nmeas, ncon, res,
-                           rel_step=float(g.get("rel_step", 1e-6)))
+    res = synthesize(plant_fn(params), nmeas, ncon, order, starts=starts, seed=seed,
+                     options={"tol": tol})
+    gs = gamma_sensitivity(plant_fn, params, nmeas, ncon, res, rel_step=rel_step)
     rows = [{"name": n, "value": params[n], "dgamma_dp": d, "normalized": z}
             for n, d, z in gs.ranked()]
     if args.json:

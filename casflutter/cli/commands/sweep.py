@@ -2,18 +2,29 @@
 
 Local worker processes by default; ``--scheduler tcp://HOST:PORT`` (or ``scheduler`` in the
 study file) sends the same study to an existing Dask distributed cluster.  Every finished
-point is stored at once in ``OUT/NAME.jsonl``; running the command again resumes.  The tidy
-table goes to ``OUT/NAME.csv`` (and ``.parquet`` where pyarrow is installed), the summary
-plot to ``OUT/NAME.png``.
+point is stored at once in ``OUT/NAME.jsonl``; running the command again resumes (and
+computes the failed points again, unless ``--keep-failed``).  The tidy table goes to
+``OUT/NAME.csv`` (and ``.parquet`` where pyarrow is installed), the summary plot to
+``OUT/NAME.png``.
+
+Exit code: 0 when every point finished without failure; 1 when points failed or are left
+(the summary line says how many) or on an error; 130 after Ctrl-C, 143 after SIGTERM (the
+worker processes are stopped; run the same command again to resume).  A second sweep on the
+same store refuses to start while the first runs.
 """
 
 from __future__ import annotations
 
+import argparse
 import json
-import sys
-from pathlib import Path
+import logging
+
+from ..._interrupt import Terminated
+from ..._outputs import check_output_path
 
 __all__ = ["register", "run"]
+
+_log = logging.getLogger(__name__)
 
 
 def register(subparsers) -> None:
@@ -30,10 +41,12 @@ def register(subparsers) -> None:
     p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
                    help="run on an existing Dask distributed scheduler")
     p.add_argument("--out", default="sweeps", help="output folder (default ./sweeps)")
-    p.add_argument("--retry-failed", action="store_true",
-                   help="compute the points stored as failed again")
+    p.add_argument("--keep-failed", action="store_true",
+                   help="do not compute the points stored as failed again (they count as "
+                        "done)")
+    p.add_argument("--retry-failed", action="store_true", help=argparse.SUPPRESS)
     p.add_argument("--max-points", type=int, default=None,
-                   help="stop after this many points (resume later)")
+                   help="stop after this many points (resume later; 0 computes nothing)")
     p.add_argument("--no-progress", action="store_true", help="no progress line on stderr")
     p.add_argument("--no-plot", action="store_true", help="skip the summary figure")
     p.add_argument("--list", action="store_true", help="list the registered evaluators")
@@ -42,7 +55,8 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
-    """Handler: 0 when every point is finished, 1 when points are left, 130 after Ctrl-C."""
+    """Handler: 0 when every point finished without failure, 1 when points failed or are
+    left, 130 after Ctrl-C, 143 after SIGTERM."""
     from ...errors import ConfigError
     from ...study import (evaluator_names, get_evaluator, load_study, plot_sweep, run_sweep,
                           sweep_table, write_table)
@@ -57,16 +71,17 @@ def run(args) -> int:
     if not args.study:
         raise ConfigError("give a study file: casflutter sweep STUDY.toml (or --list)")
     study = load_study(args.study)
-    out = Path(args.out)
+    out = check_output_path(args.out, what="--out", kind="dir")
     store = out / f"{study.name}.jsonl"
     try:
         res = run_sweep(study, store=store, workers=args.workers, scheduler=args.scheduler,
-                        progress=not args.no_progress, retry_failed=args.retry_failed,
+                        progress=not args.no_progress, retry_failed=not args.keep_failed,
                         max_points=args.max_points)
-    except KeyboardInterrupt:
-        print(f"\ninterrupted: finished points are in {store}; run the same command again "
-              "to resume", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
+        _log.warning("%s: the worker processes are stopped and the finished points are in "
+                     "%s; run the same command again to resume", what, store)
+        return 143 if isinstance(exc, Terminated) else 130
     rows = sweep_table(study, store)
     files = write_table(rows, out / study.name) if rows else []
     if rows and not args.no_plot:
@@ -91,6 +106,10 @@ def run(args) -> int:
               "worker start-up)")
         for f in [store, *files]:
             print(f"  {f}")
+        if res.n_failed:
+            print(f"  {res.n_failed} point(s) failed (their error is in the 'error' column); "
+                  "running the same command again computes them again"
+                  + (" (without --keep-failed)" if args.keep_failed else ""))
         if res.n_left:
             print("  run the same command again to resume")
-    return 0 if res.n_left == 0 else 1
+    return 0 if res.n_left == 0 and res.n_failed == 0 else 1

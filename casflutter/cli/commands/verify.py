@@ -4,15 +4,22 @@ Prints the :class:`casflutter.verify.VerificationReport` (or its JSON with ``--j
 closed-loop poles, exact H∞ norm and peak frequency, and for an LFT in ΔV (``--vf``,
 ``--n-delta`` or the plant file's ``Vf``/``n_delta``) the small-gain and the exact
 speed-index intervals (Lum et al. 2016, eq. 10-16).
+
+The verdict is the exit code: 0 when the nominal closed loop is stable and, with
+``--require-v LO HI``, stays stable over that whole speed-index range (the exact interval
+covers it); 1 otherwise, the last line (``verdict`` in the JSON) saying which check failed.
+The JSON is strict: a non-finite number (the γ of an unstable loop, an unbounded interval
+end) is ``null``.
 """
 
 from __future__ import annotations
 
 import json
+import math
 
 from ...errors import ConfigError
 
-__all__ = ["register", "run"]
+__all__ = ["register", "run", "verdict"]
 
 
 def register(subparsers) -> None:
@@ -36,12 +43,73 @@ def register(subparsers) -> None:
                    help="size of the ΔV channel (first inputs/outputs); default from the file")
     p.add_argument("--method", choices=("auto", "slycot", "scipy"), default="auto",
                    help="H-inf norm implementation (default: slycot if installed)")
+    p.add_argument("--require-v", nargs=2, type=float, default=None, metavar=("LO", "HI"),
+                   dest="require_v",
+                   help="speed-index range over which the loop must stay stable (exact "
+                        "interval, eq. 10-15); not covered -> exit code 1")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(func=run)
 
 
+def verdict(report, require_v=None) -> dict:
+    """The pass/fail verdict of a :class:`~casflutter.verify.VerificationReport`.
+
+    Parameters
+    ----------
+    report : VerificationReport
+    require_v : (float, float), optional
+        Speed-index range that the exact stability interval must cover (robustness).
+
+    Returns
+    -------
+    dict
+        ``stable``; ``required_V``; ``robust`` (``None`` without ``require_v``: not asked)
+        and ``small_gain_covers`` (whether the paper's small-gain interval alone certifies
+        the range); ``passed``; ``reason`` (one sentence).
+    """
+    out = {"stable": bool(report.stable), "required_V": None, "robust": None,
+           "small_gain_covers": None}
+    if require_v is not None:
+        lo, hi = (float(x) for x in require_v)
+        out["required_V"] = [lo, hi]
+        ex = report.exact_V
+        out["robust"] = bool(report.stable and ex is not None
+                             and (ex[0] < lo or ex[0] == 0.0) and hi < ex[1])
+        sg = report.small_gain_V
+        out["small_gain_covers"] = bool(report.stable and sg is not None
+                                        and (sg[0] < lo or sg[0] == 0.0) and hi < sg[1])
+    if not report.stable:
+        reason = (f"not stable: the nominal closed loop has a pole with real part "
+                  f"{report.spectral_abscissa:.6g} >= 0")
+    elif out["robust"] is False:
+        ex = report.exact_V
+        reason = (f"not robust: stable only for V in ({ex[0]:.6g}, {ex[1]:.6g}), which does "
+                  f"not cover the required [{out['required_V'][0]:.6g}, "
+                  f"{out['required_V'][1]:.6g}]")
+    elif out["robust"]:
+        reason = (f"stable, and robust over V in [{out['required_V'][0]:.6g}, "
+                  f"{out['required_V'][1]:.6g}]")
+    else:
+        reason = "stable (no speed range required: pass --require-v LO HI to check one)"
+    out["passed"] = bool(report.stable and out["robust"] is not False)
+    out["reason"] = reason
+    return out
+
+
+def _strict(obj):
+    """Non-finite floats to None, recursively (strict JSON)."""
+    if isinstance(obj, dict):
+        return {k: _strict(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_strict(v) for v in obj]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
 def run(args) -> int:
-    """Handler of ``casflutter verify``."""
+    """Handler of ``casflutter verify``: 0 when the verdict passes, 1 when the loop is not
+    stable or not robust over ``--require-v``."""
     from ...verify import load_controller, load_plant, verify_controller
 
     plant = load_plant(args.plant)
@@ -57,10 +125,23 @@ def run(args) -> int:
         if Vf is not None or n_delta is not None:
             raise ConfigError("the ΔV intervals need both Vf and n_delta: pass --vf and "
                               "--n-delta (or put Vf and n_delta in the plant file)")
+    if Vf is not None and not (math.isfinite(Vf) and Vf >= 0):
+        raise ConfigError(f"--vf {Vf!r}: the nominal speed index must be a finite number >= 0")
+    if args.require_v is not None:
+        lo, hi = args.require_v
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo <= hi):
+            raise ConfigError(f"--require-v {lo!r} {hi!r}: give two finite speed indices "
+                              "0 <= LO <= HI")
+        if Vf is None:
+            raise ConfigError("--require-v needs the ΔV channel: pass --vf and --n-delta (or "
+                              "put Vf and n_delta in the plant file)")
     report = verify_controller(plant.sys, K, nmeas, ncon, Vf=Vf, n_delta=n_delta,
                                method=args.method)
+    v = verdict(report, args.require_v)
     if args.json:
-        print(json.dumps(report.to_dict(), indent=1))
+        doc = _strict({**report.to_dict(), "verdict": v})
+        print(json.dumps(doc, indent=1, allow_nan=False))
     else:
         print(report.format())
-    return 0
+        print(f"  verdict: {'PASSED' if v['passed'] else 'FAILED'}, {v['reason']}")
+    return 0 if v["passed"] else 1

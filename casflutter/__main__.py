@@ -1,0 +1,7 @@
+"""``python -m casflutter``: the ``casflutter`` command."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())
