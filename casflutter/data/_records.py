@@ -152,10 +152,14 @@ class IOData:
     Parameters
     ----------
     records : sequence of Record
+        The records; all share the channel counts.
     dt : float
         Sampling time [s].
     output_names, u_names : tuple of str, optional
+        Names of the outputs ``y`` (generalised forces) and of the inputs ``u`` (modal
+        displacements); default ``y1, y2, ...`` and ``u1, u2, ...``.
     v_name : str, optional
+        Name of the flap input ``v``.
 
     Examples
     --------
