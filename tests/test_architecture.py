@@ -16,9 +16,10 @@ ROOT = Path(__file__).resolve().parents[1] / "casflutter"
 
 #: the stages, left to right; a module may import its own stage and those to its left
 LAYERS = ["structure", "data", "truth", "ident", "realize", "aeroelastic", "lco", "design",
-          "verify", "report", "pipeline", "study", "cli"]
+          "verify", "report", "pipeline", "study", "cli", "__main__"]
 #: helpers every stage may use
-INFRASTRUCTURE = {"errors", "_nlp", "_resources", "_settings", "_linalg", "__init__"}
+INFRASTRUCTURE = {"errors", "_nlp", "_resources", "_settings", "_linalg", "_logging", "_outputs",
+                  "_interrupt", "__init__"}
 #: known exceptions: design/ still calls verify/ for its exact norms (the synthesis issue
 #: removes it; design must not share code with the verification)
 KNOWN = {("design", "verify")}
