@@ -19,6 +19,7 @@ fast)::
     fl = cf.find_flutter(system, (0.3, 2.5))
     lco = cf.simulate_loop(result.model, system.structure, 1.05 * fl.Vf, 5000,
                            xs0=system.structure.displaced_state(fl.flutter_mode, 0.01))
+    branch = cf.lco_branch(truth)           # the truth's LCO branch from its Hopf point
     lft = cf.build_lft(system, fl.Vf)
     syn = cf.synthesize(lft.plant_without_d22(), lft.nmeas, lft.ncon, 3)
     rep = cf.verify_controller(lft.P, lft.physical_controller(syn.controller), lft.nmeas,
@@ -29,7 +30,7 @@ or the whole study from a configuration: ``cf.run(cf.load_config())``.
 
 from __future__ import annotations
 
-import importlib
+import importlib as _importlib
 
 from . import _logging  # noqa: F401 - the package logger's NullHandler
 from .errors import (CasflutterError, ConfigError, ConvergenceError, DataError,  # noqa: F401
@@ -60,6 +61,7 @@ _LAZY = {
     "find_flutter": "aeroelastic", "FlutterResult": "aeroelastic",
     "track_eigenvalues": "aeroelastic", "simulate_loop": "aeroelastic",
     "build_lft": "aeroelastic", "AeroelasticLFT": "aeroelastic",
+    "lco_branch": "lco", "rom_lco_branch": "lco", "LCOBranch": "lco", "LCOSettings": "lco",
     # synthesis and verification
     "synthesize": "design", "SynthesisOptions": "design", "SynthesisResult": "design",
     "verify_controller": "verify", "VerificationReport": "verify", "speed_sweep": "verify",
@@ -74,11 +76,11 @@ __all__ = ["CasflutterError", "ConfigError", "ConvergenceError", "DataError", "D
 
 def __getattr__(name: str):
     if name in _LAZY:
-        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        value = getattr(_importlib.import_module(f".{_LAZY[name]}", __name__), name)
         globals()[name] = value
         return value
     raise AttributeError(f"module 'casflutter' has no attribute {name!r}")
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+    return sorted(set(__all__) | {"errors"})

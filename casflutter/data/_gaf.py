@@ -45,9 +45,10 @@ from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import make_interp_spline
-from scipy.io import loadmat, savemat
+from scipy.io import savemat
 
 from ..errors import DataError
+from ._matfile import read_mat
 
 __all__ = ["GAFTable", "load_gaf"]
 
@@ -473,10 +474,7 @@ class GAFTable:
     def from_mat(cls, path) -> "GAFTable":
         """Read the MATLAB layout (module docstring; ``Q`` is ``N x M x nk``)."""
         path = Path(path)
-        try:
-            mat = loadmat(path)
-        except (OSError, ValueError, NotImplementedError) as exc:
-            raise DataError(f"{path}: cannot read as a .mat file ({exc})") from None
+        mat = read_mat(path)
         keys = sorted(k for k in mat if not k.startswith("__"))
         for name in ("k", "Q", "b"):
             if name not in mat:

@@ -17,6 +17,7 @@ from typing import Sequence
 import numpy as np
 
 from ..errors import DataError
+from ._matfile import read_mat
 
 __all__ = ["Record", "IOData"]
 
@@ -152,10 +153,14 @@ class IOData:
     Parameters
     ----------
     records : sequence of Record
+        The records; all share the channel counts.
     dt : float
         Sampling time [s].
     output_names, u_names : tuple of str, optional
+        Names of the outputs ``y`` (generalised forces) and of the inputs ``u`` (modal
+        displacements); default ``y1, y2, ...`` and ``u1, u2, ...``.
     v_name : str, optional
+        Name of the flap input ``v``.
 
     Examples
     --------
@@ -394,7 +399,7 @@ class IOData:
             that :class:`Record` refuses.
         """
         path = _input_file(path, ".mat")
-        mat = _read_mat(path)
+        mat = read_mat(path)
         variables = sorted(k for k in mat if not k.startswith("__"))
         if not variables:
             raise DataError(f"{path}: the MAT-file holds no variables; save y, u/v and the "
@@ -559,30 +564,6 @@ def _read_npz(path: Path) -> dict[str, np.ndarray]:
                         f"{exc}); the file may be truncated or corrupt -- write it again "
                         "with np.savez") from None
     return arrays
-
-
-def _read_mat(path: Path) -> dict:
-    """``scipy.io.loadmat`` of ``path``, or a DataError that says what the file is."""
-    from scipy.io import loadmat
-
-    with open(path, "rb") as fh:
-        head = fh.read(128)
-    if not head:
-        raise DataError(f"{path}: empty file (0 bytes); save the variables from MATLAB with "
-                        "save(file, ..., '-v7')")
-    if len(head) == 128 and head[124:128] in (b"\x00\x02IM", b"\x02\x00MI"):
-        raise DataError(f"{path}: a MATLAB v7.3 (HDF5) file, which scipy cannot read; save it "
-                        "again with save(file, ..., '-v7'), or read it with h5py and call "
-                        "IOData.from_arrays")
-    try:
-        return loadmat(path)
-    except NotImplementedError as exc:  # v7.3 detected by scipy
-        raise DataError(f"{path}: a MATLAB v7.3 (HDF5) file, which scipy cannot read ({exc}); "
-                        "save it again with save(file, ..., '-v7')") from None
-    except Exception as exc:  # noqa: BLE001 - any failure to parse the file is bad data
-        raise DataError(f"{path}: cannot be read as a MAT-file ({type(exc).__name__}: {exc}); "
-                        "the file may be truncated or not a MAT-file -- save it again from "
-                        "MATLAB with save(file, ..., '-v7')") from None
 
 
 def _mat_matrix(path: Path, name: str, value) -> np.ndarray:

@@ -212,8 +212,30 @@ def fit_report(model: HWLModel, data: IOData, mode: str = "simulation",
                skip: int | None = None) -> FitReport:
     """Score ``model`` on ``data`` by free-run simulation or mu-step prediction.
 
-    Simulation starts from the measured first ``max_lag`` outputs of each record; scores
-    exclude the first ``skip`` samples (default ``max_lag``).
+    Simulation (eq. 3 with the model's own past outputs fed back) starts from the measured
+    first ``max_lag`` outputs of each record; prediction feeds the measured outputs back
+    (the mu-step predictor of eq. 4).
+
+    Parameters
+    ----------
+    model : HWLModel
+        The identified model.
+    data : IOData
+        Records to score it on (the same channels as the model).
+    mode : {"simulation", "prediction"}
+        Free run or mu-step prediction.
+    skip : int, optional
+        Samples excluded at the start of each record (default and minimum ``max_lag``).
+
+    Returns
+    -------
+    FitReport
+        Per-output error percentage (the paper's Fig. 7), NRMSE and RMS error.
+
+    Raises
+    ------
+    ConfigError
+        ``mode`` is neither ``"simulation"`` nor ``"prediction"``.
     """
     if mode not in ("simulation", "prediction"):
         raise ConfigError(f"fit_report mode={mode!r} is not allowed: use 'simulation' or "
@@ -438,6 +460,8 @@ def identify(data: IOData, orders=(3, 1, 1, 1, 2, 2), *,
     orders : tuple, str or HWLOrders
         ``(mu, na, nb, r, p, q)``; the paper uses ``(3, 1, 1, 1, 2, 2)``.
     settings : IdentificationSettings, optional
+        Stage settings (criterion, regularisation, solver, budgets); ``**kwargs`` override
+        its fields.
     initial : HWLModel or array, optional
         Starting model (physical units) of the same structure; skips stage 1.
     **kwargs

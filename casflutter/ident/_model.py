@@ -448,6 +448,7 @@ class HWLModel:
             Modal displacements.  For a model whose only input is the flap, the first
             positional argument is taken as ``v`` (``model.simulate(v)``).
         v : array (K,), optional
+            Flap deflection (for a model with the flap input).
         y0 : array (K0 >= max_lag, N), optional
             Initial outputs for the first ``max_lag`` samples (zeros when omitted).
         n_samples : int, optional

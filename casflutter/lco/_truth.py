@@ -219,6 +219,7 @@ def lco_branch(truth, vrange=None, settings: LCOSettings | None = None,
         Speed-index range (default: the ``[lco] vrange`` of the problem definition when it
         has one, else ``[rom] V_range``); the rig sections' speed index is the airspeed.
     settings : LCOSettings, optional
+        Collocation mesh, continuation step and budget (defaults: ``LCOSettings()``).
     problem : str, optional
         Label (default the truth's name).
 

@@ -361,7 +361,13 @@ class RunResult:
             "controller": self._controller_summary(),
             "suppression": None if self.suppression is None else {
                 "attenuation_percent": self.suppression.attenuation_percent,
-                "lco_returns": self.suppression.lco_returns, "V": self.suppression.V},
+                "lco_returns": self.suppression.lco_returns, "V": self.suppression.V,
+                "open_loop_amplitude": list(self.suppression.open_loop_amplitude),
+                "closed_loop_amplitude": list(self.suppression.closed_loop_amplitude),
+                "dominant_sensor": self.suppression.dominant_sensor,
+                "started_from_lco": self.suppression.started_from_lco,
+                "flap_limit": cfg.suppression.flap_limit,
+                "flap_rate_limit": cfg.suppression.flap_rate_limit},
             "timings_s": dict(self.timings),
             "seed": cfg.seed,
         }

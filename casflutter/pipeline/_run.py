@@ -248,10 +248,24 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
             # the truth flutters at its own speed: suppress its LCO there (paper Fig. 11 was
             # measured on the real wing at an LCO condition)
             V_ref = flutter_truth.Vf if flutter_truth.flutter is not None else Vf
+            V_run = float(V_ref) * cfg.suppression.speed_factor
+            established = out.get("lco")
+            if established is None or abs(established.truth.V - V_run) > 1e-9 * V_run:
+                # the LCO stage did not run at this speed: let the truth's LCO converge here
+                established = truth_lco(truth, V_run, cfg.lco.duration, crit,
+                                        cfg.lco.initial_deflection, dt=model.dt,
+                                        sensor_rows=rows, sensor=cfg.sensors.kind)
+                tr = established
+            else:
+                tr = established.truth
+            x0 = tr.final_state if tr.kind == "lco" else None
+            if x0 is None:
+                prog.note(f"the truth has no LCO at V = {V_run:.4f} ({tr.kind}): the "
+                          "suppression run starts from a deflected mode")
             out["suppression"] = suppression_run(
                 truth, out["controller"], float(V_ref), cfg.suppression, dt=model.dt,
                 mode=crit, deflection=cfg.lco.initial_deflection, sensor_rows=rows,
-                sensor=cfg.sensors.kind)
+                sensor=cfg.sensors.kind, x0=x0)
     timings = dict(prog.timings)
     timings["total"] = time.perf_counter() - prog.t0
     result = RunResult(**out, timings=timings)

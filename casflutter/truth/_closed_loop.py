@@ -85,7 +85,8 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
                       actuator_omega: float = 2 * np.pi * 40.0, actuator_zeta: float = 0.7,
                       substeps: int = 4, sensor: str = "acceleration",
                       kick: tuple[float, int, float] | None = None,
-                      sensor_rows=None) -> TruthLoopSimulation:
+                      sensor_rows=None, flap_limit: float | None = None,
+                      flap_rate_limit: float | None = None) -> TruthLoopSimulation:
     """Sampled-data closed loop of the nonlinear truth with the controller ``K``.
 
     At every sample ``t_k`` the sensors are read, the controller (ZOH discretisation at the
@@ -93,6 +94,11 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     ``t_{k+1}``; the flap follows a second-order actuator (our choice, the paper gives none),
     which supplies the flap rate and acceleration the aerodynamics need.  The truth is
     integrated by classical Runge--Kutta with ``substeps`` steps per sample.
+
+    A real flap servo saturates: with ``flap_limit`` the command is clipped to
+    ``±flap_limit`` and the actuator stops at that angle; with ``flap_rate_limit`` the
+    actuator's rate stops growing at ``±flap_rate_limit`` (its acceleration is cut while the
+    rate is at the limit and pushing outwards, and the rate is clipped after every step).
 
     Parameters
     ----------
@@ -121,14 +127,29 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
         from a quiet wing.
     sensor_rows : array_like, shape (n_sensors, N), optional
         ``Hs`` (default: the truth's own).
+    flap_limit : float, optional
+        Largest flap angle (the truth's flap unit, rad for the seed wing); no limit when
+        omitted.
+    flap_rate_limit : float, optional
+        Largest flap rate [flap unit per time unit]; no limit when omitted.
 
     Returns
     -------
     TruthLoopSimulation
         Stopped (NaN from there on) when the state blows up.
+
+    Raises
+    ------
+    ConfigError
+        An unknown ``sensor`` or a non-positive limit.
     """
     if sensor not in ("acceleration", "displacement"):
         raise ConfigError(f"sensor={sensor!r}: use 'acceleration' or 'displacement'")
+    for name, value in (("flap_limit", flap_limit), ("flap_rate_limit", flap_rate_limit)):
+        if value is not None and not (np.isfinite(value) and value > 0):
+            raise ConfigError(f"{name} = {value!r}: give a positive limit, or None for none")
+    pos_max = np.inf if flap_limit is None else float(flap_limit)
+    rate_max = np.inf if flap_rate_limit is None else float(flap_rate_limit)
     t = np.asarray(timepts, dtype=float)
     dt = float(t[1] - t[0])
     f = truth.flap_dynamics(V)
@@ -150,8 +171,16 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     Vf = np.zeros(n)
     G = np.zeros(n)
 
-    def deriv(s_, xa_, vc):
+    def servo_acceleration(xa_, vc):
         vdd = wa2 * (vc - xa_[0]) - ca * xa_[1]
+        if abs(xa_[1]) >= rate_max and vdd * xa_[1] > 0:
+            vdd = 0.0  # the servo runs at its rate limit
+        if abs(xa_[0]) >= pos_max and xa_[0] * vdd > 0:
+            vdd = 0.0  # on the end stop
+        return vdd
+
+    def deriv(s_, xa_, vc):
+        vdd = servo_acceleration(xa_, vc)
         ds, _ = f(s_, xa_[0], xa_[1], vdd)
         return ds, np.array([xa_[1], vdd])
 
@@ -161,13 +190,14 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
         if not kicked and t[k] >= kick[0]:
             s[:2 * N] += truth.displaced_state(kick[1], kick[2])
             kicked = True
-        vdd_now = wa2 * (vc - xa[0]) - ca * xa[1]
+        vdd_now = servo_acceleration(xa, vc)
         _, acc = f(s, xa[0], xa[1], vdd_now)
         zm = Hs @ (acc if sensor == "acceleration" else s[:Hs.shape[1]])
         if not np.all(np.isfinite(zm)) or np.abs(s).max() > 1e6:
             break
         ZM[k], Vf[k], G[k] = zm, xa[0], gain(t[k])
         vc = G[k] * float((Ck @ xk + Dk @ zm)[0]) if nk else G[k] * float((Dk @ zm)[0])
+        vc = float(np.clip(vc, -pos_max, pos_max))
         if nk:
             xk = Ak @ xk + Bk @ zm
         if k == n - 1:
@@ -179,6 +209,9 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
             k4s, k4a = deriv(s + h * k3s, xa + h * k3a, vc)
             s = s + h / 6 * (k1s + 2 * k2s + 2 * k3s + k4s)
             xa = xa + h / 6 * (k1a + 2 * k2a + 2 * k3a + k4a)
+            xa[1] = float(np.clip(xa[1], -rate_max, rate_max))
+            if abs(xa[0]) > pos_max:  # the end stop
+                xa[0], xa[1] = float(np.sign(xa[0]) * pos_max), 0.0
     return TruthLoopSimulation(t, ZM, Vf, G)
 
 
@@ -197,12 +230,23 @@ class SuppressionSettings:
     """Full gain."""
     release: float = 10.0
     """Open loop again, after a tap on the wing: the LCO returns."""
+    flap_limit: float | None = None
+    """Largest flap angle of the servo (the truth's flap unit; ``None``: no limit)."""
+    flap_rate_limit: float | None = None
+    """Largest flap rate of the servo (flap unit per time unit; ``None``: no limit)."""
 
     def __post_init__(self):
         for name in ("speed_factor", "settle", "ramp", "hold", "release"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
                 raise ConfigError(f"{name} = {value!r}: must be > 0")
+        for name in ("flap_limit", "flap_rate_limit"):
+            value = getattr(self, name)
+            if value is not None and (isinstance(value, bool)
+                                      or not isinstance(value, (int, float))
+                                      or not (np.isfinite(value) and value > 0)):
+                raise ConfigError(f"{name} = {value!r}: a positive number (or leave it out "
+                                  "for no limit)")
 
 
 @dataclass(frozen=True)
@@ -223,6 +267,14 @@ class SuppressionResult:
         release.
     lco_returns : bool
         After the release the dominant sensor climbs back above half its open-loop RMS.
+    open_loop_amplitude : tuple of float
+        Peak ``|zm|`` per sensor over the last third of the settling phase, just before the
+        ramp: the amplitude of the LCO the controller is switched on against.
+    closed_loop_amplitude : tuple of float
+        Peak ``|zm|`` per sensor over the last third of the hold.
+    started_from_lco : bool
+        Whether the run started from a given (established) LCO state rather than from a
+        deflected mode.
     dominant_sensor : int
         The sensor with the largest open-loop RMS.
     """
@@ -235,13 +287,21 @@ class SuppressionResult:
     released_rms: tuple
     lco_returns: bool
     dominant_sensor: int
+    open_loop_amplitude: tuple = ()
+    closed_loop_amplitude: tuple = ()
+    started_from_lco: bool = False
 
 
 def suppression_run(truth, K: control.StateSpace, V_flutter: float,
                     settings: SuppressionSettings | None = None, *, dt: float, mode: int,
                     deflection: float, sensor_rows=None,
-                    sensor: str = "acceleration") -> SuppressionResult:
+                    sensor: str = "acceleration", x0=None) -> SuppressionResult:
     """Paper Fig. 11 on the truth: the LCO develops, the gain ramps 0 -> 1, holds, is released.
+
+    Started from ``x0``, the end state of a simulation in which the truth's LCO has
+    converged (:attr:`TruthLco.final_state`), the controller is switched on against the
+    established LCO, as in the wind tunnel; without it the run starts from a deflected mode
+    and the LCO must develop during ``settle``.
 
     The attenuation compares the RMS of the dominant sensor over the last third of the
     hold with its RMS over the last third of the settling phase (open-loop LCO);
@@ -268,6 +328,8 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
         Sensor rows ``Hs`` (default: the truth's own).
     sensor : {"acceleration", "displacement"}
         What the sensors read (:func:`closed_loop_truth`).
+    x0 : array_like, optional
+        Full truth state to start from (an established LCO at this speed).
 
     Returns
     -------
@@ -284,9 +346,11 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
     t = np.arange(0.0, T, dt)
     g = gain_schedule(sp.settle, sp.ramp, sp.hold)
     t_release = sp.settle + sp.ramp + sp.hold
-    sim = closed_loop_truth(truth, K, V, t, truth.displaced_state(mode, deflection), g,
+    start = truth.displaced_state(mode, deflection) if x0 is None else x0
+    sim = closed_loop_truth(truth, K, V, t, start, g,
                             kick=(t_release, mode, deflection), sensor_rows=sensor_rows,
-                            sensor=sensor)
+                            sensor=sensor, flap_limit=sp.flap_limit,
+                            flap_rate_limit=sp.flap_rate_limit)
     zm = sim.zm
     if not np.all(np.isfinite(zm)):
         raise CasflutterError(f"the closed-loop truth simulation at V = {V:.4f} blew up")
@@ -294,6 +358,10 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
     def rms(a, b):
         sel = (t >= a) & (t < b)
         return np.sqrt(np.mean(zm[sel] ** 2, axis=0))
+
+    def peak(a, b):
+        sel = (t >= a) & (t < b)
+        return np.max(np.abs(zm[sel]), axis=0)
 
     open_rms = rms(sp.settle * 2 / 3, sp.settle)
     dom = int(np.argmax(open_rms))
@@ -307,7 +375,12 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
                              closed_loop_rms=tuple(map(float, closed_rms)),
                              released_rms=tuple(map(float, after)),
                              lco_returns=bool(after[dom] > 0.5 * open_rms[dom]),
-                             dominant_sensor=dom)
+                             dominant_sensor=dom,
+                             open_loop_amplitude=tuple(map(float, peak(sp.settle * 2 / 3,
+                                                                       sp.settle))),
+                             closed_loop_amplitude=tuple(map(float, peak(
+                                 t_full + sp.hold * 2 / 3, t_full + sp.hold))),
+                             started_from_lco=x0 is not None)
 
 
 def truth_loop_matrix(truth, K: control.StateSpace, V: float, *, actuator_omega: float,

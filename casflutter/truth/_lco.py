@@ -34,6 +34,9 @@ class TruthLco:
         Of the sensors.
     t_start : float
         Where the returned history begins in the simulation.
+    final_state : ndarray or None
+        The truth's full state at the end (on the LCO when ``kind == "lco"``): where a
+        suppression run starts from the established LCO.
     """
 
     V: float
@@ -44,6 +47,7 @@ class TruthLco:
     zm: np.ndarray
     analysis: ResponseAnalysis
     t_start: float
+    final_state: np.ndarray | None = None
 
 
 def truth_lco(truth, V: float, duration: float, mode: int, deflection: float, *,
@@ -99,4 +103,4 @@ def truth_lco(truth, V: float, duration: float, mode: int, deflection: float, *,
     an = analyze_response(t, zm)
     return TruthLco(V=float(V), kind=an.kind, freq_hz=float(an.frequency_hz),
                     amplitude=tuple(float(a) for a in an.amplitude), timepts=t, zm=zm,
-                    analysis=an, t_start=t_start)
+                    analysis=an, t_start=t_start, final_state=np.array(sim.states[-1]))

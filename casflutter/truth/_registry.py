@@ -35,7 +35,13 @@ FILE_KINDS: dict[str, type[AeroelasticTruth]] = {PITCH_PLUNGE_KIND: PitchPlungeS
 
 
 def problem_names() -> list[str]:
-    """Names of the problems that have a truth simulator."""
+    """List the built-in problems that have a truth simulator.
+
+    Returns
+    -------
+    list of str
+        The names :func:`load_problem` accepts besides a problem file's path.
+    """
     return list(PROBLEMS)
 
 

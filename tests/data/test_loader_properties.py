@@ -9,6 +9,8 @@ is deterministic.
 from __future__ import annotations
 
 import io
+import subprocess
+import sys
 import tempfile
 from pathlib import Path
 
@@ -187,3 +189,39 @@ _CELL = st.one_of(st.floats(allow_nan=True, allow_infinity=True).map(repr),
 def test_csv_of_random_tables(header, rows):
     text = ",".join(header) + "\n" + "".join(",".join(r) + "\n" for r in rows)
     _only_ours("csv", text.encode())
+
+
+# ------------------------------------------------ MAT v5 layouts that crash scipy's parser
+
+def _fs_file() -> bytes:
+    buf = io.BytesIO()
+    scipy.io.savemat(buf, {"y": np.ones((30, 2)), "u": np.ones((30, 2)), "Fs": 100.0})
+    return buf.getvalue()
+
+
+def _flip(blob: bytes, where: int, value: int) -> bytes:
+    b = bytearray(blob)
+    b[where] = value
+    return bytes(b)
+
+
+@pytest.mark.parametrize("case", ["small element claims 171 bytes", "complex flag, no imaginary"])
+def test_layouts_that_crash_scipy_are_refused_in_a_subprocess(tmp_path, case):
+    """One-byte corruptions of a valid file that scipy's compiled MAT v5 parser trusts: the
+    type word of Fs's data tag turned into a 171-byte "small" element (scipy.io.loadmat 1.17
+    dies with SIGSEGV on it), and the complex bit set in Fs's array flags with no imaginary
+    part (scipy reads past the variable; with other flips beside it, the fuzz runs crashed).
+    The layout check refuses both with a DataError; run in a child process so that a
+    regression crashes the child, not the test run."""
+    blob = _fs_file()
+    end = len(blob)  # Fs is the last variable: flags at end-48, its data tag at end-16
+    bad = _flip(blob, end - 15, 171) if case.startswith("small") else _flip(blob, end - 47, 0x08)
+    path = tmp_path / "bad.mat"
+    path.write_bytes(bad)
+    code = ("import sys\nfrom casflutter.data import IOData\nfrom casflutter.errors import "
+            "DataError\ntry:\n    IOData.from_mat(sys.argv[1], y='y', u='u')\n"
+            "except DataError as e:\n    print('DataError:', e)\n")
+    proc = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True,
+                          text=True, timeout=120)
+    assert proc.returncode == 0, (proc.returncode, proc.stderr[-500:])
+    assert "DataError:" in proc.stdout and "corrupt MAT v5 layout" in proc.stdout

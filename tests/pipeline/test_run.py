@@ -20,7 +20,7 @@ regularization = 1e-6
 [flutter]
 n_grid = 61
 [lco]
-duration = 3.0
+duration = 6.0
 [controller]
 order = 2
 starts = 1
@@ -54,6 +54,14 @@ def test_summary_keys_and_table_i_structure(reduced):
     assert s["orders"] == [3, 1, 1, 1, 2, 2] and s["n_params"] == 230
     assert (s["nf"], s["ns"], s["nae"]) == (15, 10, 25)
     assert s["flutter"]["mode"] == 2              # the lateral branch (paper Fig. 10)
+    # the suppression run starts from the truth's established LCO of the [lco] stage (same
+    # speed): the amplitude it is switched on against is that LCO's (peak vs half
+    # peak-to-peak: 5 %)
+    sup, lco = s["suppression"], s["lco"]
+    assert lco["truth_kind"] == "lco" and sup["started_from_lco"]
+    assert sup["V"] == pytest.approx(lco["truth_V"], rel=1e-12)
+    dom = sup["dominant_sensor"]
+    assert sup["open_loop_amplitude"][dom] == pytest.approx(lco["truth_amplitude"][dom], rel=0.05)
     assert set(s["controller"]) >= {"order", "gamma", "small_gain_V", "stable_V"}
     assert s["timings_s"]["total"] >= sum(v for k, v in s["timings_s"].items() if k != "total") - 1e-6
     for name in ("summary.json", "rom.npz", "controller.json", "controller.mat", "report.html",
