@@ -18,11 +18,11 @@ ROOT = Path(__file__).resolve().parents[1] / "casflutter"
 LAYERS = ["structure", "data", "truth", "ident", "realize", "aeroelastic", "lco", "design",
           "verify", "report", "pipeline", "study", "cli", "__main__"]
 #: helpers every stage may use
-INFRASTRUCTURE = {"errors", "_nlp", "_resources", "_settings", "_linalg", "_logging", "_outputs",
-                  "_interrupt", "__init__"}
-#: known exceptions: design/ still calls verify/ for its exact norms (the synthesis issue
-#: removes it; design must not share code with the verification)
-KNOWN = {("design", "verify")}
+INFRASTRUCTURE = {"errors", "_nlp", "_resources", "_settings", "_linalg", "_threads", "_logging",
+                  "_outputs", "_interrupt", "__init__"}
+#: known exceptions (none: design/ computes its own norms and never imports verify/, the
+#: layer that must share no code with the optimiser)
+KNOWN: set = set()
 
 
 def _modules():

@@ -31,6 +31,7 @@ import traceback
 from .. import __version__
 from .._interrupt import Terminated, sigterm_raises
 from .._logging import PACKAGE_LOGGER, configure_cli_logging, remove_cli_logging
+from .._threads import single_threaded
 from ..errors import CasflutterError
 
 __all__ = ["main", "build_parser", "EXIT_ERROR", "EXIT_INTERRUPTED", "EXIT_TERMINATED",
@@ -131,7 +132,9 @@ def main(argv: list[str] | None = None) -> int:
     handler = configure_cli_logging(quiet=quiet, verbose=bool(getattr(args, "verbose", False)),
                                     debug=debug)
     try:
-        with sigterm_raises():
+        # one BLAS thread: the same seed gives bit-identical numbers however the process was
+        # launched (make demo pins the pools through the environment, a bare shell does not)
+        with sigterm_raises(), single_threaded():
             code = int(args.func(args) or 0)
         sys.stdout.flush()  # a broken pipe shows here, not at interpreter exit
         return code

@@ -1,13 +1,18 @@
-"""Fixed-order robust H∞ synthesis (paper §III.C) as a sequence of CasADi/Ipopt NLPs.
+"""Fixed-order robust H∞ synthesis (paper §III.C) and flutter suppression over a speed interval.
 
 Public names: :func:`synthesize` with :class:`SynthesisOptions`, :class:`SynthesisResult`,
-:class:`StartRecord`; :func:`load_compleib` for the benchmark plants; :func:`partition`,
-:class:`Partition`; :func:`verify_closed_loop` for an independent check of a controller.
+:class:`StartRecord`; :func:`design_flutter_controller` with :class:`FlutterDesign` (the
+LFT at Vf plus stability of ΣAE(V) over an interval, eq. 8-16); :func:`load_compleib` for
+the benchmark plants; :func:`partition`, :class:`Partition`; :func:`hinf_norm` /
+:func:`exact_hinf_norm` (the synthesis' own Hamiltonian norm) and :func:`verify_closed_loop`.
 """
 
+from ._flutter import FlutterDesign, design_flutter_controller, loop_abscissa
+from ._norm import hinf_norm
 from ._plant import Partition, exact_hinf_norm, load_compleib, partition
 from ._synthesis import (StartRecord, SynthesisOptions, SynthesisResult, synthesize,
                          verify_closed_loop)
 
-__all__ = ["synthesize", "SynthesisOptions", "SynthesisResult", "StartRecord", "load_compleib",
-           "partition", "Partition", "exact_hinf_norm", "verify_closed_loop"]
+__all__ = ["synthesize", "SynthesisOptions", "SynthesisResult", "StartRecord",
+           "design_flutter_controller", "FlutterDesign", "loop_abscissa", "load_compleib",
+           "partition", "Partition", "exact_hinf_norm", "hinf_norm", "verify_closed_loop"]

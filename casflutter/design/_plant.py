@@ -7,7 +7,9 @@ A generalised plant ``P`` (python-control's ``hinfsyn`` convention) has inputs
     z    = C1 x + D11 w + D12 u
     y    = C2 x + D21 w + D22 u
 
-A controller of order ``k``, ``xk' = Ak xk + Bk y``, ``u = Ck xk + Dk y``, is a *static*
+``D22`` may be non-zero (accelerometers that see the flap directly, eq. 14 with the
+feed-through of :mod:`casflutter.aeroelastic`): the loop ``u = Kbar y`` is then closed
+exactly through ``K~ = (I - Kbar D22)⁻¹ Kbar``.  A controller of order ``k``, ``xk' = Ak xk + Bk y``, ``u = Ck xk + Dk y``, is a *static*
 gain ``Kbar = [[Dk, Ck], [Bk, Ak]]`` on the augmented plant whose extra input is
 ``xk'`` and whose extra output is ``xk``; this is how every controller order is handled
 by the same code (paper §III.C, the loop of eq. 14 closed by ``K(s)``).
@@ -18,25 +20,26 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any, Sequence
 
 import control
 import numpy as np
 import scipy.linalg as sla
 
 from ..errors import DataError, DimensionError
+from ._norm import hinf_norm
 
 __all__ = ["Partition", "partition", "load_compleib", "exact_hinf_norm", "spectral_abscissa"]
 
 
 @dataclass(frozen=True)
 class Partition:
-    """The blocks of one generalised plant (``D22`` must be zero).
+    """The blocks of one generalised plant.
 
     Attributes
     ----------
-    A, B1, B2, C1, C2, D11, D12, D21 : ndarray
-        State-space blocks as in the module docstring.
+    A, B1, B2, C1, C2, D11, D12, D21, D22 : ndarray
+        State-space blocks as in the module docstring (``D22`` defaults to zero).
     """
 
     A: np.ndarray
@@ -47,6 +50,16 @@ class Partition:
     D11: np.ndarray
     D12: np.ndarray
     D21: np.ndarray
+    D22: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.D22 is None:
+            object.__setattr__(self, "D22", np.zeros((self.C2.shape[0], self.B2.shape[1])))
+
+    @property
+    def has_d22(self) -> bool:
+        """True when the control reaches the measurement directly (``D22 != 0``)."""
+        return bool(np.any(self.D22 != 0.0))
 
     @property
     def nx(self) -> int:
@@ -77,22 +90,43 @@ class Partition:
         C2[ny:, nx:] = np.eye(k)
         D12 = np.hstack([self.D12, np.zeros((nz, k))])
         D21 = np.vstack([self.D21, np.zeros((k, nw))])
-        return Partition(A, B1, B2, C1, C2, self.D11, D12, D21)
+        D22 = np.zeros((ny + k, nu + k))
+        D22[:ny, :nu] = self.D22
+        return Partition(A, B1, B2, C1, C2, self.D11, D12, D21, D22)
+
+    def loop_gain(self, Kbar: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(K~, L, R)``: the gain seen by the loop, ``K~ = L Kbar = Kbar R`` with
+        ``L = (I - Kbar D22)⁻¹`` and ``R = (I - D22 Kbar)⁻¹`` (``dK~ = L dKbar R``)."""
+        m, p = Kbar.shape
+        if not self.has_d22:
+            return Kbar, np.eye(m), np.eye(p)
+        L = np.linalg.inv(np.eye(m) - Kbar @ self.D22)
+        R = np.linalg.inv(np.eye(p) - self.D22 @ Kbar)
+        return L @ Kbar, L, R
+
+    def well_posedness(self, Kbar: np.ndarray) -> float:
+        """``det(I - Kbar D22)`` (1 without a feed-through; the loop is ill posed at 0)."""
+        if not self.has_d22:
+            return 1.0
+        return float(np.linalg.det(np.eye(Kbar.shape[0]) - Kbar @ self.D22))
 
     def closed_loop(self, Kbar: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Closed-loop ``(Acl, Bcl, Ccl, Dcl)`` of this (augmented) plant with the static ``Kbar``."""
-        A = self.A + self.B2 @ Kbar @ self.C2
-        B = self.B1 + self.B2 @ Kbar @ self.D21
-        C = self.C1 + self.D12 @ Kbar @ self.C2
-        D = self.D11 + self.D12 @ Kbar @ self.D21
+        Kt = self.loop_gain(Kbar)[0]
+        A = self.A + self.B2 @ Kt @ self.C2
+        B = self.B1 + self.B2 @ Kt @ self.D21
+        C = self.C1 + self.D12 @ Kt @ self.C2
+        D = self.D11 + self.D12 @ Kt @ self.D21
         return A, B, C, D
 
-    def transformed(self, T: np.ndarray, su: np.ndarray, sy: np.ndarray) -> "Partition":
-        """State similarity ``x = T x~`` and input/output scaling ``u = su u~``, ``y~ = y / sy``."""
+    def transformed(self, T: np.ndarray, su: np.ndarray, sy: np.ndarray,
+                    w0: float = 1.0) -> "Partition":
+        """State similarity ``x = T x~``, input/output scaling ``u = su u~``, ``y~ = y / sy``
+        and time scaling ``t~ = w0 t`` (frequencies divided by ``w0``)."""
         Ti = np.linalg.inv(T)
-        return Partition(Ti @ self.A @ T, Ti @ self.B1, Ti @ self.B2 * su, self.C1 @ T,
-                         (self.C2 @ T) / sy[:, None], self.D11, self.D12 * su,
-                         self.D21 / sy[:, None])
+        return Partition(Ti @ self.A @ T / w0, Ti @ self.B1 / w0, Ti @ self.B2 * su / w0,
+                         self.C1 @ T, (self.C2 @ T) / sy[:, None], self.D11, self.D12 * su,
+                         self.D21 / sy[:, None], self.D22 * su[None, :] / sy[:, None])
 
 
 def partition(P: control.StateSpace, nmeas: int, ncon: int) -> Partition:
@@ -112,7 +146,7 @@ def partition(P: control.StateSpace, nmeas: int, ncon: int) -> Partition:
     Raises
     ------
     DimensionError
-        If the split leaves no ``w`` or ``z``, if ``P`` is discrete-time, or if ``D22 != 0``.
+        If the split leaves no ``w`` or ``z``, or if ``P`` is discrete-time.
     """
     if not isinstance(P, control.StateSpace):
         try:
@@ -130,12 +164,8 @@ def partition(P: control.StateSpace, nmeas: int, ncon: int) -> Partition:
             "leave at least one exogenous input w and one performance output z")
     A, B, C, D = (np.asarray(M, dtype=float) for M in (P.A, P.B, P.C, P.D))
     nw, nz = nu_tot - ncon, ny_tot - nmeas
-    D22 = D[nz:, nw:]
-    if np.any(D22 != 0.0):
-        raise DimensionError("D22 (from u to y) must be zero; absorb a feedthrough into the "
-                             "measurement (y - D22 u) before synthesis")
     return Partition(A=A, B1=B[:, :nw], B2=B[:, nw:], C1=C[:nz, :], C2=C[nz:, :],
-                     D11=D[:nz, :nw], D12=D[:nz, nw:], D21=D[nz:, :nw])
+                     D11=D[:nz, :nw], D12=D[:nz, nw:], D21=D[nz:, :nw], D22=D[nz:, nw:].copy())
 
 
 def load_compleib(path: str | Path) -> tuple[control.StateSpace, int, int, dict[str, Any]]:
@@ -220,31 +250,13 @@ def spectral_abscissa(A: np.ndarray) -> float:
     return float(np.max(np.linalg.eigvals(A).real))
 
 
-def _linfnorm(sys: control.StateSpace) -> tuple[float, float]:
-    gamma, omega = control.linfnorm(sys)
-    return float(gamma), float(omega)
-
-
 def exact_hinf_norm(sys: control.StateSpace) -> tuple[float, float]:
     """Exact H∞ norm and peak frequency (rad/s) of a *stable* system.
 
-    Uses ``casflutter.verify.hinf_norm`` (Hamiltonian bisection, shares no code with the
-    optimiser) when that layer provides it, otherwise python-control's ``linfnorm``
-    (SLICOT ``ab13dd``).  Never a gridded value.
+    The synthesis' own Hamiltonian level iteration (:func:`._norm.hinf_norm`, relative
+    accuracy 1e-9), never a gridded value and no code shared with the verification layer.
     """
-    fn = _verify_norm()
-    if fn is not None:
-        res = fn(sys)
-        return float(res.gamma), float(res.omega_peak)
-    return _linfnorm(sys)
-
-
-def _verify_norm() -> Callable | None:
-    try:  # the verification layer is written in parallel; use it once it exists
-        from ..verify import hinf_norm  # noqa: PLC0415
-    except ImportError:
-        return None
-    return hinf_norm
+    return hinf_norm(*(np.asarray(M, dtype=float) for M in (sys.A, sys.B, sys.C, sys.D)))
 
 
 def sigma_max_grid(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray,

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
-from threadpoolctl import threadpool_limits
+from .._threads import single_threaded
 
 from .._nlp import DEFAULT_IPOPT_OPTIONS, NLPResult
 from ..data import IOData, Record
@@ -494,7 +494,7 @@ def identify(data: IOData, orders=(3, 1, 1, 1, 2, 2), *,
     settings = IdentificationSettings.build(settings, **kwargs)
     # single-threaded BLAS: the factorisations here are too small to gain from threads on a
     # shared machine, and the result then does not depend on the thread count
-    with threadpool_limits(limits=1, user_api="blas"):
+    with single_threaded():
         return _identify(data, orders, settings, initial)
 
 

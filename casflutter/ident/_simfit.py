@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import LinAlgError, cho_factor, cho_solve
-from threadpoolctl import threadpool_limits
+from .._threads import single_threaded
 
 from ..data import IOData
 from ._kernels import free_run, sensitivities
@@ -411,7 +411,7 @@ def fit_simulation_error(problem: FreeRunProblem, theta0, *, max_iter: int = 500
     # single-threaded BLAS inside the fit: the products are too small to gain from threads on
     # a shared machine (where they lose several times over), and the result then does not
     # depend on the thread count
-    with threadpool_limits(limits=1, user_api="blas"):
+    with single_threaded():
         return _fit(problem, theta0, max_iter=max_iter, tol=tol, max_time=max_time,
                     blowup=blowup)
 

@@ -210,6 +210,16 @@ class ControllerSettings(SynthesisOptions):
     """Nominal speeds of the design plants as multiples of Vf (must contain 1.0, the plant
     the verification checks): the LFT (eq. 14) is built at each and the worst-case norm is
     minimised; ``[1.0]`` is the paper's design."""
+    interval: tuple = ()
+    """Speed-index interval ``[lo, hi]`` over which the ROM loop ΣAE(V) must stay stable (the
+    interval design of :func:`casflutter.design.design_flutter_controller`); ``[]`` for the
+    paper's design on the LFT alone."""
+    n_speeds: int = 40
+    """Stability constraints spread over ``interval``."""
+    interval_decay: float = 0.05
+    """Decay rate [rad/s] required of ΣAE(V) at those speeds."""
+    steps: int = 4
+    """Continuation steps of the interval's upper end."""
 
     def __post_init__(self):
         super().__post_init__()
@@ -221,6 +231,15 @@ class ControllerSettings(SynthesisOptions):
             raise ConfigError(f"speeds = {list(sp)!r}: a non-empty list of positive multiples "
                               "of Vf, containing 1.0 (the nominal plant)")
         object.__setattr__(self, "speeds", sp)
+        iv = finite_numbers("interval", self.interval, what="[] or [lo, hi] speed indices")
+        if iv and (len(iv) != 2 or not 0 <= iv[0] < iv[1]):
+            raise ConfigError(f"controller.interval = {list(iv)!r}: [] or [lo, hi] speed "
+                              "indices with 0 <= lo < hi")
+        object.__setattr__(self, "interval", iv)
+        _integer("n_speeds", self.n_speeds, 2)
+        _integer("steps", self.steps, 1)
+        if not self.interval_decay >= 0:
+            raise ConfigError(f"interval_decay = {self.interval_decay!r}: must be >= 0")
 
 
 @dataclass(frozen=True)

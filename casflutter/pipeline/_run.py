@@ -46,7 +46,7 @@ from .._settings import settings_as
 from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, build_lft,
                            find_flutter, simulate_loop)
 from ..data import envelope_growth_rate
-from ..design import SynthesisOptions, synthesize
+from ..design import SynthesisOptions, design_flutter_controller
 from ..errors import CasflutterError
 from ..ident import (IdentificationResult, IdentificationSettings, fit_report, identify,
                      identify_common_denominator)
@@ -223,13 +223,13 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
             c = cfg.controller
             options = replace(settings_as(c, SynthesisOptions),
                               ipopt={**cfg.solver.ipopt, **c.ipopt})
-            # D22 (accelerometers see the flap) depends on the nominal speed: the multi-speed
-            # design uses each plant's own loop shift and the nominal plant's for the result
-            plants = [lft.plant_without_d22() if f == 1.0 else
-                      build_lft(system, Vf * f).plant_without_d22() for f in c.speeds]
-            syn = synthesize(plants if len(plants) > 1 else plants[0], lft.nmeas, lft.ncon,
-                             c.order, starts=c.starts, seed=cfg.seed, options=options)
-            K = lft.physical_controller(syn.controller)
+            # γ of the LFT at Vf (eq. 14-16), each design plant with its own loop shift, and
+            # ΣAE(V) kept stable over controller.interval; K acts on the physical sensors
+            design = design_flutter_controller(
+                system, Vf, c.order, speeds=tuple(c.speeds), interval=tuple(c.interval),
+                n_speeds=c.n_speeds, decay=c.interval_decay, steps=c.steps, starts=c.starts,
+                seed=cfg.seed, options=options)
+            syn, K = design.synthesis, design.controller
         with prog.stage("verify"):
             ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
             if cfg.verify.sweep:

@@ -28,8 +28,7 @@ SUMMARY_KEYS = {"problem", "V0", "n_sensors", "orders", "n_params", "fit_error_p
 
 #: the seed wing's study, cut to a few seconds per stage (a poor controller, a whole run)
 STUDY_SMALL = {"data.duration": 4.0, "flutter.n_grid": 61, "lco.duration": 1.0,
-               "controller.order": 1, "controller.max_outer": 1, "controller.nslots": 2,
-               "controller.max_stab_rounds": 2,
+               "controller.order": 1, "controller.max_outer": 1,
                "suppression": {"settle": 1.5, "ramp": 0.5, "hold": 1.5, "release": 1.0}}
 #: the flutter check, with short simulations and sweeps
 CHECK_SMALL = {"data.duration": 150.0, "controller.max_outer": 1, "closed_loop.duration": 30.0,
@@ -110,11 +109,11 @@ def test_every_field_of_a_stages_settings_is_a_configuration_key(section, stage_
 
 
 def test_a_configured_value_reaches_the_stage():
-    cfg = load_config(updates={"controller.polish_rank": 0, "controller.tol": 1e-4,
+    cfg = load_config(updates={"controller.abandon_after": 7, "controller.tol": 1e-4,
                                "rom.shooting_interval": 20, "data.taper": 0.2,
                                "suppression.hold": 3.0})
     opts = settings_as(cfg.controller, SynthesisOptions)
-    assert (opts.polish_rank, opts.tol) == (0, 1e-4)
+    assert (opts.abandon_after, opts.tol) == (7, 1e-4)
     assert settings_as(cfg.rom, IdentificationSettings).shooting_interval == 20
     assert settings_as(cfg.data, RecordSettings).taper == 0.2
     assert isinstance(cfg.suppression, SuppressionSettings) and cfg.suppression.hold == 3.0

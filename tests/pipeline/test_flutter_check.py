@@ -124,7 +124,7 @@ def _check_truth_interval(res):
 
 def test_flutter_check():
     """The problem's settings (problems/typical_section/flutter_check.toml: design plants at
-    0.5, 1 and 1.2 Vf, six minimax solves; about 15 s).  One test function, not a module
+    0.5, 1, 1.2 and 1.25 Vf).  One test function, not a module
     fixture shared by several: under ``pytest -n 2`` a shared fixture would be computed once
     per worker.  Measured: truth closed loop stable on (0.02, 1.2413) x Vf_truth."""
     res = flutter_check()

@@ -25,7 +25,6 @@ duration = 6.0
 order = 2
 starts = 1
 max_outer = 4
-nslots = 8
 stability_margin = 1e-4
 max_stab_rounds = 8
 [suppression]

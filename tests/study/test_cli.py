@@ -95,7 +95,7 @@ def test_sensitivity_command_gamma_table(tmp_path, capsys):
 
     f = tmp_path / "g.toml"
     f.write_text(f'[gamma]\nplant = "{_evals.__name__}:first_order_plant"\nnmeas = 1\n'
-                 'ncon = 1\norder = 0\nstarts = 2\nseed = 1\ntol = 1e-8\n'
+                 'ncon = 1\norder = 0\nstarts = 2\nseed = 1\ntol = 1e-12\n'
                  '[params]\na = -1.0\nrho = 0.7\n')
     assert main(["sensitivity", str(f), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)

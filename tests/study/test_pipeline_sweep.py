@@ -32,7 +32,6 @@ duration = 1.0
 order = {order}
 starts = 1
 max_outer = 1
-nslots = 2
 max_stab_rounds = 2
 stability_margin = 1e-4
 {sensors}

@@ -1,10 +1,12 @@
 """``casflutter bench synthesis``: fixed-order H∞ synthesis on COMPleib-format plants.
 
-Writes one JSON record per plant and controller order with the *verified* γ (exact norm of
-the closed loop, never the gridded value), γ* when the plant file (or a ``reference.json``
-beside it) has it, stability, status, starts and wall time.  Orders are solved in increasing
-order and each order starts (among others) from the best controller of the previous one,
-so γ cannot increase with the order.
+Writes one JSON record per plant and controller order with the exact γ of the closed loop,
+γ* when the plant file (or a ``reference.json`` beside it) has it, the state dimension
+``nx``, stability, status, starts and wall time, and a ``summary`` with the medians and the
+exponent ``p`` of the fit ``time ≈ c · nx^p``.  Orders are solved in increasing order and
+each order starts (among others) from the best controller of the previous one, so γ cannot
+increase with the order.  The file is rewritten after every plant and order, so a run that
+is stopped keeps what it finished; ``--out`` is checked to be writable before any work.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from __future__ import annotations
 import argparse
 import json
 import multiprocessing
+import os
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -64,18 +67,20 @@ def _hinfsyn_gamma(P, nmeas: int, ncon: int, timeout: float) -> float | None:
 
 
 def run_plant(path: Path, orders: list[int], starts: int, seed: int, time_limit: float | None,
-              hinfsyn_timeout: float) -> list[dict[str, Any]]:
-    """All records of one plant file (orders solved in increasing order, warm-started)."""
+              hinfsyn_timeout: float, on_record=None) -> list[dict[str, Any]]:
+    """All records of one plant file (orders solved in increasing order, warm-started);
+    ``on_record(record)`` is called after each order."""
     from ...design import SynthesisOptions, load_compleib, synthesize  # noqa: PLC0415
     from ...errors import SynthesisError  # noqa: PLC0415
 
     P, nmeas, ncon, meta = load_compleib(path)
     gstar = meta.get("gamma_full_order_lmi", meta.get("gamma_lower_bound"))
     full = _hinfsyn_gamma(P, nmeas, ncon, hinfsyn_timeout) if hinfsyn_timeout > 0 else None
+    nx = int(np.asarray(P.A).shape[0])
     records, previous = [], None
     for order in sorted(orders):
         t0 = time.perf_counter()
-        rec: dict[str, Any] = {"plant": meta.get("name", path.stem), "order": order,
+        rec: dict[str, Any] = {"plant": meta.get("name", path.stem), "order": order, "nx": nx,
                                "gamma_lower_bound": gstar, "hinfsyn_full_order_gamma": full,
                                "published_static": meta.get("published_static") or None}
         try:
@@ -90,10 +95,11 @@ def run_plant(path: Path, orders: list[int], starts: int, seed: int, time_limit:
                        norm_method=res.norm_method,
                        starts=[{"kind": s.kind, "stabilized": s.stabilized,
                                 "gamma": s.gamma if np.isfinite(s.gamma) else None,
+                                "stab_iterations": s.stab_iterations,
                                 "outer_iterations": s.outer_iterations,
-                                "converged": s.converged, "grid_gap": s.grid_gap
-                                if np.isfinite(s.grid_gap) else None,
-                                "last_ipopt_status": s.statuses[-1] if s.statuses else None,
+                                "converged": s.converged, "model_decrease": s.model_decrease
+                                if np.isfinite(s.model_decrease) else None,
+                                "last_qp_status": s.statuses[-1] if s.statuses else None,
                                 "wall_time_s": s.wall_time} for s in res.starts])
         except SynthesisError as exc:
             rec.update(gamma=None, stable=False, status=f"SynthesisError: {exc}",
@@ -104,7 +110,51 @@ def run_plant(path: Path, orders: list[int], starts: int, seed: int, time_limit:
         records.append(rec)
         print(f"{rec['plant']:>8s} k={order} gamma={rec['gamma']} gamma*={gstar} "
               f"t={rec['wall_time_s']:.1f}s {rec['status'][:40]}", file=sys.stderr, flush=True)
+        if on_record is not None:
+            on_record(rec)
     return records
+
+
+def summarize(records: list[dict[str, Any]]) -> dict[str, Any]:
+    """Medians, γ3/γ*, monotonicity in the order and the time-vs-nx exponent of ``records``."""
+    def med(v):
+        v = [x for x in v if x is not None and np.isfinite(x)]
+        return float(np.median(v)) if v else None
+
+    times = [r["wall_time_s"] for r in records]
+    nx = np.array([r["nx"] for r in records], dtype=float)
+    t = np.array(times, dtype=float)
+    fit = None
+    if len(set(nx.tolist())) >= 2 and np.all(t > 0):
+        p, logc = np.polyfit(np.log(nx), np.log(t), 1)
+        fit = {"exponent": float(p), "coefficient_s": float(np.exp(logc)),
+               "model": "wall_time_s = coefficient_s * nx ** exponent (least squares in logs)"}
+    by_plant: dict[str, list[dict]] = {}
+    for r in records:
+        by_plant.setdefault(r["plant"], []).append(r)
+    monotone = {}
+    for name, recs in by_plant.items():
+        g = [r["gamma"] for r in sorted(recs, key=lambda r: r["order"])]
+        monotone[name] = all(a is not None and b is not None and b <= a * (1 + 1e-9)
+                             for a, b in zip(g, g[1:]))
+    r3 = [r.get("ratio_to_lower_bound") for r in records if r["order"] == 3]
+    return {"n_records": len(records),
+            "all_stable": all(r["stable"] for r in records),
+            "median_wall_time_s": med(times),
+            "median_ratio_order3": med(r3),
+            "max_ratio_order3": max((x for x in r3 if x is not None), default=None),
+            "gamma_non_increasing": monotone,
+            "time_vs_nx": fit,
+            "machine": {"cpus": os.cpu_count(),
+                        "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg")
+                        else None}}
+
+
+def _write(out: Path, records: list[dict[str, Any]]) -> None:
+    tmp = out.with_name(out.name + ".tmp")
+    tmp.write_text(json.dumps({"records": records, "summary": summarize(records)}, indent=1,
+                              default=float))
+    tmp.replace(out)
 
 
 def _handler(args: argparse.Namespace) -> int:
@@ -112,20 +162,36 @@ def _handler(args: argparse.Namespace) -> int:
     if any(o < 0 for o in orders):
         print("casflutter bench synthesis: orders must be >= 0", file=sys.stderr)
         return 2
-    files = _plant_files(args.plants)
-    jobs = [(f, orders, args.starts, args.seed, args.time_limit, args.hinfsyn_timeout)
+    out = Path(args.out)
+    try:   # fail before any work when the result cannot be written
+        out.parent.mkdir(parents=True, exist_ok=True)
+        _write(out, [])
+    except OSError as exc:
+        print(f"casflutter bench synthesis: cannot write --out {out}: {exc}", file=sys.stderr)
+        return 2
+    try:
+        files = _plant_files(args.plants)
+    except FileNotFoundError as exc:
+        print(f"casflutter bench synthesis: {exc}", file=sys.stderr)
+        return 2
+    time_limit = args.time_limit if args.time_limit and args.time_limit > 0 else None
+    jobs = [(f, orders, args.starts, args.seed, time_limit, args.hinfsyn_timeout)
             for f in files]
+    records: list[dict[str, Any]] = []
     if args.jobs > 1:
         # non-daemonic workers: each may start the time-limited hinfsyn child process
         with ProcessPoolExecutor(args.jobs, mp_context=multiprocessing.get_context("spawn")) \
                 as pool:
-            chunks = list(pool.map(run_plant, *zip(*jobs)))
+            for chunk in pool.map(run_plant, *zip(*jobs)):
+                records += chunk
+                _write(out, records)
     else:
-        chunks = [run_plant(*j) for j in jobs]
-    records = [r for c in chunks for r in c]
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(records, indent=1, default=float))
+        def keep(rec):
+            records.append(rec)
+            _write(out, records)
+
+        for j in jobs:
+            run_plant(*j, on_record=keep)
     print(f"wrote {len(records)} records to {out}", file=sys.stderr)
     return 0
 
@@ -141,8 +207,9 @@ def register(subparsers) -> None:
     p.add_argument("--starts", type=int, default=3, help="starts per order (besides the "
                                                          "previous order's controller)")
     p.add_argument("--seed", type=int, default=0, help="seed of the random starts")
-    p.add_argument("--time-limit", type=float, default=120.0,
-                   help="wall-time budget per plant and order in seconds")
+    p.add_argument("--time-limit", type=float, default=0.0,
+                   help="optional wall-time budget per plant and order in seconds (0: none; "
+                        "the budget is then counted in iterations and is reproducible)")
     p.add_argument("--hinfsyn-timeout", type=float, default=10.0,
                    help="seconds allowed to control.hinfsyn for the full-order comparison "
                         "(0: skip)")

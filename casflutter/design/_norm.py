@@ -1,0 +1,240 @@
+"""The synthesis' own H∞ norm, its peak and the local maxima of σ_max(T(jω)).
+
+Bruinsma & Steinbuch (1990) / Boyd & Balakrishnan (1990): for ``γ > σ_max(D)``, ``γ`` is a
+singular value of ``T(jω) = C (jωI − A)⁻¹ B + D`` iff ``jω`` is an eigenvalue of the
+Hamiltonian ``H(γ)`` (here the extended pencil of :func:`_level_pencil`).  Starting from a lower bound taken at the poles' frequencies,
+the level is raised to the largest σ_max found at the midpoints of the imaginary
+eigenvalues until the pencil at ``(1 + 2 tol) γ`` has none: quadratic convergence to the norm, with the
+peak frequency.  The same level-set eigenvalues give every frequency band in which
+``σ_max > level``; a bounded 1-D maximisation in each band gives the *active frequencies*
+of the nonsmooth local model (Apkarian & Noll 2006).
+
+This is deliberately a different algorithm from the verification layer's (SLICOT AB13DD):
+the optimiser's accept test and the independent check share no code.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.optimize import minimize_scalar
+
+__all__ = ["hinf_norm", "sigma_max", "level_crossings", "active_frequencies"]
+
+
+def _tf(A, B, C, D, omega: np.ndarray) -> np.ndarray:
+    """``T(jω)`` for every ω (batched solve)."""
+    n = A.shape[0]
+    omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    if n == 0:
+        return np.broadcast_to(D.astype(complex), (omega.size,) + D.shape).copy()
+    M = 1j * omega[:, None, None] * np.eye(n)[None] - A[None]
+    X = np.linalg.solve(M, np.broadcast_to(B.astype(complex), (omega.size,) + B.shape))
+    return C[None] @ X + D[None]
+
+
+class _Evaluator:
+    """σ_max(T(jω)) of one system at many frequencies.
+
+    With a well-conditioned eigenvector matrix ``A = V Λ V⁻¹`` each frequency costs
+    ``O(n (m + p))`` (``T = (CV) diag(1/(jω − λ)) (V⁻¹B) + D``); otherwise one LU solve per
+    frequency.  The modal form is used only to *locate* peaks; values that decide anything
+    are recomputed by :func:`sigma_max` (solves)."""
+
+    def __init__(self, A, B, C, D):
+        self.sys = (A, B, C, D)
+        self.modal = None
+        n = A.shape[0]
+        if n:
+            try:
+                lam, V = np.linalg.eig(A)
+                if np.linalg.cond(V) < 1e6:
+                    self.modal = (lam, C @ V, np.linalg.solve(V, B))
+            except np.linalg.LinAlgError:
+                self.modal = None
+
+    def __call__(self, omega) -> np.ndarray:
+        omega = np.atleast_1d(np.asarray(omega, dtype=float))
+        if self.modal is None:
+            return sigma_max(*self.sys, omega)
+        lam, CV, VB = self.modal
+        D = self.sys[3]
+        T = np.einsum("ik,wk,kj->wij", CV, 1.0 / (1j * omega[:, None] - lam[None, :]), VB) + D
+        return np.linalg.svd(T, compute_uv=False)[:, 0]
+
+
+def sigma_max(A, B, C, D, omega) -> np.ndarray:
+    """Largest singular value of ``T(jω)`` at each ω (``inf`` where ``jωI − A`` is singular)."""
+    omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    try:
+        return np.linalg.svd(_tf(A, B, C, D, omega), compute_uv=False)[:, 0]
+    except np.linalg.LinAlgError:
+        out = np.empty(omega.size)
+        for i, w in enumerate(omega):
+            try:
+                out[i] = np.linalg.svd(_tf(A, B, C, D, [w])[0], compute_uv=False)[0]
+            except np.linalg.LinAlgError:
+                out[i] = np.inf
+        return out
+
+
+def _hamiltonian(A, B, C, D, g: float) -> np.ndarray:
+    """Hamiltonian ``H(g)`` (Bruinsma & Steinbuch) for ``g > σ_max(D)``."""
+    m, p = B.shape[1], C.shape[0]
+    R = D.T @ D - g * g * np.eye(m)
+    S = D @ D.T - g * g * np.eye(p)
+    RiDt = np.linalg.solve(R, D.T)
+    RiBt = np.linalg.solve(R, B.T)
+    H11 = A - B @ RiDt @ C
+    return np.block([[H11, -g * B @ RiBt], [g * C.T @ np.linalg.solve(S, C),
+                                             -A.T + C.T @ D @ RiBt]])
+
+
+def _level_pencil(A, B, C, D, g: float) -> tuple[np.ndarray, np.ndarray]:
+    """Extended Hamiltonian pencil ``λN − M`` whose finite eigenvalues ``jω`` are the
+    frequencies where ``g`` is a singular value of ``T(jω)``: with ``x = (jωI − A)⁻¹Bu`` and
+    ``p = (−jωI − Aᵀ)⁻¹Cᵀy``, ``T u = g y`` and ``Tᴴ y = g u`` read ``M z = λ N z`` for
+    ``z = (x, p, u, y)``.  No inverse of ``DᵀD − g²I`` is formed, so the pencil stays well
+    conditioned when ``g`` approaches ``σ_max(D)``."""
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    Z = np.zeros
+    M = np.block([[A, Z((n, n)), B, Z((n, p))],
+                  [Z((n, n)), -A.T, Z((n, m)), -C.T],
+                  [C, Z((p, n)), D, -g * np.eye(p)],
+                  [Z((m, n)), B.T, -g * np.eye(m), D.T]])
+    N = np.zeros_like(M)
+    N[:2 * n, :2 * n] = np.eye(2 * n)
+    return M, N
+
+
+def level_crossings(A, B, C, D, level: float, im_tol: float = 1e-2) -> np.ndarray:
+    """Frequencies ``ω >= 0`` at which some singular value of ``T(jω)`` may equal ``level``
+    (the imaginary eigenvalues of the Hamiltonian pencil), sorted; ``level > σ_max(D)``.
+
+    The test for "imaginary" is loose on purpose (``|Re λ| <= im_tol |λ|``): a spurious
+    frequency only costs one more evaluation of σ_max in the callers, whereas a crossing
+    missed through rounding would end the level iteration below the norm."""
+    sD = float(np.linalg.norm(D, 2)) if D.size else 0.0
+    if level > 1.05 * sD:
+        ev = np.linalg.eigvals(_hamiltonian(A, B, C, D, level))
+    else:   # close to σ_max(D) the Hamiltonian is ill-conditioned: use the pencil
+        M, N = _level_pencil(A, B, C, D, level)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ev = sla.eigvals(M, N)
+        big = 1e8 * max(1.0, float(np.max(np.abs(M))))
+        ev = ev[np.isfinite(ev) & (np.abs(ev) < big)]
+    scale = max(1.0, float(np.max(np.abs(ev), initial=0.0)))
+    imag = ev[np.abs(ev.real) <= im_tol * np.maximum(np.abs(ev), 1e-6 * scale)]
+    w = np.abs(imag.imag)
+    return np.unique(np.round(w[w >= 0], 14))
+
+
+def hinf_norm(A, B, C, D, *, tol: float = 1e-9, max_iter: int = 60) -> tuple[float, float]:
+    """H∞ norm and peak frequency of a stable ``(A, B, C, D)`` (Hamiltonian level iteration).
+
+    Parameters
+    ----------
+    A, B, C, D : ndarray
+        Continuous-time state-space matrices; ``A`` must be Hurwitz.
+    tol : float
+        Relative accuracy: the true norm lies in ``[γ, (1 + 2 tol) γ]``.
+    max_iter : int
+        Maximum number of level iterations.
+
+    Returns
+    -------
+    gamma : float
+        The norm (``inf`` when ``A`` is not Hurwitz).
+    omega : float
+        Peak frequency in rad/s (``inf`` when the peak is the feedthrough ``σ_max(D)``).
+    """
+    A, B, C, D = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (A, B, C, D))
+    n = A.shape[0]
+    sD = float(np.linalg.norm(D, 2)) if D.size else 0.0
+    if n == 0:
+        return sD, np.inf
+    poles = np.linalg.eigvals(A)
+    if np.max(poles.real) >= 0:
+        return np.inf, np.nan
+    # initial lower bound: ω = 0, the pole frequencies and the most resonant pole
+    mags = np.abs(poles)
+    lo, hi = float(np.min(mags)), float(np.max(mags))
+    grid = np.geomspace(max(0.1 * lo, 1e-9 * hi, 1e-300), 10.0 * hi, 40) if hi > 0 else []
+    cand = np.concatenate([[0.0], np.abs(poles.imag), mags, grid])
+    cand = np.unique(cand[np.isfinite(cand)])
+    ev_ = _Evaluator(A, B, C, D)
+    sv = ev_(cand)
+    i = int(np.argmax(sv))
+    lb, wpk = float(sigma_max(A, B, C, D, [cand[i]])[0]), float(cand[i])
+    if sD >= lb:
+        lb, wpk = sD, np.inf
+    if lb == 0.0:
+        return 0.0, 0.0
+    for _ in range(max_iter):
+        g = lb * (1.0 + 2.0 * tol)
+        w = level_crossings(A, B, C, D, g)
+        if w.size == 0:
+            break
+        edges = np.concatenate([w, [2.0 * w[-1] + 1.0]]) if w.size == 1 else w
+        mids = 0.5 * (edges[:-1] + edges[1:])
+        mids = np.concatenate([mids, np.sqrt(edges[:-1] * edges[1:]), w])
+        mids = mids[np.isfinite(mids)]
+        sv = ev_(mids)
+        j = int(np.argmax(sv))
+        sv[j] = sigma_max(A, B, C, D, [mids[j]])[0]
+        if not sv[j] > lb * (1.0 + tol):
+            break          # crossings found but no higher value between them: converged
+        lb, wpk = float(sv[j]), float(mids[j])
+    return lb, wpk
+
+
+def _refine_peak(A, B, C, D, a: float, b: float, w0: float, xatol: float = 1e-6
+                 ) -> tuple[float, float]:
+    """Local maximum of σ_max on ``[a, b]`` (bounded scalar search on log ω)."""
+    lo, hi = max(a, 1e-12 * max(b, 1.0)), max(b, a * (1 + 1e-12))
+    if hi <= lo * (1 + 1e-10):
+        s = float(sigma_max(A, B, C, D, [w0])[0])
+        return w0, s
+    ev = _Evaluator(A, B, C, D)
+    f = lambda x: -float(ev([np.exp(x)])[0])  # noqa: E731
+    r = minimize_scalar(f, bounds=(np.log(lo), np.log(hi)), method="bounded",
+                        options={"xatol": xatol})
+    w = float(np.exp(r.x))
+    s = float(sigma_max(A, B, C, D, [w])[0])
+    s0 = float(sigma_max(A, B, C, D, [w0])[0])
+    return (w, s) if s >= s0 else (w0, s0)
+
+
+def active_frequencies(A, B, C, D, gamma: float, omega_peak: float, *, ratio: float = 0.6,
+                       max_count: int = 8) -> list[tuple[float, float]]:
+    """Local maxima of ``σ_max(T(jω))`` above ``ratio * gamma``: ``[(ω, σ), ...]`` by
+    decreasing σ, the exact peak first.
+
+    The bands where ``σ_max > ratio γ`` are delimited by the imaginary eigenvalues of the
+    Hamiltonian at that level; one local maximum is located in each band.
+    """
+    out: list[tuple[float, float]] = []
+    if np.isfinite(omega_peak):
+        out.append((float(omega_peak), float(gamma)))
+    n = A.shape[0]
+    sD = float(np.linalg.norm(D, 2)) if D.size else 0.0
+    level = ratio * gamma
+    if n == 0 or level <= sD * (1 + 1e-9):
+        return out
+    w = level_crossings(A, B, C, D, level)
+    if w.size == 0:
+        return out
+    edges = np.concatenate([[0.0], w, [max(10.0 * w[-1], 1.0)]])
+    mids = 0.5 * (edges[:-1] + edges[1:])
+    sv = sigma_max(A, B, C, D, mids)
+    bands = [(edges[i], edges[i + 1], mids[i], sv[i]) for i in range(mids.size)
+             if sv[i] > level]
+    bands.sort(key=lambda b: -b[3])
+    for a, b, m, _ in bands[:max_count]:
+        if np.isfinite(omega_peak) and a <= omega_peak <= b:
+            continue
+        wl, sl = _refine_peak(A, B, C, D, a, b, m)
+        if sl > level:
+            out.append((wl, sl))
+    out.sort(key=lambda x: -x[1])
+    return out[:max_count]

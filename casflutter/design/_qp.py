@@ -1,0 +1,110 @@
+"""The trust-region subproblem of the nonsmooth synthesis, a small QP in the gain step only.
+
+    minimise   t + ½ dᵀ H d
+    subject to f_i + g_iᵀ d <= t            (objective cuts: local models of σ or Re λ)
+               c_l + h_lᵀ d <= 0            (constraint cuts: decay rate, well-posedness)
+               |d| <= Δ                     (box trust region)
+
+Its size is the number of controller parameters plus one, whatever the plant's state
+dimension: the plant enters only through the cut values and gradients computed in numpy.
+Solved by Ipopt through :mod:`casflutter._nlp`; one solver per (parameters, cut slots)
+size is built and reused, unused slots are free constraints.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from .._nlp import NLPSolver, make_solver
+
+__all__ = ["CutQP", "QPStep"]
+
+_SLOT = 16
+
+
+@dataclass(frozen=True)
+class QPStep:
+    """Solution of one subproblem: step ``d``, model value ``t + ½dᵀHd``, the multipliers of
+    the objective and constraint cuts, and Ipopt's status."""
+
+    d: np.ndarray
+    model: float
+    t: float
+    mu: np.ndarray
+    nu: np.ndarray
+    status: str
+    success: bool
+
+
+class CutQP:
+    """Cached QP solvers for ``n`` parameters.
+
+    Parameters
+    ----------
+    n : int
+        Number of gain parameters.
+    options : dict
+        Extra Ipopt options (flat CasADi keys).
+    """
+
+    def __init__(self, n: int, options: dict | None = None):
+        self.n = int(n)
+        self.options = {"ipopt.tol": 1e-11, "ipopt.acceptable_tol": 1e-8,
+                        "ipopt.max_iter": 300, "ipopt.hessian_constant": "yes",
+                        "ipopt.jac_c_constant": "yes", "ipopt.jac_d_constant": "yes",
+                        "ipopt.mu_strategy": "adaptive"}
+        self.options.update(options or {})
+        self._cache: dict[tuple[int, int], NLPSolver] = {}
+
+    def _solver(self, mo: int, mc: int) -> NLPSolver:
+        key = (mo, mc)
+        if key not in self._cache:
+            n = self.n
+            d = ca.SX.sym("d", n)
+            t = ca.SX.sym("t")
+            H = ca.SX.sym("H", n, n)
+            G = ca.SX.sym("G", mo, n)
+            f = ca.SX.sym("f", mo)
+            Hc = ca.SX.sym("Hc", mc, n)
+            c = ca.SX.sym("c", mc)
+            obj = t + 0.5 * ca.dot(d, ca.mtimes(H, d))
+            g = ca.vertcat(f + ca.mtimes(G, d) - t, c + ca.mtimes(Hc, d))
+            p = ca.vertcat(ca.vec(H), ca.vec(G), f, ca.vec(Hc), c)
+            self._cache[key] = make_solver({"x": ca.vertcat(d, t), "f": obj, "g": g, "p": p},
+                                           self.options, name="synthesis_qp")
+        return self._cache[key]
+
+    def solve(self, H: np.ndarray, f: np.ndarray, G: np.ndarray, c: np.ndarray,
+              Hc: np.ndarray, delta: np.ndarray | float) -> QPStep:
+        """Solve the subproblem (module docstring); ``d = 0`` must be feasible (``c <= 0``)."""
+        n = self.n
+        no, nc = f.size, c.size
+        mo = _SLOT * max(1, -(-no // _SLOT))
+        mc = _SLOT * max(1, -(-nc // _SLOT))
+        Gp = np.zeros((mo, n))
+        Gp[:no] = G
+        fp = np.zeros(mo)
+        fp[:no] = f
+        Hcp = np.zeros((mc, n))
+        Hcp[:nc] = Hc
+        cp = np.zeros(mc)
+        cp[:nc] = c
+        p = np.concatenate([H.ravel(order="F"), Gp.ravel(order="F"), fp,
+                            Hcp.ravel(order="F"), cp])
+        delta = np.broadcast_to(np.asarray(delta, dtype=float), (n,))
+        lbx = np.concatenate([-delta, [-np.inf]])
+        ubx = np.concatenate([delta, [np.inf]])
+        ubg = np.concatenate([np.where(np.arange(mo) < no, 0.0, np.inf),
+                              np.where(np.arange(mc) < nc, 0.0, np.inf)])
+        x0 = np.concatenate([np.zeros(n), [float(np.max(f)) + 1e-9 * (1 + abs(np.max(f)))]])
+        res = self._solver(mo, mc)(x0, lbx=lbx, ubx=ubx, lbg=-np.inf, ubg=ubg, p=p,
+                                   accept_acceptable=True)
+        d = res.x[:n]
+        t = float(res.x[n])
+        model = float(np.max(f + G @ d)) + 0.5 * float(d @ H @ d)
+        return QPStep(d=d, model=model, t=t, mu=np.maximum(res.lam_g[:no], 0.0),
+                      nu=np.maximum(res.lam_g[mo:mo + nc], 0.0), status=res.return_status,
+                      success=res.success)

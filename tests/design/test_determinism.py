@@ -1,0 +1,70 @@
+"""Same seed, same controller, whatever the BLAS thread count of the process.
+
+Each case runs in fresh interpreters with ``OPENBLAS_NUM_THREADS`` = 1 and 2 (and the other
+pools alike); the controllers must be bit-identical.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+SCRIPT = """
+import hashlib, json, numpy as np
+from casflutter.design import load_compleib, synthesize, SynthesisOptions
+P, nm, nc, _ = load_compleib({plant!r})
+r = synthesize(P, nm, nc, 2, starts=2, seed=5, options=SynthesisOptions(max_outer=60))
+K = r.controller
+h = hashlib.sha256(b"".join(np.ascontiguousarray(np.asarray(M, float)).tobytes()
+                            for M in (K.A, K.B, K.C, K.D))).hexdigest()
+print(json.dumps({{"hash": h, "gamma": r.gamma}}))
+"""
+
+
+def _run(code: str, threads: int, timeout: float = 600) -> dict:
+    env = dict(os.environ)
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        env[var] = str(threads)
+    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True,
+                         text=True, timeout=timeout, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_synthesis_identical_with_one_and_two_blas_threads():
+    code = SCRIPT.format(plant=str(ROOT / "problems" / "compleib" / "AC4.json"))
+    one, two = _run(code, 1), _run(code, 2)
+    assert one == two
+
+
+RUN = """
+import json, sys
+from pathlib import Path
+from casflutter.cli import main
+out = Path(sys.argv[1])
+assert main(["run", "--out", str(out), "--quiet"]) == 0
+print(json.dumps({{"controller": json.loads((out / "controller.json").read_text()),
+                   "gamma": json.loads((out / "summary.json").read_text())["controller"]["gamma"]}}))
+"""
+
+
+@pytest.mark.slow
+def test_default_run_controller_identical_with_one_and_two_blas_threads(tmp_path):
+    """`casflutter run` (the default configuration) as launched by `make demo` (pools pinned
+    by the environment) and from a bare shell with two threads: the same controller."""
+    def run(threads):
+        env = dict(os.environ, MPLBACKEND="Agg")
+        for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+            env[var] = str(threads)
+        out = subprocess.run([sys.executable, "-c", RUN.format(), str(tmp_path / f"t{threads}")],
+                             env=env, cwd=ROOT, capture_output=True, text=True, timeout=900,
+                             check=True)
+        return json.loads(out.stdout.strip().splitlines()[-1])
+
+    assert run(1) == run(2)
