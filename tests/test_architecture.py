@@ -56,8 +56,10 @@ def _imports(name: str, path: Path, is_pkg: bool):
             if not mod.startswith("casflutter"):
                 continue
             if node.module is None or node.level and not node.module:
-                for a in node.names:  # from . import x
-                    yield f"{mod}.{a.name}", level_ok
+                for a in node.names:  # from . import x: a submodule, or a name of the package
+                    sub = ROOT.parent.joinpath(*f"{mod}.{a.name}".split("."))
+                    is_module = sub.is_dir() or sub.with_suffix(".py").is_file()
+                    yield (f"{mod}.{a.name}" if is_module else mod), level_ok
             else:
                 yield mod, level_ok
 
