@@ -72,7 +72,7 @@ class SynthesisOptions:
     """Lower bound on ``det(I - Dk D22)`` for plants with a control-to-measurement
     feed-through (keeps the loop well posed with margin)."""
     trust_region: float = 0.3
-    """Initial trust-region radius (box) on the scaled gain step, relative to max(1, |K|)."""
+    """Initial trust-region radius (box) on the scaled gain step, relative to max(1, ``|K|``)."""
     max_trust_region: float = 10.0
     """Largest trust-region radius (same units)."""
     active_ratio: float = 0.6
