@@ -95,6 +95,11 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     which supplies the flap rate and acceleration the aerodynamics need.  The truth is
     integrated by classical Runge--Kutta with ``substeps`` steps per sample.
 
+    The controller is engaged with the gain: its state stays at zero while ``g = 0`` (a
+    controller switched on in the tunnel starts from rest; one that ran open-loop beside an
+    established LCO would have integrated it, and a slow controller pole turns that into a
+    flap offset at switch-on).
+
     A real flap servo saturates: with ``flap_limit`` the command is clipped to
     ``±flap_limit`` and the actuator stops at that angle; with ``flap_rate_limit`` the
     actuator's rate stops growing at ``±flap_rate_limit`` (its acceleration is cut while the
@@ -198,7 +203,7 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
         ZM[k], Vf[k], G[k] = zm, xa[0], gain(t[k])
         vc = G[k] * float((Ck @ xk + Dk @ zm)[0]) if nk else G[k] * float((Dk @ zm)[0])
         vc = float(np.clip(vc, -pos_max, pos_max))
-        if nk:
+        if nk and G[k] > 0:  # the controller runs from its engagement (state zero before)
             xk = Ak @ xk + Bk @ zm
         if k == n - 1:
             break

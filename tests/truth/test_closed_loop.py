@@ -107,3 +107,20 @@ def test_suppression_starts_from_the_established_lco(wing):
     dom = run.dominant_sensor
     assert run.open_loop_amplitude[dom] == pytest.approx(lco.amplitude[dom], rel=0.03)
     assert abs(run.attenuation_percent) < 3.0
+
+
+def test_the_controller_starts_at_its_engagement(wing):
+    """A near-integrator controller (pole at -1e-4, no feed-through) beside an oscillating
+    wing: while the gain is zero its state stays at rest, so its first command at switch-on
+    is exactly zero and the flap is still at rest one sample later -- a controller that had
+    run open-loop would command ``C x`` with ``x`` the integral of the open-loop sensors."""
+    V, dt, t_on = 1.1, 0.002, 0.3
+    t = np.arange(0.0, 0.5, dt)
+    x0 = wing.displaced_state(1, 0.05)
+    K = control.ss([[-1e-4]], [[1.0, 1.0]], [[1e-3]], [[0.0, 0.0]])
+    run = closed_loop_truth(wing, K, V, t, x0, lambda tt: 1.0 if tt >= t_on else 0.0)
+    on = int(np.argmax(t >= t_on))
+    open_loop_command = 1e-3 * abs(run.zm[:on].sum() * dt)
+    assert open_loop_command > 1e-5            # what a running controller would command
+    assert run.v[on] == 0.0 and run.v[on + 1] == 0.0
+    assert np.abs(run.v[on + 2:on + 10]).max() > 0   # and the loop does act after that
