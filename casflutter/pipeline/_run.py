@@ -249,15 +249,12 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
             # measured on the real wing at an LCO condition)
             V_ref = flutter_truth.Vf if flutter_truth.flutter is not None else Vf
             V_run = float(V_ref) * cfg.suppression.speed_factor
-            established = out.get("lco")
-            if established is None or abs(established.truth.V - V_run) > 1e-9 * V_run:
-                # the LCO stage did not run at this speed: let the truth's LCO converge here
-                established = truth_lco(truth, V_run, cfg.lco.duration, crit,
-                                        cfg.lco.initial_deflection, dt=model.dt,
-                                        sensor_rows=rows, sensor=cfg.sensors.kind)
-                tr = established
-            else:
-                tr = established.truth
+            lco = out.get("lco")
+            if lco is not None and abs(lco.truth.V - V_run) <= 1e-9 * V_run:
+                tr = lco.truth  # the LCO stage's truth run at this speed: its converged LCO
+            else:  # the LCO stage did not run at this speed: let the truth's LCO converge
+                tr = truth_lco(truth, V_run, cfg.lco.duration, crit, cfg.lco.initial_deflection,
+                               dt=model.dt, sensor_rows=rows, sensor=cfg.sensors.kind)
             x0 = tr.final_state if tr.kind == "lco" else None
             if x0 is None:
                 prog.note(f"the truth has no LCO at V = {V_run:.4f} ({tr.kind}): the "
