@@ -499,6 +499,18 @@ def default_config_path() -> Path:
     return config_path("seed_wing", "run")
 
 
+def _relative_problem(table: dict, path: Path) -> None:
+    """A ``[problem] name`` that is a path relative to the configuration file's folder (a
+    wing file beside its run configuration) becomes that path."""
+    prob = table.get("problem")
+    name = prob.get("name") if isinstance(prob, dict) else None
+    if not isinstance(name, str) or Path(name).is_absolute() or Path(name).exists():
+        return
+    near = path.parent / name
+    if near.is_file() or (near / "problem.toml").is_file():
+        prob["name"] = str(near)
+
+
 def load_config(path=None, *, updates=None, **overrides) -> RunConfig:
     """Read and validate a run configuration (default: the seed wing's).
 
@@ -525,6 +537,12 @@ def load_config(path=None, *, updates=None, **overrides) -> RunConfig:
     """
     path = Path(path) if path is not None else default_config_path()
     table = read_toml(path, "configuration file")
+    if table.get("kind") is not None:
+        raise ConfigError(f"{path} is a problem file (kind = {table['kind']!r}), not a run "
+                          "configuration: write a run configuration whose [problem] name is "
+                          f"this file (e.g. problems/example_wing/run.toml), or pass it as "
+                          "problem.name")
+    _relative_problem(table, path)
     table.update({k: v for k, v in overrides.items() if v is not None})
     for key, value in (updates or {}).items():
         set_dotted(table, RunConfig, key, value)

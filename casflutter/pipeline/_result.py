@@ -31,8 +31,9 @@ class LcoResult:
     ----------
     rom : LoopSimulation
         The nonlinear ROM in the loop with Σs at ``V``.
-    truth : TruthLco
-        The truth's own response a little above its own flutter speed.
+    truth : TruthLco or None
+        The truth's own response a little above its own flutter speed (``None`` on a wing
+        file, which has no simulator).
     V : float
         Speed of the ROM simulation: ``lco.speed_factor`` times ``V_hopf_exact_order``.
     V_hopf_exact_order : float
@@ -43,7 +44,7 @@ class LcoResult:
     """
 
     rom: LoopSimulation
-    truth: TruthLco
+    truth: TruthLco | None
     V: float
     V_hopf_exact_order: float
     flutter_exact_order: FlutterResult
@@ -171,8 +172,8 @@ class RunResult:
     ----------
     config : RunConfig
         The configuration.
-    truth : AeroelasticTruth
-        The truth simulator.
+    truth : AeroelasticTruth or None
+        The truth simulator (``None`` on a wing file).
     data : IOData
         The chirp records of the last identification.
     identification : IdentificationResult or CommonDenominatorResult
@@ -185,8 +186,10 @@ class RunResult:
         Σf by ERA and Tustin (eq. 5).
     system : AeroelasticSystem
         ΣAE(V) (eq. 8-9).
-    flutter, flutter_truth : FlutterResult
-        Flutter searches of the ROM and of the truth.
+    flutter : FlutterResult
+        Flutter search of the ROM.
+    flutter_truth : FlutterResult or None
+        Of the truth (``None`` on a wing file).
     flutter_frozen : FlutterResult or None
         Of the truth with its aerodynamics frozen at ``V0`` (stage ``frozen``).
     parametric : ParametricResult or None
@@ -213,10 +216,15 @@ class RunResult:
         Where the files were written.
     files : mapping
         Name -> path of every file written.
+    problem : object
+        What ``[problem]`` loaded: the truth, or a :class:`casflutter.truth.WingProblem`.
+    skipped : mapping
+        Stage (or part of a stage) -> why it did not run (the truth-only stages on a wing
+        file).
     """
 
     config: RunConfig
-    truth: AeroelasticTruth
+    truth: AeroelasticTruth | None
     data: IOData
     identification: IdentificationResult | CommonDenominatorResult
     identification_history: tuple
@@ -224,7 +232,7 @@ class RunResult:
     realization: Realization
     system: AeroelasticSystem
     flutter: FlutterResult
-    flutter_truth: FlutterResult
+    flutter_truth: FlutterResult | None
     flutter_frozen: FlutterResult | None = None
     parametric: ParametricResult | None = None
     lco: LcoResult | None = None
@@ -238,6 +246,8 @@ class RunResult:
     timings: Mapping[str, float] = field(default_factory=dict)
     out_dir: Path | None = None
     files: Mapping[str, Path] = field(default_factory=dict)
+    problem: Any = None
+    skipped: Mapping[str, str] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ flutter speeds
     @property
@@ -248,18 +258,18 @@ class RunResult:
     @property
     def Vf_truth(self) -> float | None:
         """The truth's flutter speed index."""
-        return self.flutter_truth.Vf
+        return None if self.flutter_truth is None else self.flutter_truth.Vf
 
     @property
     def rom_error(self) -> float | None:
         """``(Vf_rom - Vf_truth) / Vf_truth``."""
-        return _rel(self.flutter.Vf, self.flutter_truth.Vf)
+        return _rel(self.flutter.Vf, self.Vf_truth)
 
     @property
     def scaling_error(self) -> float | None:
         """``(Vf_frozen - Vf_truth) / Vf_truth``: the error the V² scaling alone causes."""
         return None if self.flutter_frozen is None else _rel(self.flutter_frozen.Vf,
-                                                             self.flutter_truth.Vf)
+                                                             self.Vf_truth)
 
     @property
     def identification_error(self) -> float | None:
@@ -271,7 +281,7 @@ class RunResult:
     def parametric_error(self) -> float | None:
         """``(Vf_parametric - Vf_truth) / Vf_truth``."""
         return None if self.parametric is None else _rel(self.parametric.flutter.Vf,
-                                                         self.flutter_truth.Vf)
+                                                         self.Vf_truth)
 
     def explanation(self) -> str:
         """The ROM's flutter-speed error and its cause, in words.
@@ -340,7 +350,7 @@ class RunResult:
             ``problem``, ``V0``, ``n_sensors``, ``orders``, ``n_params``,
             ``fit_error_percent``, ``nf``, ``ns``, ``nae``, ``flutter``, ``flutter_truth``,
             ``lco``, ``controller``, ``suppression`` (``None`` when the stage did not run),
-            ``timings_s``, ``seed``; and, for the stages that ran, ``v0_history``,
+            ``timings_s``, ``seed``, ``skipped`` (stage -> reason); and, for the stages that ran, ``v0_history``,
             ``flutter_frozen``, ``flutter_parametric``, ``verification`` and
             ``closed_loop``.
         """
@@ -370,6 +380,7 @@ class RunResult:
                 "flap_rate_limit": cfg.suppression.flap_rate_limit},
             "timings_s": dict(self.timings),
             "seed": cfg.seed,
+            "skipped": dict(self.skipped),
         }
         if cfg.rom.v0_iterations > 1:
             out["v0_history"] = [list(map(float, p)) for p in self.identification_history]
@@ -404,8 +415,10 @@ class RunResult:
         sens = sim.sensors if sim.sensors is not None else sim.modes
         return {"V": self.lco.V, "V_hopf_exact_order": self.lco.V_hopf_exact_order,
                 "freq_hz": sens.frequency_hz, "amplitude": list(sens.amplitude),
-                "kind": sens.kind, "truth_V": tr.V, "truth_freq_hz": tr.freq_hz,
-                "truth_amplitude": list(tr.amplitude), "truth_kind": tr.kind}
+                "kind": sens.kind, "truth_V": None if tr is None else tr.V,
+                "truth_freq_hz": None if tr is None else tr.freq_hz,
+                "truth_amplitude": None if tr is None else list(tr.amplitude),
+                "truth_kind": None if tr is None else tr.kind}
 
     def _controller_summary(self) -> dict | None:
         if self.verification is None:

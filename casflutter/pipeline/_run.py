@@ -22,6 +22,12 @@ identification speed and the flutter speed agree.  Then the optional ``stages``:
   truth's linear closed loop over speed;
 - ``suppression`` — the truth with the controller gain ramped 0 -> 1 and released (Fig. 11).
 
+A wing file without a simulator (``[problem] name`` a ``kind = "wing"`` file: modal data,
+sensors and records, :class:`casflutter.truth.WingProblem`) runs the same stages on its records
+at its own ``V0``; the stages that need the truth (its flutter search, ``frozen``,
+``parametric``, the truth's LCO, ``closed_loop``, ``suppression``) are skipped with a logged
+note and listed in ``RunResult.skipped``.
+
 Two configurations ship with the package: ``problems/seed_wing/run.toml`` (the paper's
 study, ``casflutter run``) and ``problems/typical_section/flutter_check.toml`` (an order-2
 controller designed on the ROM identified at its own flutter speed and checked on the
@@ -31,6 +37,7 @@ truth); ``problems/NAME/flutter.toml`` are the ROM routes of ``casflutter flutte
 from __future__ import annotations
 
 import json
+import logging
 import sys
 import time
 from contextlib import contextmanager
@@ -47,12 +54,12 @@ from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, b
                            find_flutter, simulate_loop)
 from ..data import envelope_growth_rate
 from ..design import SynthesisOptions, design_flutter_controller
-from ..errors import CasflutterError
+from ..errors import CasflutterError, ConfigError
 from ..ident import (IdentificationResult, IdentificationSettings, fit_report, identify,
                      identify_common_denominator)
 from ..realize import ParametricROM, realize, speed_nodes
 from ..report import write_figures, write_html
-from ..truth import (RecordSettings, closed_loop_truth, frozen_aero_truth, suppression_run,
+from ..truth import (AeroelasticTruth, RecordSettings, WingProblem, closed_loop_truth, frozen_aero_truth, suppression_run,
                      truth_lco, truth_loop_matrix, truth_loop_sweep, truth_records)
 from ..verify import controller_to_json, speed_sweep, verify_controller
 from ._config import RunConfig, load_config
@@ -60,6 +67,14 @@ from ._result import (ClosedLoopChecks, LcoResult, ParametricResult, RunResult,
                       SimulationCheck, _jsonable)
 
 __all__ = ["run"]
+
+log = logging.getLogger("casflutter.pipeline")
+
+#: stages (and parts of stages) that need a truth simulator, skipped on a wing file
+_TRUTH_ONLY = {"flutter_truth": "the truth's flutter search", "frozen": "stage 'frozen'",
+               "parametric": "stage 'parametric' (records at several speeds)",
+               "truth_lco": "the truth's LCO of stage 'lco'",
+               "closed_loop": "stage 'closed_loop'", "suppression": "stage 'suppression'"}
 
 
 class _Progress:
@@ -88,11 +103,33 @@ class _Progress:
             print(f"      {text}", file=sys.stderr, flush=True)
 
 
-def _stage_names(cfg: RunConfig) -> list[str]:
+def _stage_names(cfg: RunConfig, skipped=()) -> list[str]:
     names = ["data", "rom", "realize", "structure", "flutter"]
     for s in cfg.stages:
-        names += ["lft", "controller", "verify"] if s == "controller" else [s]
+        if s not in skipped:
+            names += ["lft", "controller", "verify"] if s == "controller" else [s]
     return names
+
+
+def _wing_setup(cfg: RunConfig, wing: WingProblem) -> tuple[RunConfig, dict]:
+    """A wing file's configuration (``data.V0`` the records' speed) and the truth-only stages
+    it skips, ``{stage: reason}``; checked before any work."""
+    if cfg.rom.v0_iterations > 1:
+        raise ConfigError(f"rom.v0_iterations = {cfg.rom.v0_iterations}: the records of the "
+                          f"wing file {wing.path} are taken at one speed (V0 = {wing.V0:g}); "
+                          "set rom.v0_iterations = 1")
+    if cfg.sensors.kind != wing.structure.sensor:
+        raise ConfigError(f"sensors.kind = {cfg.sensors.kind!r} of the run configuration "
+                          f"differs from sensors.kind = {wing.structure.sensor!r} of the wing "
+                          f"file {wing.path}; set [sensors] kind = "
+                          f"\"{wing.structure.sensor}\" in the run configuration")
+    why = f"needs a truth simulator; the wing file {wing.name!r} has records only"
+    wanted = {"flutter_truth"} | set(cfg.stages) | ({"truth_lco"} if "lco" in cfg.stages
+                                                     else set())
+    skipped = {k: f"{v}: {why}" for k, v in _TRUTH_ONLY.items() if k in wanted}
+    for text in skipped.values():
+        log.warning("skipped %s", text)
+    return replace(cfg, data=replace(cfg.data, V0=float(wing.V0))), skipped
 
 
 def _mode(res: FlutterResult) -> int:
@@ -153,21 +190,33 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
     cfg = config if isinstance(config, RunConfig) else load_config(config)
     if seed is not None:
         cfg = replace(cfg, seed=int(seed))
-    prog = _Progress(quiet, _stage_names(cfg))
-    truth = cfg.problem.load()
-    structure = truth.modal_structure().with_sensors(cfg.sensors.rows or None, cfg.sensors.kind)
+    problem = cfg.problem.load()
+    truth = problem if isinstance(problem, AeroelasticTruth) else None
+    skipped: dict = {}
+    if isinstance(problem, WingProblem):
+        cfg, skipped = _wing_setup(cfg, problem)
+    elif truth is None:
+        raise ConfigError(f"problem.name = {cfg.problem.name!r} is a {type(problem).__name__}, "
+                          "which casflutter.pipeline.run does not take; give a truth problem "
+                          "or a wing file (kind = \"wing\")")
+    prog = _Progress(quiet, _stage_names(cfg, skipped))
+    for text in skipped.values():
+        prog.note(f"skipped {text}")
+    structure = problem.modal_structure().with_sensors(cfg.sensors.rows or None,
+                                                       cfg.sensors.kind)
     rows = cfg.sensors.rows or None
     records = settings_as(cfg.data, RecordSettings)
     vr = cfg.flutter.V_range
     flutter_kw = dict(n_grid=cfg.flutter.n_grid, max_refine=cfg.flutter.max_refine)
     needs_vf = cfg.rom.v0_iterations > 1 or bool(set(cfg.stages) & {"lco", "controller"})
-    out: dict = {"config": cfg, "truth": truth}
+    out: dict = {"config": cfg, "truth": truth, "problem": problem, "skipped": skipped}
 
     # 1-5: records, ROM, Σf, ΣAE, flutter; repeated at the ROM's own flutter speed
     V0, history = cfg.data.V0, []
     for it in range(cfg.rom.v0_iterations):
         with prog.stage("data"):
-            data = truth_records(truth, records, V0=V0)
+            data = (truth_records(truth, records, V0=V0) if truth is not None
+                    else problem.records)
         with prog.stage("rom"):
             ident, model = _identify(data, cfg)
         with prog.stage("realize"):
@@ -182,7 +231,8 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
             last = (it == cfg.rom.v0_iterations - 1 or Vf is None
                     or abs(Vf - V0) <= cfg.rom.v0_rtol * Vf)
             if last:
-                flutter_truth = find_flutter(truth, vr, **flutter_kw)
+                flutter_truth = (find_flutter(truth, vr, **flutter_kw) if truth is not None
+                                 else None)
             if Vf is None and needs_vf:
                 raise CasflutterError(f"the ROM identified at V0 = {V0:.4g} has no flutter "
                                       f"crossing in V ∈ {vr}: {flutter.message}; widen "
@@ -195,16 +245,16 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
            else fit_report(model, data, "simulation"))
     prog.note(f"{model}; fit error % " + ", ".join(f"{e:.3f}" for e in fit.error_percent))
     prog.note(f"ROM Vf = {Vf if Vf is not None else float('nan'):.4f}; truth Vf = "
-              f"{flutter_truth.Vf if flutter_truth.flutter else float('nan'):.4f}")
+              f"{flutter_truth.Vf if flutter_truth and flutter_truth.flutter else float('nan'):.4f}")
     out.update(data=data, identification=ident, identification_history=tuple(history),
                fit=fit, realization=real, system=system, flutter=flutter,
                flutter_truth=flutter_truth)
     crit = _mode(flutter)
 
-    if "frozen" in cfg.stages:
+    if "frozen" in cfg.stages and "frozen" not in skipped:
         with prog.stage("frozen"):
             out["flutter_frozen"] = find_flutter(frozen_aero_truth(truth, V0), vr, **flutter_kw)
-    if "parametric" in cfg.stages:
+    if "parametric" in cfg.stages and "parametric" not in skipped:
         with prog.stage("parametric"):
             speeds = speed_nodes(vr, cfg.parametric.n_speeds)
             prom = ParametricROM(speeds, tuple(
@@ -239,11 +289,11 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
                                                V=np.linspace(lo * Vf, hi * Vf,
                                                              cfg.verify.n_sweep))
         out.update(lft=lft, synthesis=syn, controller=K, verification=ver)
-    if "closed_loop" in cfg.stages:
+    if "closed_loop" in cfg.stages and "closed_loop" not in skipped:
         with prog.stage("closed_loop"):
             out["closed_loop"] = _closed_loop(cfg, truth, model, system, out["lft"],
                                               out["controller"], flutter, flutter_truth, rows)
-    if "suppression" in cfg.stages:
+    if "suppression" in cfg.stages and "suppression" not in skipped:
         with prog.stage("suppression"):
             # the truth flutters at its own speed: suppress its LCO there (paper Fig. 11 was
             # measured on the real wing at an LCO condition)
@@ -291,10 +341,12 @@ def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth, prog) 
     crit = _mode(flutter)
     sim = simulate_loop(model, structure, V_lco, int(round(lc.duration / model.dt)),
                         xs0=structure.displaced_state(crit, lc.initial_deflection))
-    V_truth = (float(flutter_truth.Vf) * lc.speed_factor if flutter_truth.flutter is not None
-               else V_lco)
-    tr = truth_lco(truth, V_truth, lc.duration, crit, lc.initial_deflection, dt=model.dt,
-                   sensor_rows=structure.Hs, sensor=structure.sensor)
+    tr = None
+    if truth is not None:
+        V_truth = (float(flutter_truth.Vf) * lc.speed_factor
+                   if flutter_truth.flutter is not None else V_lco)
+        tr = truth_lco(truth, V_truth, lc.duration, crit, lc.initial_deflection, dt=model.dt,
+                       sensor_rows=structure.Hs, sensor=structure.sensor)
     prog.note(f"ROM LCO at V = {V_lco:.4f} (exact-order Hopf {V_hopf:.4f}): "
               f"{sim.sensors.kind}, {sim.sensors.frequency_hz:.3f} Hz")
     return LcoResult(rom=sim, truth=tr, V=V_lco, V_hopf_exact_order=V_hopf,

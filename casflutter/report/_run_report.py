@@ -88,11 +88,12 @@ def write_figures(out: Path, result) -> dict:
     real = result.realization
     files["hankel"] = _save(plot_hankel(real.hankel_singular_values, real.order),
                             out / "hankel_singular_values.png")
-    fp = flap_pulse_comparison(result.truth, model, result.system.structure,
-                               result.config.data.V0, dt=model.dt)
-    files["fig8_flap_pulses"] = _save(plot_flap_pulses(fp["timepts"], fp["truth_zm"],
-                                                       fp["rom_zm"], fp["v"]),
-                                      out / "fig8_flap_pulses.png")
+    if result.truth is not None:   # a wing file has no truth to compare with
+        fp = flap_pulse_comparison(result.truth, model, result.system.structure,
+                                   result.config.data.V0, dt=model.dt)
+        files["fig8_flap_pulses"] = _save(plot_flap_pulses(fp["timepts"], fp["truth_zm"],
+                                                           fp["rom_zm"], fp["v"]),
+                                          out / "fig8_flap_pulses.png")
     if result.lco is not None:
         files["fig9_lco"] = _save(plot_lco(result.lco.rom, truth=result.lco.truth),
                                   out / "fig9_lco.png")

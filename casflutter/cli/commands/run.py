@@ -18,8 +18,9 @@ def _main(args) -> int:
         f"nf = {s['nf']}, ns = {s['ns']}, nae = {s['nae']}",
         "ROM fit error per mode [%]: " + ", ".join(f"{e:.3f}" for e in s["fit_error_percent"]),
         f"flutter (ROM):   V = {fl['V']}, {fl['freq_hz']} Hz, mode {fl['mode']}",
-        f"flutter (truth): V = {ft['V']}, {ft['freq_hz']} Hz, mode {ft['mode']}",
     ]
+    if ft is not None:
+        lines.append(f"flutter (truth): V = {ft['V']}, {ft['freq_hz']} Hz, mode {ft['mode']}")
     if s["lco"] is not None:
         lines.append(f"LCO: {s['lco']['freq_hz']} Hz ({s['lco']['kind']})")
     if s["controller"] is not None:
@@ -29,6 +30,8 @@ def _main(args) -> int:
     if s["suppression"] is not None:
         lines.append(f"suppression: attenuation {s['suppression']['attenuation_percent']} %, LCO "
                      f"returns on release: {s['suppression']['lco_returns']}")
+    for stage, why in s["skipped"].items():
+        lines.append(f"skipped {stage}: {why}")
     if res.interval_ok is not None or res.closed_loop is not None:
         lines.append(f"checks passed: {res.success}")
     lines.append(f"total {s['timings_s']['total']:.1f} s; outputs in {res.out_dir}/")
