@@ -28,6 +28,14 @@ at its own ``V0``; the stages that need the truth (its flutter search, ``frozen`
 ``parametric``, the truth's LCO, ``closed_loop``, ``suppression``) are skipped with a logged
 note and listed in ``RunResult.skipped``.
 
+A wing file with frequency-domain aerodynamics (``kind = "gaf"``: modal data and ``Q(ik)``,
+:class:`casflutter.truth.GAFProblem`) replaces stages 1-5 by the rational-function
+approximation (``rfa``, :func:`casflutter.realize.fit_rfa`), the flutter search of ΣAE(U) in
+the airspeed with the p–k solution on the same table beside it (``flutter``), and Σf of the
+RFA frozen at the flutter speed with ΣAE(V) (``realize``, ``structure``); the ``controller``
+stage then runs on that ΣAE (the LFT of eq. 14 is exact at Vf).  The RFA is linear: ``lco`` is
+skipped with the truth-only stages.
+
 Two configurations ship with the package: ``problems/seed_wing/run.toml`` (the paper's
 study, ``casflutter run``) and ``problems/typical_section/flutter_check.toml`` (an order-2
 controller designed on the ROM identified at its own flutter speed and checked on the
@@ -50,16 +58,18 @@ from scipy.io import savemat
 
 from .._linalg import spectral_abscissa
 from .._settings import settings_as
-from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, build_lft,
+from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, RFASystem,
+                           build_lft, pk_flutter,
                            find_flutter, simulate_loop)
 from ..data import envelope_growth_rate
 from ..design import SynthesisOptions, design_flutter_controller
 from ..errors import CasflutterError, ConfigError
 from ..ident import (IdentificationResult, IdentificationSettings, fit_report, identify,
                      identify_common_denominator)
-from ..realize import ParametricROM, realize, speed_nodes
+from ..realize import ParametricROM, RFASettings, fit_rfa, realize, speed_nodes
 from ..report import write_figures, write_html
-from ..truth import (AeroelasticTruth, RecordSettings, WingProblem, closed_loop_truth, frozen_aero_truth, suppression_run,
+from ..truth import (AeroelasticTruth, GAFProblem, RecordSettings, WingProblem,
+                     closed_loop_truth, frozen_aero_truth, suppression_run,
                      truth_lco, truth_loop_matrix, truth_loop_sweep, truth_records)
 from ..verify import controller_to_json, speed_sweep, verify_controller
 from ._config import RunConfig, load_config
@@ -111,6 +121,80 @@ def _stage_names(cfg: RunConfig, skipped=()) -> list[str]:
     return names
 
 
+def _gaf_setup(cfg: RunConfig, gaf: GAFProblem) -> tuple[RFASettings, dict]:
+    """The RFA settings of a GAF wing file and the stages it skips; checked before any work."""
+    try:
+        settings = RFASettings(**gaf.rfa)
+    except ConfigError as exc:
+        raise ConfigError(f"[gaf] of the wing file {gaf.path}: {exc}") from None
+    if "controller" in cfg.stages and settings.poly_order != 0:
+        raise ConfigError(f"stages: 'controller' on the GAF problem {gaf.name!r} needs the "
+                          "frozen Σf of eq. 5, which is proper only without p, p^2 terms; set "
+                          f"gaf.poly_order = 0 in {gaf.path} (now {settings.poly_order}) or "
+                          "drop the controller stage")
+    if cfg.sensors.kind != gaf.structure.sensor:
+        raise ConfigError(f"sensors.kind = {cfg.sensors.kind!r} of the run configuration "
+                          f"differs from sensors.kind = {gaf.structure.sensor!r} of the wing "
+                          f"file {gaf.path}; set [sensors] kind = "
+                          f"\"{gaf.structure.sensor}\" in the run configuration")
+    why = f"needs a truth simulator; the wing file {gaf.name!r} has Q(ik) only"
+    skipped = {k: f"{v}: {why}" for k, v in _TRUTH_ONLY.items()
+               if k in {"flutter_truth"} | set(cfg.stages)}
+    if "lco" in cfg.stages:
+        skipped["lco"] = ("stage 'lco': the RFA of Q(ik) is linear (no LCO); it needs "
+                          "records of a nonlinear model or a truth simulator")
+    for text in skipped.values():
+        log.info("skipped %s", text)
+    return settings, skipped
+
+
+def _pk_modes(gaf: GAFProblem, U_lo: float) -> tuple[int, ...]:
+    """The modes p–k can follow from ``U_lo``: in-vacuo reduced frequency ``omega b / U_lo``
+    within 0.8 of the table's largest ``k`` (the iteration must stay inside the table)."""
+    k_vac = gaf.structure.omega * gaf.table.b / U_lo
+    modes = tuple(int(i) for i in np.flatnonzero(k_vac <= 0.8 * gaf.table.k[-1]))
+    return modes or (0,)
+
+
+def _run_gaf(cfg: RunConfig, gaf: GAFProblem, settings: RFASettings, structure, prog,
+             out: dict) -> None:
+    """Stages of a GAF wing file (module docstring): RFA, flutter in m/s with p–k, frozen Σf
+    and ΣAE(V), and the controller stage on it."""
+    U_lo, U_hi = gaf.U_range
+    with prog.stage("rfa"):
+        rfa = fit_rfa(gaf.table, settings)
+        rsys = RFASystem(rfa, structure, gaf.U_ref)
+    prog.note(f"{rfa.summary()}")
+    with prog.stage("flutter"):
+        fl_U = find_flutter(rsys, (U_lo, U_hi), n_grid=gaf.n_grid,
+                            max_refine=cfg.flutter.max_refine)
+        pk = pk_flutter(gaf.table, structure, np.linspace(U_lo, U_hi, 29),
+                        modes=_pk_modes(gaf, U_lo))
+    prog.note(f"RFA ΣAE(U): Uf = {fl_U.Vf if fl_U.Vf is not None else float('nan'):.4f} m/s, "
+              f"{fl_U.omega_f if fl_U.omega_f is not None else float('nan'):.4f} rad/s; p–k: "
+              f"{pk.flutter_speed if pk.found else float('nan'):.4f} m/s")
+    if fl_U.Vf is None:
+        raise CasflutterError(f"the RFA system of {gaf.name!r} has no flutter crossing in "
+                              f"U ∈ [{U_lo:g}, {U_hi:g}] m/s: {fl_U.message}; widen "
+                              "gaf.U_range")
+    out.update(rfa=rfa, rfa_system=rsys, rfa_flutter=fl_U, pk=pk)
+    if settings.poly_order != 0:   # no proper Σf: the flutter route ends here
+        out.update(system=None, flutter=None)
+        return
+    Vf = float(fl_U.Vf) / gaf.U_ref
+    with prog.stage("realize"):
+        sigma_f = rsys.frozen_sigma_f(float(fl_U.Vf))
+    with prog.stage("structure"):
+        system = AeroelasticSystem.from_parts(sigma_f, structure, warn_unstable=False)
+        flutter = find_flutter(system, cfg.flutter.V_range, n_grid=cfg.flutter.n_grid,
+                               max_refine=cfg.flutter.max_refine)
+    if flutter.Vf is None or abs(flutter.Vf / Vf - 1) > 1e-3:
+        prog.note(f"warning: ΣAE(V) of Σf frozen at Uf flutters at V = {flutter.Vf} in "
+                  f"{cfg.flutter.V_range}, not at Uf / U_ref = {Vf:.6g}; the LFT is built at "
+                  "Uf / U_ref, where the frozen system is exact")
+    out.update(system=system, flutter=flutter, gaf_Vf=Vf)
+
+
 def _wing_setup(cfg: RunConfig, wing: WingProblem) -> tuple[RunConfig, dict]:
     """A wing file's configuration (``data.V0`` the records' speed) and the truth-only stages
     it skips, ``{stage: reason}``; checked before any work."""
@@ -128,7 +212,7 @@ def _wing_setup(cfg: RunConfig, wing: WingProblem) -> tuple[RunConfig, dict]:
                                                      else set())
     skipped = {k: f"{v}: {why}" for k, v in _TRUTH_ONLY.items() if k in wanted}
     for text in skipped.values():
-        log.warning("skipped %s", text)
+        log.info("skipped %s", text)
     return replace(cfg, data=replace(cfg.data, V0=float(wing.V0))), skipped
 
 
@@ -195,11 +279,16 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
     skipped: dict = {}
     if isinstance(problem, WingProblem):
         cfg, skipped = _wing_setup(cfg, problem)
+    elif isinstance(problem, GAFProblem):
+        rfa_settings, skipped = _gaf_setup(cfg, problem)
     elif truth is None:
         raise ConfigError(f"problem.name = {cfg.problem.name!r} is a {type(problem).__name__}, "
                           "which casflutter.pipeline.run does not take; give a truth problem "
                           "or a wing file (kind = \"wing\")")
-    prog = _Progress(quiet, _stage_names(cfg, skipped))
+    names = _stage_names(cfg, skipped)
+    if isinstance(problem, GAFProblem):
+        names = ["rfa", "flutter", "realize", "structure"] + names[5:]
+    prog = _Progress(quiet, names)
     for text in skipped.values():
         prog.note(f"skipped {text}")
     structure = problem.modal_structure().with_sensors(cfg.sensors.rows or None,
@@ -210,6 +299,14 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
     flutter_kw = dict(n_grid=cfg.flutter.n_grid, max_refine=cfg.flutter.max_refine)
     needs_vf = cfg.rom.v0_iterations > 1 or bool(set(cfg.stages) & {"lco", "controller"})
     out: dict = {"config": cfg, "truth": truth, "problem": problem, "skipped": skipped}
+    if isinstance(problem, GAFProblem):
+        _run_gaf(cfg, problem, rfa_settings, structure, prog, out)
+        Vf = out.pop("gaf_Vf", None)
+        out.update(data=None, identification=None, identification_history=(), fit=None,
+                   realization=None, flutter_truth=None)
+        if "controller" in cfg.stages and "controller" not in skipped:
+            _controller_stages(cfg, out["system"], Vf, prog, out)
+        return _finish(out, prog, out_dir, write)
 
     # 1-5: records, ROM, Σf, ΣAE, flutter; repeated at the ROM's own flutter speed
     V0, history = cfg.data.V0, []
@@ -267,28 +364,7 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
         with prog.stage("lco"):
             out["lco"] = _lco(cfg, truth, model, structure, flutter, flutter_truth, prog)
     if "controller" in cfg.stages:
-        with prog.stage("lft"):
-            lft = build_lft(system, Vf)
-        with prog.stage("controller"):
-            c = cfg.controller
-            options = replace(settings_as(c, SynthesisOptions),
-                              ipopt={**cfg.solver.ipopt, **c.ipopt})
-            # γ of the LFT at Vf (eq. 14-16), each design plant with its own loop shift, and
-            # ΣAE(V) kept stable over controller.interval; K acts on the physical sensors
-            design = design_flutter_controller(
-                system, Vf, c.order, speeds=tuple(c.speeds), interval=tuple(c.interval),
-                n_speeds=c.n_speeds, decay=c.interval_decay, steps=c.steps, starts=c.starts,
-                seed=cfg.seed, options=options)
-            syn, K = design.synthesis, design.controller
-        with prog.stage("verify"):
-            ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
-            if cfg.verify.sweep:
-                lo, hi = cfg.verify.sweep
-                out["rom_sweep"] = speed_sweep(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf,
-                                               n_delta=lft.n_delta,
-                                               V=np.linspace(lo * Vf, hi * Vf,
-                                                             cfg.verify.n_sweep))
-        out.update(lft=lft, synthesis=syn, controller=K, verification=ver)
+        _controller_stages(cfg, system, Vf, prog, out)
     if "closed_loop" in cfg.stages and "closed_loop" not in skipped:
         with prog.stage("closed_loop"):
             out["closed_loop"] = _closed_loop(cfg, truth, model, system, out["lft"],
@@ -313,6 +389,36 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
                 truth, out["controller"], float(V_ref), cfg.suppression, dt=model.dt,
                 mode=crit, deflection=cfg.lco.initial_deflection, sensor_rows=rows,
                 sensor=cfg.sensors.kind, x0=x0)
+    return _finish(out, prog, out_dir, write)
+
+
+def _controller_stages(cfg: RunConfig, system, Vf: float, prog, out: dict) -> None:
+    """The LFT at Vf (eq. 10-15), the fixed-order synthesis (§III.C) and the verification."""
+    with prog.stage("lft"):
+        lft = build_lft(system, Vf)
+    with prog.stage("controller"):
+        c = cfg.controller
+        options = replace(settings_as(c, SynthesisOptions),
+                          ipopt={**cfg.solver.ipopt, **c.ipopt})
+        # γ of the LFT at Vf (eq. 14-16), each design plant with its own loop shift, and
+        # ΣAE(V) kept stable over controller.interval; K acts on the physical sensors
+        design = design_flutter_controller(
+            system, Vf, c.order, speeds=tuple(c.speeds), interval=tuple(c.interval),
+            n_speeds=c.n_speeds, decay=c.interval_decay, steps=c.steps, starts=c.starts,
+            seed=cfg.seed, options=options)
+        syn, K = design.synthesis, design.controller
+    with prog.stage("verify"):
+        ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
+        if cfg.verify.sweep:
+            lo, hi = cfg.verify.sweep
+            out["rom_sweep"] = speed_sweep(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf,
+                                           n_delta=lft.n_delta,
+                                           V=np.linspace(lo * Vf, hi * Vf, cfg.verify.n_sweep))
+    out.update(lft=lft, synthesis=syn, controller=K, verification=ver)
+
+
+def _finish(out: dict, prog, out_dir, write: bool) -> RunResult:
+    """The result with its timings, and its files when ``write``."""
     timings = dict(prog.timings)
     timings["total"] = time.perf_counter() - prog.t0
     result = RunResult(**out, timings=timings)
@@ -413,8 +519,9 @@ def _write_outputs(out: Path, result: RunResult) -> dict:
         json.dump(summary, fh, indent=2)
     tmp.replace(out / "summary.json")
     files["summary"] = out / "summary.json"
-    result.identification.model.save(out / "rom.npz")
-    files["rom"] = out / "rom.npz"
+    if result.identification is not None:   # a GAF wing file has an RFA, no ROM
+        result.identification.model.save(out / "rom.npz")
+        files["rom"] = out / "rom.npz"
     K = result.controller
     if K is not None:
         with open(out / "controller.json", "w") as fh:

@@ -82,8 +82,16 @@ def write_figures(out: Path, result) -> dict:
         Figure name -> path.
     """
     out = Path(out)
-    model = result.identification.model
     files = {}
+    if result.identification is None:   # a GAF wing file: no records, ROM or ERA
+        if result.rfa_flutter is not None:
+            fig = plot_vg_vf(result.rfa_flutter, hz=False)
+            fig.axes[-1].set_xlabel("airspeed U [m/s]")
+            files["vg_vf_airspeed"] = _save(fig, out / "vg_vf_airspeed.png")
+        if result.flutter is not None:
+            files["vg_vf"] = _save(plot_vg_vf(result.flutter), out / "vg_vf.png")
+        return files
+    model = result.identification.model
     files["fig7_rom_fit"] = _save(plot_rom_fit(model, result.data), out / "fig7_rom_fit.png")
     real = result.realization
     files["hankel"] = _save(plot_hankel(real.hankel_singular_values, real.order),

@@ -42,6 +42,8 @@ Layout (paths are relative to the file's folder)::
     flap = "flap"                  # channel of the flap [rad] (optional)
     forces = ["Q1", "Q2"]          # channels of the generalised forces y, in mode order
 
+    [reference]                    # optional, free-form: published values for the record
+
     [gaf]                          # kind = "gaf"
     file = "q.npz"                 # Q(ik) table (casflutter.data.load_gaf: NPZ, CSV, .mat)
     U_range = [60.0, 200.0]        # airspeeds [m/s] of the flutter search
@@ -77,7 +79,7 @@ log = logging.getLogger("casflutter.truth.wing_file")
 WING_KIND = "wing"
 GAF_KIND = "gaf"
 
-_TOP = {"kind", "problem", "modes", "speed", "sensors"}
+_TOP = {"kind", "problem", "modes", "speed", "sensors", "reference"}
 _MODES = {"names", "frequencies_hz", "damping", "alpha"}
 _SPEED = {"U_ref", "rho"}
 _SENSORS = {"kind", "names", "units", "rows"}
