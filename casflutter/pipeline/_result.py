@@ -365,7 +365,8 @@ class RunResult:
             ``problem``, ``V0``, ``n_sensors``, ``orders``, ``n_params``,
             ``fit_error_percent``, ``nf``, ``ns``, ``nae``, ``flutter``, ``flutter_truth``,
             ``lco``, ``controller``, ``suppression`` (``None`` when the stage did not run),
-            ``timings_s``, ``seed``, ``skipped`` (stage -> reason); and, for the stages that ran, ``v0_history``,
+            ``timings_s``, ``seed``; ``skipped`` (stage -> reason) when a stage was
+            skipped; and, for the stages that ran, ``v0_history``,
             ``flutter_frozen``, ``flutter_parametric``, ``verification`` and
             ``closed_loop``.
         """
@@ -399,8 +400,9 @@ class RunResult:
                 "flap_rate_limit": cfg.suppression.flap_rate_limit},
             "timings_s": dict(self.timings),
             "seed": cfg.seed,
-            "skipped": dict(self.skipped),
         }
+        if self.skipped:
+            out["skipped"] = dict(self.skipped)
         if cfg.rom.v0_iterations > 1:
             out["v0_history"] = [list(map(float, p)) for p in self.identification_history]
         if self.flutter_frozen is not None:

@@ -169,6 +169,29 @@ class _Wing:
         """
         return self.structure
 
+    @property
+    def params(self) -> "_Wing":
+        """The wing itself (its :meth:`describe` lists the file's values)."""
+        return self
+
+    def describe(self) -> list[tuple]:
+        """``(name, value, unit, meaning)`` of the file's scalars and modes (for listings).
+
+        Returns
+        -------
+        list of tuple
+        """
+        s = self.structure
+        rows = [("alpha", s.alpha, "-", "flow constant of eq. 6"),
+                ("U_ref", self.U_ref, "m/s", "airspeed per unit speed index"),
+                ("rho", self.rho if self.rho is not None else "-", "kg/m^3", "air density")]
+        for name, w, z in zip(s.mode_names, s.omega, s.zeta):
+            rows.append((f"f[{name}]", float(w / (2 * np.pi)), "Hz",
+                         f"in-vacuo frequency, damping ratio {z:g}"))
+        for name, unit in zip(s.sensor_names, self.sensor_units):
+            rows.append((f"sensor[{name}]", s.sensor, unit or "-", "row of Hs"))
+        return rows
+
     def airspeed(self, V):
         """Airspeed ``U = V U_ref`` [m/s] of a speed index."""
         return float(V) * self.U_ref
@@ -195,8 +218,8 @@ class _Wing:
         source = f"wing file {path}"
         unknown = sorted(k for k in data if k not in _TOP | extra)
         if unknown:
-            raise ConfigError(f"{source}: unknown key or table {unknown[0]!r}; allowed: "
-                              f"{', '.join(sorted(_TOP | extra))}")
+            raise ConfigError(f"{source}: unknown key or table {unknown[0]!r} for 'kind' = "
+                              f"{kind!r}; allowed: {', '.join(sorted(_TOP | extra))}")
         info = _table(data, "problem", source, {"name", "description", "source"}, False)
         modes = _table(data, "modes", source, _MODES)
         f = _numbers(_need(modes, "modes", "frequencies_hz", source,

@@ -30,7 +30,7 @@ def _main(args) -> int:
     if s["suppression"] is not None:
         lines.append(f"suppression: attenuation {s['suppression']['attenuation_percent']} %, LCO "
                      f"returns on release: {s['suppression']['lco_returns']}")
-    for stage, why in s["skipped"].items():
+    for stage, why in s.get("skipped", {}).items():
         lines.append(f"skipped {stage}: {why}")
     if res.interval_ok is not None or res.closed_loop is not None:
         lines.append(f"checks passed: {res.success}")
