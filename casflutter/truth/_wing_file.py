@@ -41,6 +41,7 @@ Layout (paths are relative to the file's folder)::
     displacements = ["u1", "u2"]   # channels of the modal displacements, in mode order
     flap = "flap"                  # channel of the flap [rad] (optional)
     forces = ["Q1", "Q2"]          # channels of the generalised forces y, in mode order
+                                   #   (eq. 6 normalisation: the modal force is alpha V0^2 y)
 
     [reference]                    # optional, free-form: published values for the record
 

@@ -81,6 +81,13 @@ def test_goland_gaf_flutter_through_the_cli_within_one_percent_of_published(caps
 def test_gaf_problem_flags_that_do_not_apply_are_refused(capsys):
     assert main(["flutter", str(ROOT / "goland_gaf"), "--v0", "100"]) != 0
     assert "--v0 does not apply" in capsys.readouterr().err
+    assert main(["flutter", str(ROOT / "goland_gaf"), "--set", "alpha=2"]) != 0
+    assert "no parameters to change" in capsys.readouterr().err
+
+
+def test_flutter_command_on_a_records_wing_file_points_at_casflutter_run(capsys):
+    assert main(["flutter", "example_wing"]) != 0
+    assert "casflutter run" in capsys.readouterr().err
 
 
 @pytest.mark.slow

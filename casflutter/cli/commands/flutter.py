@@ -34,7 +34,9 @@ def register(subparsers) -> None:
                     "with a parametric ROM interpolated in V; compare with the truth.  Speeds "
                     "in the problem's unit (speed index for the typical section, m/s for the "
                     "Goland wing).")
-    p.add_argument("problem", help="problem name (see `casflutter problems`) or rig TOML file")
+    p.add_argument("problem", help="problem name (see `casflutter problems`), rig TOML file, "
+                                   "or GAF wing file (kind = \"gaf\", e.g. "
+                                   "problems/goland_gaf: RFA flutter in m/s with p-k)")
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="NAME=VALUE",
                    help="change a problem parameter (repeatable)")
     p.add_argument("--vrange", nargs=2, type=float, metavar=("LO", "HI"), default=None,
@@ -248,7 +250,8 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
 def run(args) -> int:
     """Handler: run the route, print or write JSON, save the figure."""
     from ...pipeline import flutter_config, run as run_config
-    from ...truth import GAFProblem, load_problem, parse_sets, problem_label
+    from ...errors import ConfigError
+    from ...truth import GAFProblem, WingProblem, load_problem, parse_sets, problem_label
 
     fig_path = None                  # figures only where asked, checked before the work
     if args.figure is not None and args.figure.lower() != "none":
@@ -258,6 +261,11 @@ def run(args) -> int:
     label = problem_label(args.problem)
     if isinstance(truth, GAFProblem):
         return _run_gaf(args, truth, label, fig_path)
+    if isinstance(truth, WingProblem):
+        raise ConfigError(f"{args.problem} is a wing file with records (kind = \"wing\"): "
+                          "its flutter speed comes from `casflutter run` with a run "
+                          "configuration whose [problem] name is the file (e.g. "
+                          "problems/example_wing/run.toml, stages = [] for flutter only)")
     label = problem_label(args.problem)
     _, from_unit, vunit = _speed_conv(truth)
     updates = {"problem.set": changes}
