@@ -70,7 +70,10 @@ class ProblemSection:
     """``[problem]``: which truth, and its parameter changes."""
 
     name: str = "seed_wing"
-    """A problem name (``casflutter problems``) or the path of a problem TOML file."""
+    """A problem name (``casflutter problems``) or the path of a problem TOML file: a rig
+    section, or a wing file without a simulator (``kind = "wing"`` with records, ``"gaf"``
+    with ``Q(ik)``; :class:`casflutter.truth.WingProblem`); a relative path is looked up
+    beside the configuration file first."""
     set: dict = field(default_factory=dict)
     """Parameter changes ``{name = value}``, checked by the truth's parameter class."""
 

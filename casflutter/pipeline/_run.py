@@ -121,6 +121,15 @@ def _stage_names(cfg: RunConfig, skipped=()) -> list[str]:
     return names
 
 
+def _same_sensors(cfg: RunConfig, wing) -> None:
+    """The run's ``[sensors] kind`` must be the wing file's (its rows are read that way)."""
+    if cfg.sensors.kind != wing.structure.sensor:
+        raise ConfigError(f"sensors.kind = {cfg.sensors.kind!r} of the run configuration "
+                          f"differs from sensors.kind = {wing.structure.sensor!r} of the wing "
+                          f"file {wing.path}; set [sensors] kind = "
+                          f"\"{wing.structure.sensor}\" in the run configuration")
+
+
 def _gaf_setup(cfg: RunConfig, gaf: GAFProblem) -> tuple[RFASettings, dict]:
     """The RFA settings of a GAF wing file and the stages it skips; checked before any work."""
     try:
@@ -132,11 +141,7 @@ def _gaf_setup(cfg: RunConfig, gaf: GAFProblem) -> tuple[RFASettings, dict]:
                           "frozen Σf of eq. 5, which is proper only without p, p^2 terms; set "
                           f"gaf.poly_order = 0 in {gaf.path} (now {settings.poly_order}) or "
                           "drop the controller stage")
-    if cfg.sensors.kind != gaf.structure.sensor:
-        raise ConfigError(f"sensors.kind = {cfg.sensors.kind!r} of the run configuration "
-                          f"differs from sensors.kind = {gaf.structure.sensor!r} of the wing "
-                          f"file {gaf.path}; set [sensors] kind = "
-                          f"\"{gaf.structure.sensor}\" in the run configuration")
+    _same_sensors(cfg, gaf)
     why = f"needs a truth simulator; the wing file {gaf.name!r} has Q(ik) only"
     skipped = {k: f"{v}: {why}" for k, v in _TRUTH_ONLY.items()
                if k in {"flutter_truth"} | set(cfg.stages)}
@@ -202,11 +207,7 @@ def _wing_setup(cfg: RunConfig, wing: WingProblem) -> tuple[RunConfig, dict]:
         raise ConfigError(f"rom.v0_iterations = {cfg.rom.v0_iterations}: the records of the "
                           f"wing file {wing.path} are taken at one speed (V0 = {wing.V0:g}); "
                           "set rom.v0_iterations = 1")
-    if cfg.sensors.kind != wing.structure.sensor:
-        raise ConfigError(f"sensors.kind = {cfg.sensors.kind!r} of the run configuration "
-                          f"differs from sensors.kind = {wing.structure.sensor!r} of the wing "
-                          f"file {wing.path}; set [sensors] kind = "
-                          f"\"{wing.structure.sensor}\" in the run configuration")
+    _same_sensors(cfg, wing)
     why = f"needs a truth simulator; the wing file {wing.name!r} has records only"
     wanted = {"flutter_truth"} | set(cfg.stages) | ({"truth_lco"} if "lco" in cfg.stages
                                                      else set())

@@ -353,23 +353,18 @@ class WingProblem(_Wing):
     V0: float = 0.0
 
     @classmethod
-    def from_mapping(cls, data: Mapping[str, Any], name: str | None = None,
-                     source: str = "wing file", sets: Iterable[str] = (),
-                     path: Path | None = None) -> "WingProblem":
+    def from_mapping(cls, data: Mapping[str, Any], *, path, sets: Iterable[str] = ()
+                     ) -> "WingProblem":
         """The wing of a ``kind = "wing"`` file's tables; record paths relative to ``path``.
 
         Parameters
         ----------
         data : mapping
             The file's tables.
-        name : str, optional
-            Overrides ``[problem] name``.
-        source : str
-            Unused (the messages name the file).
+        path : str or Path
+            The file (named in the messages; its folder resolves the record paths).
         sets : iterable
             Must be empty: a wing file has no parameters to change.
-        path : Path
-            The file (its folder resolves the record paths).
 
         Returns
         -------
@@ -382,7 +377,7 @@ class WingProblem(_Wing):
         DataError
             A missing or unreadable record file, an unknown channel, non-finite samples.
         """
-        path = Path(path or "wing.toml")
+        path = Path(path)
         _no_sets(sets, path, WING_KIND)
         common = cls._common(data, path, WING_KIND, {"records"})
         src = f"wing file {path}"
@@ -428,11 +423,10 @@ class WingProblem(_Wing):
         if len(dts) != 1:
             raise DataError(f"{src}: the record files have different sampling times "
                             f"{sorted(dts)}; resample them to one")
+        log.debug("%s: %d record files, dt = %g s", path, len(files), datas[0].dt)
         records = IOData(tuple(r for d in datas for r in d.records), datas[0].dt,
                          output_names=tuple(forces), u_names=tuple(disp or ()),
                          v_name=flap or "v", meta={"V": V0, "source": str(path)})
-        if name:
-            common["name"] = name
         return cls(**common, records=records, V0=V0)
 
     def __repr__(self) -> str:
@@ -462,15 +456,18 @@ class GAFProblem(_Wing):
     rfa: dict = field(default_factory=dict)
 
     @classmethod
-    def from_mapping(cls, data: Mapping[str, Any], name: str | None = None,
-                     source: str = "wing file", sets: Iterable[str] = (),
-                     path: Path | None = None) -> "GAFProblem":
+    def from_mapping(cls, data: Mapping[str, Any], *, path, sets: Iterable[str] = ()
+                     ) -> "GAFProblem":
         """The wing of a ``kind = "gaf"`` file's tables; the table path relative to ``path``.
 
         Parameters
         ----------
-        data, name, source, sets, path
-            As :meth:`WingProblem.from_mapping`.
+        data : mapping
+            The file's tables.
+        path : str or Path
+            The file (its folder resolves ``gaf.file``).
+        sets : iterable
+            Must be empty: a GAF file has no parameters to change.
 
         Returns
         -------
@@ -484,7 +481,7 @@ class GAFProblem(_Wing):
             A missing or malformed ``Q(ik)`` file, or one whose modes or ``U_ref`` do not
             match the modal data.
         """
-        path = Path(path or "wing.toml")
+        path = Path(path)
         _no_sets(sets, path, GAF_KIND)
         common = cls._common(data, path, GAF_KIND, {"gaf"})
         src = f"wing file {path}"
@@ -513,8 +510,6 @@ class GAFProblem(_Wing):
         if isinstance(n_grid, bool) or not isinstance(n_grid, int) or n_grid < 3:
             raise ConfigError(f"{src}: gaf.n_grid = {n_grid!r} must be an integer >= 3")
         rfa = {k: g[k] for k in _RFA_KEYS if k in g}
-        if name:
-            common["name"] = name
         return cls(**common, table=table, U_range=(float(ur[0]), float(ur[1])),
                    n_grid=n_grid, rfa=rfa)
 
