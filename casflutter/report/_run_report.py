@@ -85,7 +85,9 @@ def write_figures(out: Path, result) -> dict:
     files = {}
     if result.identification is None:   # a GAF wing file: no records, ROM or ERA
         if result.rfa_flutter is not None:
-            fig = plot_vg_vf(result.rfa_flutter, hz=False)
+            fl = result.rfa_flutter     # the structural branches, not the lag roots
+            modes = [b for b in fl.tracking.upper_branches() if fl.origin[b] >= 0]
+            fig = plot_vg_vf(fl, branches=modes, hz=False)
             fig.axes[-1].set_xlabel("airspeed U [m/s]")
             files["vg_vf_airspeed"] = _save(fig, out / "vg_vf_airspeed.png")
         if result.flutter is not None:

@@ -205,9 +205,11 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
         from ...report import plot_vg_vf
 
         Path(fig_path).parent.mkdir(parents=True, exist_ok=True)
-        fig = plot_vg_vf(result.rfa_flutter, hz=False)
+        pk, fl = result.pk, result.rfa_flutter
+        low = [b for b in fl.tracking.upper_branches() if fl.origin[b] in pk.modes]
+        fig = plot_vg_vf(fl, branches=low, hz=False)
         ag, af = fig.axes
-        pk = result.pk
+        ag.set_title(f"Uf = {fl.Vf:.2f} m/s, {fl.omega_f:.2f} rad/s")
         for j in range(len(pk.modes)):
             ag.plot(pk.U, pk.damping_ratio[:, j], "ko", ms=3, mfc="none",
                     label="p–k" if j == 0 else None)
