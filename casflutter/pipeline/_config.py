@@ -522,6 +522,17 @@ def load_config(path=None, *, updates=None, **overrides) -> RunConfig:
     ------
     ConfigError
         A missing or malformed file, or any unknown or invalid key (named).
+
+    See Also
+    --------
+    run : runs the configuration.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> cfg = cf.load_config(updates={"controller.order": 2}, seed=3)
+    >>> cfg.controller.order, cfg.seed, cfg.problem.name
+    (2, 3, 'seed_wing')
     """
     path = Path(path) if path is not None else default_config_path()
     table = read_toml(path, "configuration file")

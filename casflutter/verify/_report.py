@@ -221,6 +221,21 @@ def verify_controller(P: SystemLike, K: SystemLike, nmeas: int, ncon: int, *,
         Loop not well posed (``I - Dk D22`` singular).
     ConfigError
         ``Vf`` without ``n_delta`` (or the reverse), or a discrete-time system.
+
+    See Also
+    --------
+    speed_sweep : the closed-loop poles on a grid of speeds.
+    synthesize : the controller design it checks.
+
+    Examples
+    --------
+    >>> import control
+    >>> import casflutter as cf
+    >>> P = control.ss([[1.0]], [[1.0, 1.0]], [[1.0], [1.0]], [[0.0, 0.0], [0.0, 0.0]])
+    >>> K = control.ss([], [], [], [[-3.0]])
+    >>> rep = cf.verify_controller(P, K, nmeas=1, ncon=1)
+    >>> rep.stable, round(rep.hinf.gamma, 4)
+    (True, 0.5)
     """
     if delta_channel is not None:
         if n_delta is not None and n_delta != delta_channel:
