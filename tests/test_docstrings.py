@@ -84,15 +84,19 @@ def test_numpydoc(qualname):
 
 
 def _attribute_docstrings(cls) -> set[str]:
-    """Fields of ``cls`` followed by a string literal in the class body (the attribute
-    docstrings Sphinx's autodoc shows)."""
-    tree = ast.parse(textwrap.dedent(inspect.getsource(cls)))
-    body = tree.body[0].body
+    """Fields of ``cls`` documented the ways Sphinx's autodoc shows: a string literal after
+    the field, or ``#:`` comment lines before it."""
+    source = textwrap.dedent(inspect.getsource(cls))
+    lines = source.splitlines()
+    body = ast.parse(source).body[0].body
     out = set()
-    for stmt, nxt in zip(body, body[1:]):
-        if (isinstance(stmt, ast.AnnAssign) and isinstance(stmt.target, ast.Name)
-                and isinstance(nxt, ast.Expr) and isinstance(nxt.value, ast.Constant)
-                and isinstance(nxt.value.value, str)):
+    for stmt, nxt in zip(body, body[1:] + [None]):
+        if not (isinstance(stmt, ast.AnnAssign) and isinstance(stmt.target, ast.Name)):
+            continue
+        after = (isinstance(nxt, ast.Expr) and isinstance(nxt.value, ast.Constant)
+                 and isinstance(nxt.value.value, str))
+        before = stmt.lineno >= 2 and lines[stmt.lineno - 2].strip().startswith("#:")
+        if after or before:
             out.add(stmt.target.id)
     return out
 

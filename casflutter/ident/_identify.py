@@ -161,7 +161,19 @@ class IdentificationSettings:
     @classmethod
     def build(cls, settings=None, **kwargs) -> "IdentificationSettings":
         """Settings from an instance and/or keyword overrides; unknown keys are a
-        :class:`~casflutter.errors.ConfigError` listing the known ones."""
+        :class:`~casflutter.errors.ConfigError` listing the known ones.
+
+        Parameters
+        ----------
+        settings : IdentificationSettings, optional
+            Settings to start from (default: the defaults).
+        **kwargs
+            Fields to replace, by name.
+
+        Returns
+        -------
+        IdentificationSettings
+        """
         names = [f.name for f in fields(cls)]
         unknown = sorted(set(kwargs) - set(names))
         if unknown:
@@ -338,7 +350,13 @@ class IdentificationResult:
         return self.model.n_params
 
     def summary(self) -> str:
-        """Human-readable report with the fit table."""
+        """Human-readable report with the fit table.
+
+        Returns
+        -------
+        str
+            Orders, solver status, costs, times and the fit error per output.
+        """
         m = self.model
         stage2 = (f"{self.settings.criterion}, {self.solver}" if self.settings.refine
                   else "skipped")

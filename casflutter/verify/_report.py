@@ -79,7 +79,12 @@ class VerificationReport:
 
     def to_dict(self) -> dict:
         """JSON-serialisable summary; a non-finite number (the infinite γ of an unstable
-        loop, an unbounded interval end) becomes ``None`` (``null``: strict JSON)."""
+        loop, an unbounded interval end) becomes ``None`` (``null``: strict JSON).
+
+        Returns
+        -------
+        dict
+        """
         def num(x):
             if x is None:
                 return None
@@ -116,7 +121,17 @@ class VerificationReport:
         return out
 
     def format(self, max_poles: int = 8) -> str:
-        """A readable multi-line report."""
+        """A readable multi-line report.
+
+        Parameters
+        ----------
+        max_poles : int
+            Number of rightmost closed-loop poles listed.
+
+        Returns
+        -------
+        str
+        """
         def f(x):
             return f"{x:.6g}" if x is not None else "-"
 
