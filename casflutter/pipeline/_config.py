@@ -70,7 +70,10 @@ class ProblemSection:
     """``[problem]``: which truth, and its parameter changes."""
 
     name: str = "seed_wing"
-    """A problem name (``casflutter problems``) or the path of a problem TOML file."""
+    """A problem name (``casflutter problems``) or the path of a problem TOML file: a rig
+    section, or a wing file without a simulator (``kind = "wing"`` with records, ``"gaf"``
+    with ``Q(ik)``; :class:`casflutter.truth.WingProblem`); a relative path is looked up
+    beside the configuration file first."""
     set: dict = field(default_factory=dict)
     """Parameter changes ``{name = value}``, checked by the truth's parameter class."""
 
@@ -531,6 +534,18 @@ def default_config_path() -> Path:
     return config_path("seed_wing", "run")
 
 
+def _relative_problem(table: dict, path: Path) -> None:
+    """A ``[problem] name`` that is a path relative to the configuration file's folder (a
+    wing file beside its run configuration) becomes that path."""
+    prob = table.get("problem")
+    name = prob.get("name") if isinstance(prob, dict) else None
+    if not isinstance(name, str) or Path(name).is_absolute() or Path(name).exists():
+        return
+    near = path.parent / name
+    if near.is_file() or (near / "problem.toml").is_file():
+        prob["name"] = str(near)
+
+
 def load_config(path=None, *, updates=None, **overrides) -> RunConfig:
     """Read and validate a run configuration (default: the seed wing's).
 
@@ -568,6 +583,12 @@ def load_config(path=None, *, updates=None, **overrides) -> RunConfig:
     """
     path = Path(path) if path is not None else default_config_path()
     table = read_toml(path, "configuration file")
+    if table.get("kind") is not None:
+        raise ConfigError(f"{path} is a problem file (kind = {table['kind']!r}), not a run "
+                          "configuration: write a run configuration whose [problem] name is "
+                          f"this file (e.g. problems/example_wing/run.toml), or pass it as "
+                          "problem.name")
+    _relative_problem(table, path)
     table.update({k: v for k, v in overrides.items() if v is not None})
     for key, value in (updates or {}).items():
         set_dotted(table, RunConfig, key, value)

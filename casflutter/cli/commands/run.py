@@ -13,13 +13,27 @@ def _main(args) -> int:
     res = run(cfg, out_dir=args.out, seed=args.seed, quiet=args.quiet)
     s = res.summary()
     fl, ft = s["flutter"], s["flutter_truth"]
-    lines = [
-        f"problem {s['problem']}: orders {tuple(s['orders'])}, {s['n_params']} parameters, "
-        f"nf = {s['nf']}, ns = {s['ns']}, nae = {s['nae']}",
-        "ROM fit error per mode [%]: " + ", ".join(f"{e:.3f}" for e in s["fit_error_percent"]),
-        f"flutter (ROM):   V = {fl['V']}, {fl['freq_hz']} Hz, mode {fl['mode']}",
-        f"flutter (truth): V = {ft['V']}, {ft['freq_hz']} Hz, mode {ft['mode']}",
-    ]
+    if s["orders"] is not None:
+        lines = [
+            f"problem {s['problem']}: orders {tuple(s['orders'])}, {s['n_params']} parameters, "
+            f"nf = {s['nf']}, ns = {s['ns']}, nae = {s['nae']}",
+            "ROM fit error per mode [%]: " + ", ".join(f"{e:.3f}"
+                                                       for e in s["fit_error_percent"])]
+    else:                            # a GAF wing file: the RFA of Q(ik) in place of the ROM
+        r = s["rfa"]
+        lines = [f"problem {s['problem']}: {r['method']} RFA, {r['n_lags']} lag roots, fit "
+                 f"error {r['fit_error']:.3g}, ns = {s['ns']}, nae = {s['nae']}"]
+        for key, label in (("flutter", "RFA ΣAE(U)"), ("pk", "p-k")):
+            b = r[key]
+            if b is not None:
+                lines.append(f"flutter ({label}): U = {b['airspeed_m_s']:.6g} m/s, "
+                             f"{b['omega_rad_s']:.6g} rad/s, mode {b['mode']}")
+    if fl is not None:
+        what = "ROM" if s["orders"] is not None else "ΣAE(V), Σf frozen at Uf"
+        lines.append(f"flutter ({what}):   V = {fl['V']}, {fl['freq_hz']} Hz, mode "
+                     f"{fl['mode']}")
+    if ft is not None:
+        lines.append(f"flutter (truth): V = {ft['V']}, {ft['freq_hz']} Hz, mode {ft['mode']}")
     if s["lco"] is not None:
         lines.append(f"LCO: {s['lco']['freq_hz']} Hz ({s['lco']['kind']})")
     if s["controller"] is not None:
@@ -29,6 +43,8 @@ def _main(args) -> int:
     if s["suppression"] is not None:
         lines.append(f"suppression: attenuation {s['suppression']['attenuation_percent']} %, LCO "
                      f"returns on release: {s['suppression']['lco_returns']}")
+    for stage, why in s.get("skipped", {}).items():
+        lines.append(f"skipped {stage}: {why}")
     if res.interval_ok is not None or res.closed_loop is not None:
         lines.append(f"checks passed: {res.success}")
     lines.append(f"total {s['timings_s']['total']:.1f} s; outputs in {res.out_dir}/")
