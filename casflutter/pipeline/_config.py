@@ -33,6 +33,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from .._nlp import check_solver_options
 from .._resources import problems_dir, read_toml
 from .._settings import build_settings, finite_numbers, set_dotted
 from ..design import SynthesisOptions
@@ -152,6 +153,8 @@ class RomSection(IdentificationSettings):
         _integer("nb", self.nb, 1)
         _integer("v0_iterations", self.v0_iterations, 1)
         _positive("v0_rtol", self.v0_rtol)
+        object.__setattr__(self, "ipopt_options",
+                           check_solver_options(self.ipopt_options, "ipopt_options"))
 
 
 @dataclass(frozen=True)
@@ -240,6 +243,7 @@ class ControllerSettings(SynthesisOptions):
         _integer("steps", self.steps, 1)
         if not self.interval_decay >= 0:
             raise ConfigError(f"interval_decay = {self.interval_decay!r}: must be >= 0")
+        object.__setattr__(self, "ipopt", check_solver_options(self.ipopt, "ipopt"))
 
 
 @dataclass(frozen=True)
@@ -351,6 +355,11 @@ class SolverSection:
     stage's own (``rom.ipopt_options``, ``controller.ipopt``)."""
 
     ipopt: dict = field(default_factory=dict)
+    """Options by CasADi name: ``ipopt.NAME`` is checked against the installed Ipopt's own
+    option list (name, type, range, settings), the others are CasADi's ``nlpsol`` options."""
+
+    def __post_init__(self):
+        object.__setattr__(self, "ipopt", check_solver_options(self.ipopt, "ipopt"))
 
 
 @dataclass(frozen=True)
