@@ -49,3 +49,56 @@ def test_binary_config_file_is_refused(tmp_path):
     p.write_bytes(bytes(range(256)))
     with pytest.raises(ConfigError, match=r"is not a UTF-8 text file .*give a TOML text file"):
         load_config(p)
+
+
+@pytest.mark.parametrize("text,match", [
+    # the exact order of the seed wing ROM's linear part: 5 modes x largest lag 5 of the
+    # paper's orders (3, 1, 1, 1, 2, 2) = 25 states
+    ("[rom]\nnf = 1000\n", r"^rom\.nf = 1000: at most 25 here .*5 modes of 'seed_wing'.*"
+                           r"give 1\.\.25 or \"auto\""),
+    ("[rom]\nnf = 26\n", r"^rom\.nf = 26: at most 25"),
+    # common denominator na = 2, nb = 6: largest lag 6, 30 states
+    ("stages = []\n[rom]\nmethod = \"common_denominator\"\nnf = 31\n",
+     r"^rom\.nf = 31: at most 30 .*na = 2, nb = 6"),
+    ("[data]\ncoupling_delay = 100000\n",
+     r"^data\.coupling_delay = 100000: must be an integer from 0 to 3999 samples .*"
+     r"duration / dt = 4000 samples.*steps of dt, not seconds"),
+])
+def test_limits_from_the_data_are_stated(tmp_path, text, match):
+    t0 = time.perf_counter()
+    with pytest.raises(ConfigError, match=match):
+        load_config(_write(tmp_path, text))
+    assert time.perf_counter() - t0 < 1.0
+
+
+def test_nf_up_to_the_exact_order_is_accepted(tmp_path):
+    assert load_config(_write(tmp_path, "[rom]\nnf = 25\n")).rom.nf == 25
+    cd = "stages = []\n[rom]\nmethod = \"common_denominator\"\nnf = 30\n"
+    assert load_config(_write(tmp_path, cd)).rom.nf == 30
+
+
+def test_nf_bound_is_the_realisation_bound():
+    """The bound the configuration states is the one the realisation reports for an
+    identified ROM (common-denominator ROM of short seed-wing records, na = 2, nb = 6)."""
+    from casflutter._settings import settings_as
+    from casflutter.ident import identify_common_denominator
+    from casflutter.realize import realize
+    from casflutter.truth import RecordSettings, truth_records
+
+    cfg = load_config(updates={"stages": [], "rom.method": "common_denominator",
+                               "data.duration": 1.0})
+    data = truth_records(cfg.problem.load(), settings_as(cfg.data, RecordSettings),
+                         V0=cfg.data.V0)
+    real = realize(identify_common_denominator(data, cfg.rom.na, cfg.rom.nb).model)
+    assert real.exact_order_bound == 30
+    with pytest.raises(ConfigError, match=r"at most 30"):
+        load_config(updates={"stages": [], "rom.method": "common_denominator", "rom.nf": 31})
+
+
+def test_empty_config_is_the_seed_wing_study(tmp_path):
+    """The code defaults are problems/seed_wing/run.toml: an empty file runs that study."""
+    from casflutter.pipeline import RunConfig, default_config_path
+
+    shipped = load_config(default_config_path())
+    assert load_config(_write(tmp_path, "")) == shipped
+    assert RunConfig() == shipped
