@@ -102,3 +102,41 @@ def test_empty_config_is_the_seed_wing_study(tmp_path):
     shipped = load_config(default_config_path())
     assert load_config(_write(tmp_path, "")) == shipped
     assert RunConfig() == shipped
+
+
+@pytest.mark.parametrize("text,words", [
+    ("seed = -1\n", ["seed = -1", "integer >= 0"]),
+    ("[flutter]\nn_grid = 0\n", ["flutter.n_grid = 0", "integer >= 3"]),
+    ("[rom]\nnf = 1000\n", ["rom.nf = 1000", "at most 25"]),
+    ("[rom]\nregularization = nan\n", ["rom.regularization = nan", "finite number"]),
+    ("[data]\nband = [\"a\", 60]\n", ["data.band", "'a' is not a finite number"]),
+    ("[data]\ncoupling_delay = 100000\n", ["data.coupling_delay = 100000", "0 to 3999"]),
+    ('[solver.ipopt]\n"ipopt.fooo" = 1\n', ["solver.ipopt", "unknown Ipopt option 'ipopt.fooo'"]),
+    ("[nonsense]\nx = 1\n", ["unknown key 'nonsense'", "allowed: problem"]),
+])
+def test_cli_run_refuses_before_any_stage(tmp_path, capsys, monkeypatch, text, words):
+    """``casflutter run``: one line naming the key, exit 1, no stage run, no output folder."""
+    import casflutter.pipeline as pipeline
+    from casflutter.cli import main
+
+    def no_run(*a, **k):
+        raise AssertionError("a stage ran although the configuration is invalid")
+
+    monkeypatch.setattr(pipeline, "run", no_run)
+    t0 = time.perf_counter()
+    rc = main(["run", str(_write(tmp_path, text)), "--out", str(tmp_path / "out")])
+    assert time.perf_counter() - t0 < 1.0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 1 and len(err) == 1 and err[0].startswith("casflutter: error: ")
+    assert all(w in err[0] for w in words), err[0]
+    assert not (tmp_path / "out").exists()
+
+
+def test_cli_run_refuses_a_binary_config(tmp_path, capsys):
+    from casflutter.cli import main
+
+    p = tmp_path / "run.toml"
+    p.write_bytes(b"\x00\xff\xfe\x89PNG\r\n")
+    assert main(["run", str(p), "--out", str(tmp_path / "out")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "not a UTF-8 text file" in err[0] and str(p) in err[0]
