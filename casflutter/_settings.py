@@ -70,7 +70,7 @@ def _check_type(path: str, value, typ):
                 return _check_type(path, value, member)
             except ConfigError as exc:
                 errors.append(str(exc))
-        raise errors[0] if len(errors) == 1 else ConfigError(
+        raise ConfigError(errors[0]) if len(errors) == 1 else ConfigError(
             f"{path}: expected one of {typ}, got {_kind(value)}")
     if origin is typing.Literal:
         allowed = typing.get_args(typ)
