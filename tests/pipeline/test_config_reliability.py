@@ -140,3 +140,18 @@ def test_cli_run_refuses_a_binary_config(tmp_path, capsys):
     assert main(["run", str(p), "--out", str(tmp_path / "out")]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "not a UTF-8 text file" in err[0] and str(p) in err[0]
+
+
+def test_cli_run_checks_the_output_folder_before_any_stage(tmp_path, capsys, monkeypatch):
+    """``casflutter run --out afile/sub`` used to compute for 45 s and then fail."""
+    import casflutter.pipeline as pipeline
+    from casflutter.cli import main
+
+    def no_run(*a, **k):
+        raise AssertionError("a stage ran although the output folder cannot be made")
+
+    monkeypatch.setattr(pipeline, "run", no_run)
+    (tmp_path / "afile").write_text("")
+    assert main(["run", "--out", str(tmp_path / "afile" / "sub")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--out" in err[0] and "is a file, not a folder" in err[0]
