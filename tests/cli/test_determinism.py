@@ -109,3 +109,21 @@ def test_short_run_is_bit_identical(tmp_path):
         assert sorted(r0.files) == sorted(r1.files)
         for name in r0.files:
             assert np.array_equal(r0[name], r1[name]), name
+
+
+def test_single_threaded_limits_pools_loaded_after_the_cli_starts():
+    """The CLI enters ``single_threaded()`` before a command imports numpy/scipy: every BLAS
+    pool must still run one thread inside the block, whatever the environment says."""
+    code = ("import casflutter.cli\n"
+            "from casflutter._threads import single_threaded\n"
+            "import threadpoolctl, json\n"
+            "with single_threaded():\n"
+            "    import scipy.linalg, control\n"
+            "    print(json.dumps([p['num_threads'] for p in threadpoolctl.threadpool_info()"
+            " if p['user_api'] == 'blas']))\n")
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "2", "OMP_NUM_THREADS": "2"}
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=env, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    threads = json.loads(proc.stdout)
+    assert threads and all(n == 1 for n in threads), threads
