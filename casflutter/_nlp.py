@@ -284,7 +284,7 @@ def ipopt_option_list() -> Mapping[str, IpoptOption]:
 
     Ipopt prints the documentation of every option (type, valid range, settings, advanced
     ones included) when a solver is built with ``print_options_documentation``; the list is
-    read once per process (a few milliseconds, no solve).
+    read once per process (a fraction of a second, no solve).
 
     Returns
     -------
