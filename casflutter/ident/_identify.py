@@ -515,7 +515,9 @@ def identify(data: IOData, orders=(3, 1, 1, 1, 2, 2), *,
         Orders missing, not integers, out of range or inconsistent with the data.
     ConvergenceError
         Stage 2 did not converge, or the identified model's free run diverges on the
-        estimation data (status ``Unstable_Free_Run``); the result is attached as ``.result``.
+        estimation data (status ``Unstable_Free_Run``), or its free-run fit is not a finite
+        number for some output (status ``Non_Finite_Fit``); the result is attached as
+        ``.result``.
 
     See Also
     --------
@@ -646,6 +648,10 @@ def _identify(data, orders, settings: IdentificationSettings, initial) -> Identi
         warnings.simplefilter("ignore", UnstableModelWarning)
         fit = fit_report(model, data, "simulation")
     pfit = fit_report(model, data, "prediction")
+    non_finite = [name for name, e, r in zip(model.output_names, fit.error_percent, fit.nrmse)
+                  if not (np.isfinite(e) and np.isfinite(r))]
+    if non_finite and where is None:  # a fit that cannot be scored is never a success
+        success, status = False, "Non_Finite_Fit"
     result = IdentificationResult(
         model=model, initial_model=initial_model, fit=fit, prediction_fit=pfit, success=success,
         return_status=status, iterations=iters, cost=float(cost), cost_initial=float(cost0),
@@ -661,6 +667,13 @@ def _identify(data, orders, settings: IdentificationSettings, initial) -> Identi
             f"{iters} iterations); "
             + ("use criterion='simulation', " if settings.criterion == "prediction" else "")
             + "lower the orders or add regularization", result)
+    if non_finite:
+        raise ConvergenceError(
+            f"the identified model's free-run fit is not a finite number for output(s) "
+            f"{', '.join(map(str, non_finite))} (error % "
+            f"{', '.join(f'{e:.4g}' for e in fit.error_percent)}; stage 2: "
+            f"{settings.criterion} criterion, {iters} iterations); lower the orders, add "
+            "regularization or check that every output varies", result)
     if status in _ACCEPTABLE and settings.accept_acceptable:
         warnings.warn(f"stage 2 stopped at the acceptable level ({status}, {iters} iterations, "
                       f"cost {cost0:.3e} -> {cost:.3e}); the result is returned",

@@ -81,8 +81,10 @@ class RecordSettings:
         if isinstance(d, bool) or not isinstance(d, int) or d < 0:
             raise ConfigError(f"coupling_delay = {d!r}: must be an integer >= 0")
         if d >= self.n_samples:
-            raise ConfigError(f"coupling_delay = {d} is not shorter than the record "
-                              f"({self.n_samples} samples)")
+            raise ConfigError(f"coupling_delay = {d}: must be an integer from 0 to "
+                              f"{self.n_samples - 1} samples (shorter than the record: "
+                              f"duration / dt = {self.n_samples} samples); it counts steps "
+                              "of dt, not seconds")
 
     @property
     def n_samples(self) -> int:

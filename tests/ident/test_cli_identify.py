@@ -10,6 +10,8 @@ import pytest
 import casflutter.ident as ident
 from casflutter.cli import main
 from casflutter.cli.commands.identify import _finite
+from casflutter.data import IOData
+from casflutter.errors import ConvergenceError
 from casflutter.ident import random_hwl_model, synthetic_data
 
 
@@ -120,3 +122,33 @@ def test_max_time_exits_one_with_one_line(npz, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert any("warning" in e and "max_time" in e for e in err)
     assert err[-1].startswith("casflutter: identification stopped at --max-time")
+
+
+def test_nan_fit_is_a_failure(npz, capsys, monkeypatch):
+    """A fit that cannot be scored (a NaN error, e.g. orders 10,5,5,5,5,5) is never reported
+    as Solve_Succeeded with exit 0: identify raises, the CLI prints one line and exits 1."""
+    import casflutter.ident._identify as core
+
+    real_report = core.fit_report
+
+    def nan_report(model, data, mode="simulation", skip=None):
+        rep = real_report(model, data, mode, skip)
+        if mode != "simulation":
+            return rep
+        pct = np.array(rep.error_percent, dtype=float)
+        pct[-1] = math.nan
+        return type(rep)(rep.mode, pct, rep.nrmse, rep.rms_error, rep.skip)
+
+    monkeypatch.setattr(core, "fit_report", nan_report)
+    data = IOData.from_npz(npz)
+    with pytest.raises(ConvergenceError, match=r"not a finite number for output\(s\) y2") as exc:
+        ident.identify(data, (2, 1, 1, 1, 2, 2), criterion="simulation")
+    assert exc.value.result.success is False
+    assert exc.value.result.return_status == "Non_Finite_Fit"
+    assert main(["identify", str(npz), "--orders", "2,1,1,1,2,2", "--criterion",
+                 "simulation", "--json"]) == 1
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    errors = [ln for ln in captured.err.splitlines() if ln.startswith("casflutter: error")]
+    assert len(errors) == 1 and "not a finite number" in errors[0]
+    assert "Traceback" not in captured.err

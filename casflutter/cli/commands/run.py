@@ -5,11 +5,14 @@ from __future__ import annotations
 
 import json
 
+from ..._outputs import check_output_path
+
 
 def _main(args) -> int:
     from ...pipeline import load_config, run
 
     cfg = load_config(args.config)   # validated before any work starts
+    check_output_path(args.out, what="--out", kind="dir")
     res = run(cfg, out_dir=args.out, seed=args.seed, quiet=args.quiet)
     s = res.summary()
     fl, ft = s["flutter"], s["flutter_truth"]
