@@ -34,11 +34,14 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Iterable, Iterator, Literal, Mapping
 
+import numpy as np
+
 from . import __version__
 from .errors import OutputError
 
 __all__ = ["check_output_path", "check_figure_path", "atomic_folder", "atomic_file",
            "provenance", "thread_settings", "config_hash", "write_manifest", "utc_now",
+           "plain_json",
            "INCOMPLETE_TAG", "MANIFEST_NAME", "THREAD_ENV_VARS"]
 
 #: Part of the name of a folder being written (``NAME.incomplete-XXXXXX``, beside NAME).
@@ -269,6 +272,24 @@ def atomic_file(target: str | os.PathLike) -> Iterator[Path]:
 
 
 # ---------------------------------------------------------------------- provenance
+def plain_json(x: Any):
+    """Plain JSON values of nested dicts, lists, tuples, numpy scalars and arrays; a
+    non-finite float becomes ``None`` (strict JSON: ``null``)."""
+    if isinstance(x, dict):
+        return {k: plain_json(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [plain_json(v) for v in x]
+    if isinstance(x, (np.floating, float)):
+        return None if not np.isfinite(x) else float(x)
+    if isinstance(x, np.integer):
+        return int(x)
+    if isinstance(x, np.bool_):
+        return bool(x)
+    if isinstance(x, np.ndarray):
+        return plain_json(x.tolist())
+    return x
+
+
 def utc_now() -> str:
     """The current time, UTC, ISO 8601 to the second (``2026-01-31T12:00:00Z``)."""
     return datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")

@@ -13,11 +13,13 @@ from ..aeroelastic import (AeroelasticLFT, AeroelasticSystem, FlutterResult, Loo
                            ParametricSystem)
 from ..data import IOData
 from ..design import SynthesisResult
+from .._outputs import plain_json
 from ..ident import CommonDenominatorResult, FitReport, IdentificationResult
 from ..realize import ParametricROM, Realization
 from ..truth import AeroelasticTruth, SuppressionResult, TruthLco, TruthLoopSweep
 from ..verify import SpeedSweep, VerificationReport
 from ._config import RunConfig
+from ._exports import label_summary
 
 __all__ = ["RunResult", "LcoResult", "ParametricResult", "SimulationCheck",
            "ClosedLoopChecks"]
@@ -130,19 +132,8 @@ class ClosedLoopChecks:
     truth_simulation: SimulationCheck
 
 
-def _jsonable(x: Any):
-    """Plain JSON values: floats (non-finite as ``None``), ints, lists, dicts."""
-    if isinstance(x, dict):
-        return {k: _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, (np.floating, float)):
-        return None if not np.isfinite(x) else float(x)
-    if isinstance(x, (np.integer,)):
-        return int(x)
-    if isinstance(x, np.ndarray):
-        return _jsonable(x.tolist())
-    return x
+#: Plain JSON values (non-finite floats as ``None``).
+_jsonable = plain_json
 
 
 def _pair(t):
@@ -213,6 +204,9 @@ class RunResult:
         Where the files were written.
     files : mapping
         Name -> path of every file written.
+    provenance : mapping
+        What produced the run (:func:`casflutter._outputs.provenance`: version, seed,
+        thread settings, libraries) and its start time (``started``).
     """
 
     config: RunConfig
@@ -238,6 +232,7 @@ class RunResult:
     timings: Mapping[str, float] = field(default_factory=dict)
     out_dir: Path | None = None
     files: Mapping[str, Path] = field(default_factory=dict)
+    provenance: Mapping[str, Any] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ flutter speeds
     @property
@@ -395,7 +390,7 @@ class RunResult:
                                           "open_eig_rate": s.open_eig_rate,
                                           "closed_eig_rate": s.closed_eig_rate}
                                 for s in (cl.rom_simulation, cl.truth_simulation)}}
-        return _jsonable(out)
+        return _jsonable(label_summary(out, self))
 
     def _lco_summary(self) -> dict | None:
         if self.lco is None:
