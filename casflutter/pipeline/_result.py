@@ -20,6 +20,7 @@ from ..truth import AeroelasticTruth, SuppressionResult, TruthLco, TruthLoopSwee
 from ..verify import SpeedSweep, VerificationReport
 from ._config import RunConfig
 from ._exports import label_summary
+from ._units import speed_scale, speed_values
 
 __all__ = ["RunResult", "LcoResult", "ParametricResult", "SimulationCheck",
            "ClosedLoopChecks"]
@@ -277,7 +278,11 @@ class RunResult:
         """
         def pct(x):
             return "n/a" if x is None else f"{100 * x:+.3f}%"
-        text = (f"ROM identified at V0 = {self.config.data.V0:g}: Vf error "
+        V0 = speed_values(self.config.data.V0, speed_scale(
+            getattr(self, "problem", None) or self.truth))
+        air = (f" (U0 = {V0['airspeed_m_s']:.4g} m/s)" if V0.get("airspeed_m_s") is not None
+               else "")
+        text = (f"ROM identified at speed index V0 = {V0['speed_index']:g}{air}: Vf error "
                 f"{pct(self.rom_error)} vs the truth.")
         if self.flutter_frozen is not None:
             text += (f" The V² scaling of ΣAE freezes the aerodynamic time scale (reduced "

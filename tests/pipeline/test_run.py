@@ -141,10 +141,10 @@ def test_exports_carry_names_units_speeds_and_reproduce_the_verification(reduced
         [28.9 * v for v in s["controller"]["stable_V"]], rel=1e-12)
     assert c["casflutter_version"] == s["casflutter_version"]
     M = loadmat(out / "controller.mat")
-    assert float(M["Ts"]) == 0.0 and str(M["time_unit"][0]) == "s"
+    assert M["Ts"].item() == 0.0 and str(M["time_unit"][0]) == "s"
     assert [str(x[0]) for x in M["input_names"].ravel()] == [i["name"] for i in c["inputs"]]
     np.testing.assert_allclose(M["exact_V"].ravel(), s["controller"]["stable_V"], rtol=1e-15)
-    np.testing.assert_allclose(float(M["Vf_airspeed_m_s"]), 28.9 * Vf, rtol=1e-12)
+    np.testing.assert_allclose(M["Vf_airspeed_m_s"].item(), 28.9 * Vf, rtol=1e-12)
 
     assert main(["verify", str(out / "plant.json"), str(out / "controller.json"),
                  "--json"]) == 0
