@@ -131,7 +131,8 @@ def units_block(scale: SpeedScale) -> dict:
         ``time``.
     """
     t = scale.time_unit
-    return {"V": scale.speed_index_label,
+    return {"V": scale.speed_index_label + ": every key V, V0, *_V, V_* that is not named "
+                 "*_m_s or *_Pa",
             "airspeed_m_s": "m/s" if scale.to_airspeed is not None else None,
             "dynamic_pressure_Pa": "Pa" if scale.to_dynamic_pressure is not None else None,
             "freq_hz": "Hz" if t == "s" else f"cycles per time unit {t}",
