@@ -83,3 +83,25 @@ def test_a_problem_without_a_speed_scale_has_only_the_speed_index():
     scale = speed_scale(load_problem("typical_section"))
     assert speed_values(2.0, scale) == {"speed_index": 2.0}
     assert scale.speed_index_label.startswith("speed index (V = U / (b omega_theta)")
+
+
+def test_a_discrete_controller_file_is_refused_not_misread(tmp_path, capsys):
+    from casflutter.cli import main
+    from casflutter.verify import controller_to_json, plant_to_json, save_json
+
+    P = control.ss([[-1.0]], [[1.0, 1.0]], [[1.0], [1.0]], np.zeros((2, 2)))
+    save_json(plant_to_json(P, 1, 1), tmp_path / "plant.json")
+    doc = controller_to_json(control.ss([[-0.5]], [[1.0]], [[0.1]], [[0.0]]))
+    for time_base, code in (({"domain": "continuous", "dt": None}, 0),
+                            ({"domain": "discrete", "dt": 0.002}, 1),
+                            ({"domain": "sampled"}, 1)):
+        save_json({**doc, "time_base": time_base}, tmp_path / "controller.json")
+        assert main(["verify", str(tmp_path / "plant.json"),
+                     str(tmp_path / "controller.json")]) == code
+        out, err = capsys.readouterr()
+        if time_base["domain"] == "discrete":
+            assert "discrete time (dt=0.002)" in err
+        elif code:
+            assert "time_base" in err and "continuous" in err
+        else:
+            assert "PASSED" in out
