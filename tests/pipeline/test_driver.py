@@ -93,6 +93,15 @@ def test_the_flutter_check_is_a_configuration_of_the_same_driver(check):
     assert {"v0_history", "verification", "closed_loop"} <= set(s)
     assert s["verification"]["interval_ok"] == r.interval_ok
     json.dumps(s, allow_nan=False)
+    # the closed-loop stage has a flap actuator: the controller's poles are checked against
+    # its bandwidth and against the Nyquist frequency of the records
+    import numpy as np
+    fastest = np.max(np.abs(np.linalg.eigvals(np.asarray(r.controller.A))))
+    assert s["flags"] == {
+        "controller_faster_than_nyquist": bool(fastest > np.pi / r.data.dt),
+        "controller_faster_than_actuator": bool(fastest > r.config.closed_loop.actuator_omega)}
+    assert s["units"]["V"].startswith("speed index (V = U / (b omega_theta)")
+    assert s["units"]["airspeed_m_s"] is None and "airspeed_m_s" not in s["flutter"]
 
 
 @pytest.mark.parametrize("section, stage_class", [
