@@ -355,7 +355,39 @@ class SolverSection:
 
 @dataclass(frozen=True)
 class RunConfig:
-    """The whole configuration of a run; each field is one TOML table (module docstring)."""
+    """The whole configuration of a run; each field is one TOML table (module docstring).
+
+    Attributes
+    ----------
+    problem : ProblemSection
+        ``[problem]``: the truth or problem file and its parameter changes.
+    data : DataSection
+        ``[data]``: the identification records.
+    rom : RomSection
+        ``[rom]``: the identification of the ROM and its realisation.
+    flutter : FlutterSection
+        ``[flutter]``: the flutter search.
+    lco : LcoSection
+        ``[lco]``: the LCO simulations and branches.
+    controller : ControllerSettings
+        ``[controller]``: the robust synthesis.
+    verify : VerifySection
+        ``[verify]``: the verification's speed grid.
+    closed_loop : ClosedLoopSection
+        ``[closed_loop]``: the closed-loop simulations on the ROM and the truth.
+    suppression : SuppressionSettings
+        ``[suppression]``: the gain ramp on the truth (paper Fig. 11).
+    parametric : ParametricSection
+        ``[parametric]``: the ROM interpolated in the speed.
+    sensors : SensorsSection
+        ``[sensors]``: the sensor rows and kind.
+    solver : SolverSection
+        ``[solver]``: Ipopt options.
+    seed : int
+        Seed of every random choice of the run.
+    stages : tuple of str
+        The optional stages to run (``"lco"``, ``"controller"``, ``"suppression"``, ...).
+    """
 
     problem: ProblemSection = field(default_factory=ProblemSection)
     data: DataSection = field(default_factory=DataSection)
@@ -522,6 +554,17 @@ def load_config(path=None, *, updates=None, **overrides) -> RunConfig:
     ------
     ConfigError
         A missing or malformed file, or any unknown or invalid key (named).
+
+    See Also
+    --------
+    run : runs the configuration.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> cfg = cf.load_config(updates={"controller.order": 2}, seed=3)
+    >>> cfg.controller.order, cfg.seed, cfg.problem.name
+    (2, 3, 'seed_wing')
     """
     path = Path(path) if path is not None else default_config_path()
     table = read_toml(path, "configuration file")

@@ -150,11 +150,22 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
     casflutter.errors.SynthesisError
         No synthesis start stabilised the design plants.
 
+    See Also
+    --------
+    load_config : the configuration it runs.
+
     Examples
     --------
-    >>> import casflutter as cf                                  # doctest: +SKIP
-    >>> result = cf.run(cf.load_config(), write=False)           # doctest: +SKIP
-    >>> result.flutter.Vf, result.verification.exact_V           # doctest: +SKIP
+    The typical section's flutter route (records, linear ROM, Σf, flutter) without writing files:
+
+    >>> import casflutter as cf
+    >>> from casflutter.pipeline import config_path
+    >>> config = cf.load_config(config_path("typical_section", "flutter"), updates={"stages": []})
+    >>> result = cf.run(config, write=False, quiet=True)
+    >>> round(result.flutter.Vf, 4)
+    2.2589
+
+    The paper's study on the seed wing (about a minute): ``cf.run(cf.load_config())``.
     """
     cfg = config if isinstance(config, RunConfig) else load_config(config)
     if seed is not None:

@@ -117,6 +117,19 @@ def truth_records(truth, settings: RecordSettings | None = None, **changes) -> I
     ------
     ConfigError
         An invalid setting (named), e.g. a band above the Nyquist frequency.
+
+    See Also
+    --------
+    identify : the HWL ROM from such records.
+    identify_common_denominator : the linear ROM from such records.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section")
+    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
+    >>> len(data.records), data.n_modes, data.has_v
+    (3, 2, True)
     """
     s = replace(settings or RecordSettings(), **changes) if changes else (
         settings or RecordSettings())

@@ -41,6 +41,16 @@ def problem_names() -> list[str]:
     -------
     list of str
         The names :func:`load_problem` accepts besides a problem file's path.
+
+    See Also
+    --------
+    load_problem : a problem's truth, with parameter changes.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> sorted(cf.problem_names())
+    ['goland', 'seed_wing', 'typical_section']
     """
     return list(PROBLEMS)
 
@@ -140,6 +150,18 @@ def load_problem(name: str, params: Mapping[str, Any] | Iterable[str] = ()) -> A
     ------
     ConfigError
         Unknown problem or parameter, or a non-physical value.
+
+    See Also
+    --------
+    problem_names : the built-in problems.
+    find_flutter : the flutter speed of the loaded truth.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section", ["mu=25"])
+    >>> truth.n_modes, truth.params.mu
+    (2, 25.0)
     """
     path = _file_of(name)
     if path is not None:
