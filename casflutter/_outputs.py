@@ -40,7 +40,7 @@ from . import __version__
 from .errors import OutputError
 
 __all__ = ["check_output_path", "check_figure_path", "atomic_folder", "atomic_file",
-           "provenance", "thread_settings", "config_hash", "write_manifest", "utc_now",
+           "check_output_folder", "provenance", "thread_settings", "config_hash", "write_manifest", "utc_now",
            "plain_json",
            "INCOMPLETE_TAG", "MANIFEST_NAME", "THREAD_ENV_VARS"]
 
@@ -167,6 +167,38 @@ def check_figure_path(path: str | os.PathLike, *, what: str = "--figure",
 
 
 # ---------------------------------------------------------------------- atomic writing
+def check_output_folder(path: str | os.PathLike, *, overwrite: bool = False,
+                        what: str = "output folder") -> Path:
+    """Check, before any work, that :func:`atomic_folder` can write ``path``.
+
+    :func:`check_output_path` of the folder, and the folder that will hold it (where the
+    incomplete folder is written) must be writable too.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The output folder.
+    overwrite : bool
+        Whether an existing non-empty folder may be replaced.
+    what : str
+        How the message names the folder.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    OutputError
+        As :func:`check_output_path`, or the parent folder is not writable.
+    """
+    target = check_output_path(path, what=what, kind="dir", overwrite=overwrite)
+    anc = _nearest_existing(target.parent)
+    if anc.is_dir():
+        _probe(anc, what, target)
+    return target
+
+
 @contextmanager
 def atomic_folder(target: str | os.PathLike, *, overwrite: bool = False,
                   what: str = "output folder") -> Iterator[Path]:
@@ -201,7 +233,7 @@ def atomic_folder(target: str | os.PathLike, *, overwrite: bool = False,
         ``target`` cannot be written (:func:`check_output_path`) or exists and is not empty
         without ``overwrite``.
     """
-    target = check_output_path(target, what=what, kind="dir", overwrite=overwrite)
+    target = check_output_folder(target, what=what, overwrite=overwrite)
     target.parent.mkdir(parents=True, exist_ok=True)
     try:
         tmp = Path(tempfile.mkdtemp(prefix=target.name + INCOMPLETE_TAG, dir=target.parent))

@@ -26,8 +26,9 @@ from pathlib import Path
 import numpy as np
 from scipy.io import savemat
 
-from .._outputs import (MANIFEST_NAME, atomic_folder, check_output_path, plain_json,
-                        provenance, write_manifest)
+from .._outputs import MANIFEST_NAME, atomic_folder
+from .._outputs import check_output_folder as _check_folder
+from .._outputs import plain_json, provenance, write_manifest
 from ..report import write_figures, write_html
 from ..verify import controller_to_json, plant_to_json
 from ._units import (FLAP_UNIT, interval_values, sensor_units, speed_scale, speed_values,
@@ -76,11 +77,11 @@ def check_output_folder(out_dir, *, overwrite: bool = False) -> Path:
     Raises
     ------
     OutputError
-        The folder cannot be created or written, or exists and is not empty without
-        ``overwrite``.
+        The folder (or the folder that holds it) cannot be created or written, or it exists
+        and is not empty without ``overwrite``.
     """
-    return check_output_path(out_dir if out_dir is not None else DEFAULT_OUT,
-                             what="output folder", kind="dir", overwrite=overwrite)
+    return _check_folder(out_dir if out_dir is not None else DEFAULT_OUT,
+                         what="output folder", overwrite=overwrite)
 
 
 # ---------------------------------------------------------------------- controller poles

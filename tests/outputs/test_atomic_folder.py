@@ -168,3 +168,17 @@ def test_thread_settings_report_the_environment_and_the_pools(monkeypatch):
     assert t["env"]["OPENBLAS_NUM_THREADS"] == "3" and t["env"]["OMP_NUM_THREADS"] is None
     assert t["pools"] and all(p["num_threads"] == 1 for p in t["pools"])
     assert {p["user_api"] for p in t["pools"]} >= {"blas"}
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into read-only folders")
+def test_a_folder_whose_parent_is_not_writable_is_refused_before_the_work(tmp_path):
+    from casflutter._outputs import check_output_folder
+
+    parent = tmp_path / "ro"
+    (parent / "out").mkdir(parents=True)
+    parent.chmod(0o555)           # the existing output folder is writable, its parent not
+    try:
+        with pytest.raises(OutputError, match="cannot write in the folder"):
+            check_output_folder(parent / "out", overwrite=True)
+    finally:
+        parent.chmod(0o755)
