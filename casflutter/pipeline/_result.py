@@ -13,11 +13,14 @@ from ..aeroelastic import (AeroelasticLFT, AeroelasticSystem, FlutterResult, Loo
                            ParametricSystem, PKResult, RFASystem)
 from ..data import IOData
 from ..design import SynthesisResult
+from .._outputs import plain_json
 from ..ident import CommonDenominatorResult, FitReport, IdentificationResult
 from ..realize import ParametricROM, RationalApproximation, Realization
 from ..truth import AeroelasticTruth, SuppressionResult, TruthLco, TruthLoopSweep
 from ..verify import SpeedSweep, VerificationReport
 from ._config import RunConfig
+from ._exports import label_summary
+from ._units import speed_scale, speed_values
 
 __all__ = ["RunResult", "LcoResult", "ParametricResult", "SimulationCheck",
            "ClosedLoopChecks"]
@@ -131,19 +134,8 @@ class ClosedLoopChecks:
     truth_simulation: SimulationCheck
 
 
-def _jsonable(x: Any):
-    """Plain JSON values: floats (non-finite as ``None``), ints, lists, dicts."""
-    if isinstance(x, dict):
-        return {k: _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, (np.floating, float)):
-        return None if not np.isfinite(x) else float(x)
-    if isinstance(x, (np.integer,)):
-        return int(x)
-    if isinstance(x, np.ndarray):
-        return _jsonable(x.tolist())
-    return x
+#: Plain JSON values (non-finite floats as ``None``).
+_jsonable = plain_json
 
 
 def _pair(t):
@@ -232,6 +224,9 @@ class RunResult:
         The flutter search of ``rfa_system`` (speeds in m/s, frequencies in rad/s).
     pk : PKResult or None
         The p–k solution on the same ``Q(ik)`` (the independent check).
+    provenance : mapping
+        What produced the run (:func:`casflutter._outputs.provenance`: version, seed,
+        thread settings, libraries) and its start time (``started``).
     """
 
     config: RunConfig
@@ -263,6 +258,7 @@ class RunResult:
     rfa_system: RFASystem | None = None
     rfa_flutter: FlutterResult | None = None
     pk: PKResult | None = None
+    provenance: Mapping[str, Any] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ flutter speeds
     @property
@@ -307,7 +303,11 @@ class RunResult:
         """
         def pct(x):
             return "n/a" if x is None else f"{100 * x:+.3f}%"
-        text = (f"ROM identified at V0 = {self.config.data.V0:g}: Vf error "
+        V0 = speed_values(self.config.data.V0, speed_scale(
+            getattr(self, "problem", None) or self.truth))
+        air = (f" (U0 = {V0['airspeed_m_s']:.4g} m/s)" if V0.get("airspeed_m_s") is not None
+               else "")
+        text = (f"ROM identified at speed index V0 = {V0['speed_index']:g}{air}: Vf error "
                 f"{pct(self.rom_error)} vs the truth.")
         if self.flutter_frozen is not None:
             text += (f" The V² scaling of ΣAE freezes the aerodynamic time scale (reduced "
@@ -432,7 +432,7 @@ class RunResult:
                                           "open_eig_rate": s.open_eig_rate,
                                           "closed_eig_rate": s.closed_eig_rate}
                                 for s in (cl.rom_simulation, cl.truth_simulation)}}
-        return _jsonable(out)
+        return _jsonable(label_summary(out, self))
 
     def _rfa_summary(self) -> dict:
         """The RFA, its flutter in m/s and rad/s and the p–k check (GAF wing files)."""

@@ -44,7 +44,6 @@ truth); ``problems/NAME/flutter.toml`` are the ROM routes of ``casflutter flutte
 
 from __future__ import annotations
 
-import json
 import logging
 import sys
 import time
@@ -54,9 +53,9 @@ from pathlib import Path
 
 import control
 import numpy as np
-from scipy.io import savemat
 
 from .._linalg import spectral_abscissa
+from .._outputs import provenance, utc_now
 from .._settings import settings_as
 from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, RFASystem,
                            build_lft, pk_flutter,
@@ -67,14 +66,14 @@ from ..errors import CasflutterError, ConfigError
 from ..ident import (IdentificationResult, IdentificationSettings, fit_report, identify,
                      identify_common_denominator)
 from ..realize import ParametricROM, RFASettings, fit_rfa, realize, speed_nodes
-from ..report import write_figures, write_html
 from ..truth import (AeroelasticTruth, GAFProblem, RecordSettings, WingProblem,
                      closed_loop_truth, frozen_aero_truth, suppression_run,
                      truth_lco, truth_loop_matrix, truth_loop_sweep, truth_records)
-from ..verify import controller_to_json, speed_sweep, verify_controller
+from ..verify import speed_sweep, verify_controller
 from ._config import RunConfig, load_config
+from ._exports import check_output_folder, log_flags, write_outputs
 from ._result import (ClosedLoopChecks, LcoResult, ParametricResult, RunResult,
-                      SimulationCheck, _jsonable)
+                      SimulationCheck)
 
 __all__ = ["run"]
 
@@ -236,7 +235,7 @@ def _identify(data, cfg: RunConfig):
 
 
 def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int | None = None,
-        quiet: bool = False, write: bool = True) -> RunResult:
+        quiet: bool = False, write: bool = True, overwrite: bool = False) -> RunResult:
     """Run the stages of a configuration (module docstring) and write its outputs.
 
     Parameters
@@ -244,13 +243,17 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
     config : RunConfig, path or None
         Configuration (default: the seed wing's ``problems/seed_wing/run.toml``).
     out_dir : path, optional
-        Output folder (default ``casflutter-run``).
+        Output folder (default ``casflutter-run``), checked before any work and written
+        atomically with its ``manifest.json`` (:mod:`casflutter.pipeline._exports`).
     seed : int, optional
         Overrides ``config.seed``.
     quiet : bool
         No progress on stderr.
     write : bool
-        Write files (summary, figures, report, ROM, controller).
+        Write files (summary, figures, report, ROM, controller and plant, manifest).
+    overwrite : bool
+        Replace an existing non-empty output folder (as a whole); without it such a folder
+        is refused before any work.
 
     Returns
     -------
@@ -260,6 +263,9 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
     ------
     ConfigError
         An invalid configuration (before any work).
+    OutputError
+        An output folder that cannot be written, or exists and is not empty without
+        ``overwrite`` (before any work).
     CasflutterError
         No ROM flutter in ``flutter.V_range`` when a later stage needs it (or no truth
         flutter for the closed-loop stage), or a simulation that blew up.
@@ -286,6 +292,8 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
     cfg = config if isinstance(config, RunConfig) else load_config(config)
     if seed is not None:
         cfg = replace(cfg, seed=int(seed))
+    target = check_output_folder(out_dir, overwrite=overwrite) if write else None
+    info = {**provenance(seed=cfg.seed), "started": utc_now()}
     problem = cfg.problem.load()
     truth = problem if isinstance(problem, AeroelasticTruth) else None
     skipped: dict = {}
@@ -318,7 +326,7 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
                    realization=None, flutter_truth=None)
         if "controller" in cfg.stages and "controller" not in skipped:
             _controller_stages(cfg, out["system"], Vf, prog, out)
-        return _finish(out, prog, out_dir, write)
+        return _finish(out, prog, target, write, overwrite, info)
 
     # 1-5: records, ROM, Σf, ΣAE, flutter; repeated at the ROM's own flutter speed
     V0, history = cfg.data.V0, []
@@ -401,7 +409,7 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
                 truth, out["controller"], float(V_ref), cfg.suppression, dt=model.dt,
                 mode=crit, deflection=cfg.lco.initial_deflection, sensor_rows=rows,
                 sensor=cfg.sensors.kind, x0=x0)
-    return _finish(out, prog, out_dir, write)
+    return _finish(out, prog, target, write, overwrite, info)
 
 
 def _controller_stages(cfg: RunConfig, system, Vf: float, prog, out: dict) -> None:
@@ -429,14 +437,17 @@ def _controller_stages(cfg: RunConfig, system, Vf: float, prog, out: dict) -> No
     out.update(lft=lft, synthesis=syn, controller=K, verification=ver)
 
 
-def _finish(out: dict, prog, out_dir, write: bool) -> RunResult:
-    """The result with its timings, and its files when ``write``."""
+def _finish(out: dict, prog, target: Path | None, write: bool, overwrite: bool,
+            info: dict) -> RunResult:
+    """The result with its timings and provenance, and its files (written atomically into
+    ``target``) when ``write``."""
     timings = dict(prog.timings)
     timings["total"] = time.perf_counter() - prog.t0
-    result = RunResult(**out, timings=timings)
+    result = RunResult(**out, timings=timings, provenance=info)
+    log_flags(result)
     if write:
-        target = Path(out_dir or "casflutter-run")
-        result = replace(result, out_dir=target, files=_write_outputs(target, result))
+        result = replace(result, out_dir=target,
+                         files=write_outputs(target, result, overwrite=overwrite))
     return result
 
 
@@ -518,34 +529,3 @@ def _closed_loop(cfg: RunConfig, truth, model, system, lft, K, flutter, flutter_
                                 spectral_abscissa(A_cl))
     return ClosedLoopChecks(truth_sweep=sweep, rom_simulation=rom_sim,
                             truth_simulation=truth_sim)
-
-
-def _write_outputs(out: Path, result: RunResult) -> dict:
-    """``summary.json``, ``rom.npz``, the controller (JSON and .mat), ``config.json``, the
-    figures and ``report.html``."""
-    out.mkdir(parents=True, exist_ok=True)
-    files = {}
-    summary = result.summary()
-    tmp = out / "summary.json.tmp"
-    with open(tmp, "w") as fh:
-        json.dump(summary, fh, indent=2)
-    tmp.replace(out / "summary.json")
-    files["summary"] = out / "summary.json"
-    if result.identification is not None:   # a GAF wing file has an RFA, no ROM
-        result.identification.model.save(out / "rom.npz")
-        files["rom"] = out / "rom.npz"
-    K = result.controller
-    if K is not None:
-        with open(out / "controller.json", "w") as fh:
-            json.dump(controller_to_json(K), fh, indent=2)
-        files["controller_json"] = out / "controller.json"
-        savemat(out / "controller.mat", {"A": np.asarray(K.A), "B": np.asarray(K.B),
-                                          "C": np.asarray(K.C), "D": np.asarray(K.D)})
-        files["controller_mat"] = out / "controller.mat"
-    with open(out / "config.json", "w") as fh:
-        json.dump(_jsonable(result.config.to_dict()), fh, indent=2)
-    files["config"] = out / "config.json"
-    figs = write_figures(out, result)
-    files.update(figs)
-    files["report"] = write_html(out, summary, figs)
-    return files

@@ -69,6 +69,30 @@ def test_json_is_valid_and_out_written(npz, tmp_path, capsys):
     assert ident.HWLModel.load(out).orders.as_tuple() == (2, 1, 1, 1, 2, 2)
 
 
+def test_out_is_never_left_half_written(npz, tmp_path, capsys, monkeypatch):
+    """The model is written under a temporary name and renamed: a failure while writing
+    leaves the previous file as it was and no temporary file behind."""
+    out = tmp_path / "model.npz"
+    out.write_bytes(b"previous model")
+    real_save = ident.HWLModel.save
+
+    def fails_midway(self, fh):
+        fh.write(b"PK\x03\x04 half a zip")
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(ident.HWLModel, "save", fails_midway)
+    args = ["identify", str(npz), "--orders", "2,1,1,1,2,2", "--json", "--out", str(out)]
+    assert main(args) == 1
+    assert "No space left on device" in capsys.readouterr().err
+    assert out.read_bytes() == b"previous model" and sorted(tmp_path.iterdir()) == [out]
+    monkeypatch.setattr(ident.HWLModel, "save", real_save)
+    stem = tmp_path / "rom"                    # numpy's rule: savez adds .npz
+    assert main(["identify", str(npz), "--orders", "2,1,1,1,2,2", "--out", str(stem)]) == 0
+    assert f"model written to {stem}.npz" in capsys.readouterr().out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["model.npz", "rom.npz"]
+    assert ident.HWLModel.load(tmp_path / "rom.npz").orders.as_tuple() == (2, 1, 1, 1, 2, 2)
+
+
 def test_json_null_for_non_finite():
     assert _finite([1.0, math.nan, math.inf]) == [1.0, None, None]
     assert json.dumps({"x": _finite(np.float64("nan"))}, allow_nan=False) == '{"x": null}'

@@ -54,7 +54,8 @@ def register(subparsers) -> None:
 
 def _speed_conv(truth):
     """(V -> problem unit, problem unit -> V, unit name)."""
-    if hasattr(truth, "airspeed") and hasattr(truth, "speed_index"):
+    if callable(getattr(truth, "airspeed", None)) and callable(getattr(truth, "speed_index",
+                                                                      None)):
         return truth.airspeed, truth.speed_index, "m/s"
     return float, float, "speed index " + truth.modal_structure().speed_index
 
@@ -95,10 +96,14 @@ def summarize(result, problem: str) -> dict:
     if not rom_stable:
         warn.append("the single-speed ROM is unstable on its own (ΣAE unstable at V = 0): "
                     "its crossings are not flutter onsets")
+    # the searches' own messages speak in the speed index: say so when the output does not
+    note = "" if vunit.startswith("speed index") else (
+        f" (V in this message is the speed index {truth.modal_structure().speed_index}; the "
+        f"speeds above are in {vunit})")
     for key, r in (("truth", result.flutter_truth), ("rom", result.flutter),
                    ("parametric_rom", parametric)):
         if r is not None and r.Vf is None:
-            warn.append(f"{key}: {r.message}")
+            warn.append(f"{key}: {r.message}{note}")
 
     def err(x):
         return None if x is None else float(x)
@@ -109,7 +114,10 @@ def summarize(result, problem: str) -> dict:
         "rom": rom,
         "parametric_rom": _block(parametric, truth, to_unit, fscale),
         "frozen_aero_truth": _block(result.flutter_frozen, truth, to_unit, fscale),
-        "units": {"V_flutter": vunit, "V_divergence": vunit, "omega_flutter": funit},
+        "units": {"V_flutter": vunit, "V_divergence": vunit, "omega_flutter": funit,
+                  "rom_V0": vunit, "V_range": vunit, "parametric_speeds": vunit,
+                  "relative_errors": "fraction (0.01 = 1 %)", "timings": "s",
+                  "speed_index": truth.modal_structure().speed_index},
         "rom_V0": to_unit(result.config.data.V0),
         "V_range": [to_unit(v) for v in result.config.flutter.V_range],
         "parametric_speeds": (None if result.parametric is None
@@ -293,16 +301,19 @@ def run(args) -> int:
         sys.stdout.write("\n")
         return 0
     u = doc["units"]
+    vu = "m/s" if u["V_flutter"] == "m/s" else "index"
     print(f"{label}: flutter speed ({u['V_flutter']}), frequency ({u['omega_flutter']})")
-    print(f"  {'':16} {'V_flutter':>14} {'omega_flutter':>14} {'mode':>12} {'V_divergence':>14}")
-    for key, label in (("truth", "truth"), ("rom", f"ROM at V0={doc['rom_V0']:.4g}"),
+    print(f"  {'':20} {f'V_flutter [{vu}]':>18} {'omega_flutter':>14} {'mode':>12} "
+          f"{f'V_divergence [{vu}]':>20}")
+    v0 = f"{doc['rom_V0']:.4g}" + (" m/s" if vu == "m/s" else "")
+    for key, label in (("truth", "truth"), ("rom", f"ROM at V0={v0}"),
                        ("frozen_aero_truth", "frozen-aero truth"),
                        ("parametric_rom", "parametric ROM")):
         b = doc[key]
         if b is None:
             continue
-        print(f"  {label:16} {_fmt(b['V_flutter']):>14} {_fmt(b['omega_flutter']):>14} "
-              f"{str(b['mode']):>12} {_fmt(b['V_divergence']):>14}")
+        print(f"  {label:20} {_fmt(b['V_flutter']):>18} {_fmt(b['omega_flutter']):>14} "
+              f"{str(b['mode']):>12} {_fmt(b['V_divergence']):>20}")
     print(f"  {doc['explanation']}")
     for w in doc["warnings"]:
         print(f"  warning: {w}")
