@@ -34,12 +34,17 @@ class LcoResult:
     truth : TruthLco
         The truth's own response a little above its own flutter speed.
     V : float
-        Speed of the ROM simulation: ``lco.speed_factor`` times ``V_hopf_exact_order``.
+        Speed of the ROM simulation: ``lco.speed_factor`` times ``V_hopf_loop`` (or
+        ``V_hopf_exact_order`` when the loop has no flutter point in the range).
     V_hopf_exact_order : float
-        Hopf speed of the ROM realised at its exact order (the nonlinear ROM carries its full
-        linear part; a truncated Σf has another Hopf point).
+        Hopf speed of the continuous ΣAE with the ROM realised at its exact order (the
+        nonlinear ROM carries its full linear part; a truncated Σf has another Hopf point).
     flutter_exact_order : FlutterResult
-        The flutter search of that exact-order loop.
+        The flutter search of that exact-order continuous loop.
+    V_hopf_loop : float or None
+        The ROM's own flutter speed: the Neimark--Sacker point of the sampled-data loop it is
+        simulated in (:func:`casflutter.lco.rom_loop_map`); None when there is none in the
+        flutter search range.
     """
 
     rom: LoopSimulation
@@ -47,6 +52,7 @@ class LcoResult:
     V: float
     V_hopf_exact_order: float
     flutter_exact_order: FlutterResult
+    V_hopf_loop: float | None = None
 
 
 @dataclass(frozen=True)
@@ -403,6 +409,7 @@ class RunResult:
         sim, tr = self.lco.rom, self.lco.truth
         sens = sim.sensors if sim.sensors is not None else sim.modes
         return {"V": self.lco.V, "V_hopf_exact_order": self.lco.V_hopf_exact_order,
+                "V_hopf_loop": self.lco.V_hopf_loop,
                 "freq_hz": sens.frequency_hz, "amplitude": list(sens.amplitude),
                 "kind": sens.kind, "truth_V": tr.V, "truth_freq_hz": tr.freq_hz,
                 "truth_amplitude": list(tr.amplitude), "truth_kind": tr.kind}
