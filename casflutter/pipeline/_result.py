@@ -14,6 +14,7 @@ from ..aeroelastic import (AeroelasticLFT, AeroelasticSystem, FlutterResult, Loo
 from ..data import IOData
 from ..design import SynthesisResult
 from ..ident import CommonDenominatorResult, FitReport, IdentificationResult
+from ..lco import LCOBranch
 from ..realize import ParametricROM, Realization
 from ..truth import AeroelasticTruth, SuppressionResult, TruthLco, TruthLoopSweep
 from ..verify import SpeedSweep, VerificationReport
@@ -45,6 +46,9 @@ class LcoResult:
         The ROM's own flutter speed: the Neimark--Sacker point of the sampled-data loop it is
         simulated in (:func:`casflutter.lco.rom_loop_map`); None when there is none in the
         flutter search range.
+    truth_branch, rom_branch : LCOBranch or None
+        The LCO branches of the truth and of the ROM loop from their flutter points
+        (``lco.branch_points > 0``).
     """
 
     rom: LoopSimulation
@@ -53,6 +57,8 @@ class LcoResult:
     V_hopf_exact_order: float
     flutter_exact_order: FlutterResult
     V_hopf_loop: float | None = None
+    truth_branch: LCOBranch | None = None
+    rom_branch: LCOBranch | None = None
 
 
 @dataclass(frozen=True)
@@ -412,7 +418,12 @@ class RunResult:
                 "V_hopf_loop": self.lco.V_hopf_loop,
                 "freq_hz": sens.frequency_hz, "amplitude": list(sens.amplitude),
                 "kind": sens.kind, "truth_V": tr.V, "truth_freq_hz": tr.freq_hz,
-                "truth_amplitude": list(tr.amplitude), "truth_kind": tr.kind}
+                "truth_amplitude": list(tr.amplitude), "truth_kind": tr.kind,
+                "branches": {name: {"V_hopf": br.hopf.V, "kind": br.hopf.kind,
+                                    "points": len(br.points), "completed": br.completed}
+                             for name, br in (("truth", self.lco.truth_branch),
+                                              ("rom", self.lco.rom_branch))
+                             if br is not None}}
 
     def _controller_summary(self) -> dict | None:
         if self.verification is None:

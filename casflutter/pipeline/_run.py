@@ -49,10 +49,10 @@ from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, b
                            find_flutter, simulate_loop)
 from ..data import envelope_growth_rate
 from ..design import SynthesisOptions, design_flutter_controller
-from ..errors import CasflutterError
+from ..errors import CasflutterError, ConfigError, ConvergenceError
 from ..ident import (IdentificationResult, IdentificationSettings, fit_report, identify,
                      identify_common_denominator)
-from ..lco import rom_loop_map
+from ..lco import LCOSettings, lco_branch, rom_lco_branch, rom_loop_map, speed_convention
 from ..realize import ParametricROM, realize, speed_nodes
 from ..report import write_figures, write_html
 from ..truth import (RecordSettings, closed_loop_truth, frozen_aero_truth, suppression_run,
@@ -313,8 +313,30 @@ def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth, prog) 
     prog.note(f"ROM LCO at V = {V_lco:.4f} (loop flutter {V_loop or float('nan'):.4f}, "
               f"continuous exact-order Hopf {V_hopf:.4f}): "
               f"{sim.sensors.kind}, {sim.sensors.frequency_hz:.3f} Hz")
+    branches = _branches(cfg, truth, model, structure, prog) if lc.branch_points else {}
     return LcoResult(rom=sim, truth=tr, V=V_lco, V_hopf_exact_order=V_hopf,
-                     flutter_exact_order=fl_exact, V_hopf_loop=V_loop)
+                     flutter_exact_order=fl_exact, V_hopf_loop=V_loop, **branches)
+
+
+def _branches(cfg: RunConfig, truth, model, structure, prog) -> dict:
+    """The LCO branches of the ROM loop and of the truth (``lco.branch_points`` points
+    each), or the reason a branch could not be started."""
+    settings = LCOSettings(max_points=cfg.lco.branch_points, sensor_kind=structure.sensor)
+    scale, unit = speed_convention(truth)
+    ms = truth.modal_structure()
+    out = {}
+    for key, compute in (
+            ("truth_branch", lambda: lco_branch(truth, cfg.flutter.V_range, settings,
+                                                problem="truth")),
+            ("rom_branch", lambda: rom_lco_branch(
+                model, structure, cfg.flutter.V_range, settings, mode_names=ms.mode_names,
+                sensor_names=structure.sensor_names, problem="ROM loop", speed_scale=scale,
+                speed_unit=unit, time_unit=ms.time_unit))):
+        try:
+            out[key] = compute()
+        except (ConfigError, ConvergenceError) as exc:
+            prog.note(f"no {key.replace('_', ' ')}: {exc}")
+    return out
 
 
 #: most continuations of an LCO simulation that still grows
