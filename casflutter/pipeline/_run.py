@@ -54,7 +54,7 @@ from ..ident import (IdentificationResult, IdentificationSettings, fit_report, i
                      identify_common_denominator)
 from ..lco import LCOSettings, lco_branch, rom_lco_branch, rom_loop_map, speed_convention
 from ..realize import ParametricROM, realize, speed_nodes
-from ..report import write_figures, write_html
+from ..report import figure_captions, write_figures, write_html
 from ..truth import (RecordSettings, closed_loop_truth, frozen_aero_truth, suppression_run,
                      truth_lco, truth_loop_matrix, truth_loop_sweep, truth_records)
 from ..verify import controller_to_json, speed_sweep, verify_controller
@@ -336,6 +336,12 @@ def _branches(cfg: RunConfig, truth, model, structure, prog) -> dict:
             out[key] = compute()
         except (ConfigError, ConvergenceError) as exc:
             prog.note(f"no {key.replace('_', ' ')}: {exc}")
+    if "truth_branch" in out and "rom_branch" in out:
+        # the ROM loop's outputs are the truth's quantities: give them the truth's units
+        units = dict(zip(out["truth_branch"].outputs, out["truth_branch"].output_units))
+        rb = out["rom_branch"]
+        out["rom_branch"] = replace(rb, output_units=tuple(
+            units.get(n, u) for n, u in zip(rb.outputs, rb.output_units)))
     return out
 
 
@@ -442,5 +448,5 @@ def _write_outputs(out: Path, result: RunResult) -> dict:
     files["config"] = out / "config.json"
     figs = write_figures(out, result)
     files.update(figs)
-    files["report"] = write_html(out, summary, figs)
+    files["report"] = write_html(out, summary, figs, figure_captions(result))
     return files

@@ -36,8 +36,26 @@ def _fmt(x, digits=4):
     return html.escape(str(x))
 
 
-def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflutter run") -> str:
-    """HTML text of the report (figures read from PNG files and embedded as base64)."""
+def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflutter run",
+                captions: dict[str, str] | None = None) -> str:
+    """HTML text of the report (figures read from PNG files and embedded as base64).
+
+    Parameters
+    ----------
+    summary : dict
+        The run's summary (``summary.json``).
+    figures : dict
+        Figure name -> PNG path.
+    title : str
+        Page title.
+    captions : dict, optional
+        Figure name -> caption; a figure without one is captioned by its file name.
+
+    Returns
+    -------
+    str
+    """
+    captions = captions or {}
     s = summary
     fl, ctrl = s.get("flutter") or {}, s.get("controller") or {}
     lco, sup = s.get("lco") or {}, s.get("suppression") or {}
@@ -71,8 +89,10 @@ def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflu
     imgs = []
     for name, path in figures.items():
         data = base64.b64encode(Path(path).read_bytes()).decode("ascii")
-        imgs.append(f'<figure><img alt="{html.escape(name)}" src="data:image/png;base64,{data}">'
-                    f"<figcaption>{html.escape(name)}</figcaption></figure>")
+        caption = captions.get(name) or Path(path).name
+        imgs.append(f'<figure><img alt="{html.escape(caption)}" '
+                    f'src="data:image/png;base64,{data}">'
+                    f"<figcaption>{html.escape(caption)}</figcaption></figure>")
     timings = s.get("timings_s", {})
     trows = "\n".join(f"<tr><td>{html.escape(k)}</td><td>{v:.2f}</td></tr>"
                       for k, v in timings.items() if isinstance(v, (int, float)))
