@@ -82,7 +82,7 @@ def plot_vg_vf(result, *, branches=None, hz: bool = True, ax=None, mode_names=No
         if res.Vf is not None:
             mode = (f" (mode {res.flutter_mode + 1})"
                     if res.flutter_mode is not None and res.flutter_mode >= 0 else "")
-            ag.set_title(f"flutter at V = {res.Vf:.4g}, {res.frequency_hz:.3g} Hz{mode}",
+            ag.set_title(f"flutter: Vf = {res.Vf:.4g}, {res.frequency_hz:.3g} Hz{mode}",
                          fontsize="medium")
         else:
             ag.set_title(res.status.replace("_", " "), fontsize="medium")
