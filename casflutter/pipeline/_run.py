@@ -304,7 +304,9 @@ def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth, prog) 
         sim = simulate_loop(model, structure, V_lco, n, xs0=xs0)
         if sim.stopped_early or sim.modes.kind != "divergence":
             break
-        xs0 = sim.xs[-1]        # still growing: continue from where it ended
+        # still growing: continue from where the structure ended (the ROM's past outputs
+        # restart at zero, a small kick that the converging LCO forgets)
+        xs0 = sim.xs[-1]
     V_truth = (float(flutter_truth.Vf) * lc.speed_factor if flutter_truth.flutter is not None
                else V_lco)
     tr = truth_lco(truth, V_truth, lc.duration, crit, lc.initial_deflection, dt=model.dt,
