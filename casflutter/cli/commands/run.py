@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import json
 
-from ..._outputs import check_output_path
-
 
 def _speed(block) -> str:
     """``V = 1.2 (speed index), U = 34.7 m/s, q = 737 Pa`` of a flutter block."""
@@ -26,7 +24,6 @@ def _main(args) -> int:
     cfg = load_config(args.config)   # validated before any work starts
     # the output folder is checked (and refused when not empty without --overwrite) before
     # any work, and written atomically at the end
-    check_output_path(args.out, what="--out", kind="dir", overwrite=args.overwrite)
     res = run(cfg, out_dir=args.out, seed=args.seed, quiet=args.quiet,
               overwrite=args.overwrite)
     s = res.summary()
