@@ -287,7 +287,8 @@ def find_flutter(system, V_range=None, *, V_grid=None, n_grid: int = 101, mode_s
     if flut is not None:
         status = "flutter"
         msg = (f"flutter at V = {flut.V:.10g}, {flut.omega:.6g} rad/s ({flut.frequency_hz:.6g} Hz), "
-               f"branch {flut.branch} from structural mode {flut.origin_mode}")
+               + (f"structural mode {flut.origin_mode + 1} (numbered from 1)"
+                  if flut.origin_mode >= 0 else f"branch {flut.branch} (not a structural mode)"))
     elif div is not None:
         status, msg = "divergence", f"no flutter; static divergence at V = {div.V:.10g}"
     else:

@@ -5,8 +5,10 @@ generalised aerodynamic forces Q(ik) with their files."""
 from ._gaf import GAFTable, load_gaf
 from ._records import IOData, Record
 from ._response import ResponseAnalysis, analyze_response, dominant_frequency, envelope_growth_rate
-from ._signals import backward_derivatives, check_band, chirp_excitation, chirp_motion
+from ._signals import (backward_derivatives, check_band, chirp_excitation, chirp_motion,
+                       stepped_chirp_motion)
 
-__all__ = ["IOData", "Record", "chirp_excitation", "chirp_motion", "backward_derivatives",
+__all__ = ["IOData", "Record", "chirp_excitation", "chirp_motion", "stepped_chirp_motion",
+           "backward_derivatives",
            "check_band", "ResponseAnalysis", "analyze_response", "envelope_growth_rate",
            "dominant_frequency", "GAFTable", "load_gaf"]

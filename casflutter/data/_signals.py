@@ -1,11 +1,15 @@
 """Excitation signals (band-limited chirps, paper §IV.A) and backward-difference derivatives.
 
-Two chirp shapes serve two kinds of experiment, with one check of their band:
+Three chirp shapes serve three kinds of experiment, with one check of their band:
 
 - :func:`chirp_excitation` — several mutually decorrelated channels at once (triangle sweeps at
   seeded rates and phases), for records in which every input moves together;
 - :func:`chirp_motion` — one tapered linear sweep with its exact first and second
-  derivatives, for a prescribed motion that starts and ends at rest (one channel per record).
+  derivatives, for a prescribed motion that starts and ends at rest (one channel per record);
+- :func:`stepped_chirp_motion` — the same sweep repeated at several amplitudes one after the
+  other, each repetition starting and ending at rest: a record that covers the amplitude
+  range of a nonlinear response (the amplitude-dependent terms of a nonlinear model are
+  fitted where they act).
 
 :func:`backward_derivatives` gives the grid velocity and acceleration a second-order implicit
 CFD time step computes from the displacement samples (BDF2): a causal function of the samples.
@@ -17,7 +21,8 @@ import numpy as np
 
 from ..errors import ConfigError, DataError
 
-__all__ = ["chirp_excitation", "chirp_motion", "backward_derivatives", "check_band"]
+__all__ = ["chirp_excitation", "chirp_motion", "stepped_chirp_motion", "backward_derivatives",
+           "check_band"]
 
 
 def check_band(band, dt: float | None = None) -> tuple[float, float]:
@@ -203,6 +208,60 @@ def chirp_motion(timepts, band: tuple[float, float], amplitude: float = 1.0,
     ud = w1 * s + w * d1 * c
     udd = w2 * s + 2 * w1 * d1 * c + w * d2 * c - w * d1 * d1 * s
     return amplitude * u, amplitude * ud, amplitude * udd
+
+
+def stepped_chirp_motion(timepts, band: tuple[float, float], levels, taper: float = 0.1,
+                         phase: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Amplitude-stepped chirps: :func:`chirp_motion` once per level, one after the other.
+
+    The samples are split into ``len(levels)`` consecutive segments of (nearly) equal length;
+    segment ``k`` is a tapered chirp over the whole ``band`` with peak amplitude
+    ``levels[k]``.  Every segment starts and ends at rest (value and both derivatives zero),
+    so the concatenation is twice continuously differentiable and its derivatives are exact.
+
+    Parameters
+    ----------
+    timepts : array_like, shape (K,)
+        Increasing, uniformly spaced sample times.
+    band : (float, float)
+        Start and end frequency of every segment [cycles per time unit of the problem].
+    levels : sequence of float
+        Peak amplitude of each segment, in the order they are applied (at least one; every
+        segment keeps at least 4 samples).
+    taper : float
+        Fraction of each segment tapered at each end, in (0, 0.5].
+    phase : float
+        Phase offset of every segment [rad].
+
+    Returns
+    -------
+    s, sdot, sddot : ndarray, shape (K,)
+
+    Raises
+    ------
+    ConfigError
+        No level, a level that is not a finite number, or a bad taper or band
+        (:func:`chirp_motion`).
+    DataError
+        Times that do not increase, or fewer than 4 samples per segment.
+    """
+    t = np.asarray(timepts, dtype=float).ravel()
+    try:
+        amps = [float(a) for a in levels]
+    except (TypeError, ValueError):
+        raise ConfigError(f"levels = {levels!r}: give a list of amplitudes") from None
+    if not amps or not all(np.isfinite(amps)):
+        raise ConfigError(f"levels = {levels!r}: give at least one finite amplitude")
+    n = len(amps)
+    if t.size < 4 * n:
+        raise DataError(f"{t.size} samples cannot hold {n} chirps of at least 4 samples")
+    edges = np.linspace(0, t.size, n + 1).round().astype(int)
+    out = [np.empty(t.size) for _ in range(3)]
+    for k, a in enumerate(amps):
+        seg = slice(edges[k], edges[k + 1])
+        for o, x in zip(out, chirp_motion(t[seg], band, a, taper, phase)):
+            o[seg] = x
+    return out[0], out[1], out[2]
 
 
 def backward_derivatives(x, dt: float) -> tuple[np.ndarray, np.ndarray]:

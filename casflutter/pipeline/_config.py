@@ -201,10 +201,17 @@ class LcoSection:
     speed_factor: float = 1.05
     """Simulate at ``speed_factor`` times each model's own Hopf speed: exactly at the Hopf
     point the linear damping is zero and the approach to the LCO is infinitely slow."""
+    branch_points: int = 20
+    """Points of the ROM loop's and the truth's LCO branches from their flutter points
+    (:mod:`casflutter.lco`, the bifurcation diagrams of the report); 0: none."""
 
     def __post_init__(self):
         for name in ("duration", "initial_deflection", "speed_factor"):
             _positive(name, getattr(self, name))
+        _integer("branch_points", self.branch_points, 0)
+        if 0 < self.branch_points < 3:
+            raise ConfigError(f"branch_points = {self.branch_points}: give 0 (no branches) or "
+                              "at least 3")
 
 
 @dataclass(frozen=True)

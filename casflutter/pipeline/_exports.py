@@ -29,7 +29,7 @@ from scipy.io import savemat
 from .._outputs import MANIFEST_NAME, atomic_folder
 from .._outputs import check_output_folder as _check_folder
 from .._outputs import plain_json, provenance, write_manifest
-from ..report import write_figures, write_html
+from ..report import figure_captions, write_figures, write_html
 from ..verify import controller_to_json, plant_to_json
 from ._units import (FLAP_UNIT, interval_values, sensor_units, speed_scale, speed_values,
                      units_block)
@@ -428,7 +428,7 @@ def write_outputs(target, result, *, overwrite: bool = False) -> dict:
         files["config"] = _dump(config, tmp / "config.json")
         figs = write_figures(tmp, result)
         files.update(figs)
-        files["report"] = write_html(tmp, summary, figs)
+        files["report"] = write_html(tmp, summary, figs, figure_captions(result))
         info = dict(getattr(result, "provenance", None) or {}) or provenance(
             seed=result.config.seed)
         stages = [k for k in result.timings if k != "total"]

@@ -15,6 +15,7 @@ from ..data import IOData
 from ..design import SynthesisResult
 from .._outputs import plain_json
 from ..ident import CommonDenominatorResult, FitReport, IdentificationResult
+from ..lco import LCOBranch
 from ..realize import ParametricROM, RationalApproximation, Realization
 from ..truth import AeroelasticTruth, SuppressionResult, TruthLco, TruthLoopSweep
 from ..verify import SpeedSweep, VerificationReport
@@ -38,12 +39,20 @@ class LcoResult:
         The truth's own response a little above its own flutter speed (``None`` on a wing
         file, which has no simulator).
     V : float
-        Speed of the ROM simulation: ``lco.speed_factor`` times ``V_hopf_exact_order``.
+        Speed of the ROM simulation: ``lco.speed_factor`` times ``V_hopf_loop`` (or
+        ``V_hopf_exact_order`` when the loop has no flutter point in the range).
     V_hopf_exact_order : float
-        Hopf speed of the ROM realised at its exact order (the nonlinear ROM carries its full
-        linear part; a truncated Σf has another Hopf point).
+        Hopf speed of the continuous ΣAE with the ROM realised at its exact order (the
+        nonlinear ROM carries its full linear part; a truncated Σf has another Hopf point).
     flutter_exact_order : FlutterResult
-        The flutter search of that exact-order loop.
+        The flutter search of that exact-order continuous loop.
+    V_hopf_loop : float or None
+        The ROM's own flutter speed: the Neimark--Sacker point of the sampled-data loop it is
+        simulated in (:func:`casflutter.lco.rom_loop_map`); None when there is none in the
+        flutter search range.
+    truth_branch, rom_branch : LCOBranch or None
+        The LCO branches of the truth and of the ROM loop from their flutter points
+        (``lco.branch_points > 0``).
     """
 
     rom: LoopSimulation
@@ -51,6 +60,9 @@ class LcoResult:
     V: float
     V_hopf_exact_order: float
     flutter_exact_order: FlutterResult
+    V_hopf_loop: float | None = None
+    truth_branch: LCOBranch | None = None
+    rom_branch: LCOBranch | None = None
 
 
 @dataclass(frozen=True)
@@ -458,11 +470,17 @@ class RunResult:
         sim, tr = self.lco.rom, self.lco.truth
         sens = sim.sensors if sim.sensors is not None else sim.modes
         return {"V": self.lco.V, "V_hopf_exact_order": self.lco.V_hopf_exact_order,
+                "V_hopf_loop": self.lco.V_hopf_loop,
                 "freq_hz": sens.frequency_hz, "amplitude": list(sens.amplitude),
                 "kind": sens.kind, "truth_V": None if tr is None else tr.V,
                 "truth_freq_hz": None if tr is None else tr.freq_hz,
                 "truth_amplitude": None if tr is None else list(tr.amplitude),
-                "truth_kind": None if tr is None else tr.kind}
+                "truth_kind": None if tr is None else tr.kind,
+                "branches": {name: {"V_hopf": br.hopf.V, "kind": br.hopf.kind,
+                                    "points": len(br.points), "completed": br.completed}
+                             for name, br in (("truth", self.lco.truth_branch),
+                                              ("rom", self.lco.rom_branch))
+                             if br is not None}}
 
     def _controller_summary(self) -> dict | None:
         if self.verification is None:

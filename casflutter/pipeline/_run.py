@@ -51,8 +51,10 @@ from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 
+import casadi as ca
 import control
 import numpy as np
+from scipy.optimize import brentq
 
 from .._linalg import spectral_abscissa
 from .._outputs import provenance, utc_now
@@ -62,9 +64,11 @@ from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, R
                            find_flutter, simulate_loop)
 from ..data import envelope_growth_rate
 from ..design import SynthesisOptions, design_flutter_controller
-from ..errors import CasflutterError, ConfigError
+from ..errors import CasflutterError, ConfigError, ConvergenceError
 from ..ident import (IdentificationResult, IdentificationSettings, fit_report, identify,
                      identify_common_denominator)
+from ..lco import (LCOSettings, lco_branch, rom_lco_branch, rom_loop_map,
+                   speed_convention)
 from ..realize import ParametricROM, RFASettings, fit_rfa, realize, speed_nodes
 from ..truth import (AeroelasticTruth, GAFProblem, RecordSettings, WingProblem,
                      closed_loop_truth, frozen_aero_truth, suppression_run,
@@ -454,11 +458,16 @@ def _finish(out: dict, prog, target: Path | None, write: bool, overwrite: bool,
 def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth, prog) -> LcoResult:
     """Paper Fig. 9: the ROM's and the truth's LCO a little above their own Hopf points.
 
-    The nonlinear ROM carries its full linear part (exact order); when Σf is truncated
-    (the paper's nf = 15) its own Hopf point differs from Vf.  It is simulated a few per
-    cent above the Hopf point of the exact-order linearisation, where the LCO develops; the
-    truth the same distance above its own Hopf point (the ROM's speed can be far above the
-    truth's flutter speed, where the truth diverges).
+    The ROM's own flutter point is that of the loop it is simulated in: the sampled-data
+    loop of the nonlinear ROM with Σs (a Neimark--Sacker point of the map of
+    :func:`casflutter.lco.rom_loop_map`).  Its speed differs from the Hopf speed of the
+    continuous ΣAE by the sampling (the zero-order hold and the one-sample coupling), by
+    several per cent for the seed wing, so a speed a few per cent above the continuous Hopf
+    point can lie below the loop's.  The ROM is simulated ``speed_factor`` times above the
+    loop's point and the truth the same factor above its own Hopf point (the ROM's speed can
+    be far above the truth's flutter speed, where the truth diverges); each simulation is
+    continued while it still grows.  The Hopf speed of the exact-order continuous ΣAE is
+    kept for the record.
     """
     vr, lc = cfg.flutter.V_range, cfg.lco
     exact = realize(model, "auto")
@@ -466,20 +475,88 @@ def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth, prog) 
     fl_exact = find_flutter(sys_exact, vr, n_grid=cfg.flutter.n_grid,
                             max_refine=cfg.flutter.max_refine)
     V_hopf = float(fl_exact.Vf) if fl_exact.flutter is not None else float(flutter.Vf)
-    V_lco = V_hopf * lc.speed_factor
+    V_loop = _loop_hopf(model, structure, vr, cfg.flutter.n_grid)
+    V_lco = (V_loop if V_loop is not None else V_hopf) * lc.speed_factor
     crit = _mode(flutter)
-    sim = simulate_loop(model, structure, V_lco, int(round(lc.duration / model.dt)),
-                        xs0=structure.displaced_state(crit, lc.initial_deflection))
+    n = int(round(lc.duration / model.dt))
+    xs0 = structure.displaced_state(crit, lc.initial_deflection)
+    for _ in range(_MAX_EXTENSIONS + 1):
+        sim = simulate_loop(model, structure, V_lco, n, xs0=xs0)
+        if sim.stopped_early or sim.modes.kind != "divergence":
+            break
+        # still growing: continue from where the structure ended (the ROM's past outputs
+        # restart at zero, a small kick that the converging LCO forgets)
+        xs0 = sim.xs[-1]
     tr = None
     if truth is not None:
         V_truth = (float(flutter_truth.Vf) * lc.speed_factor
                    if flutter_truth.flutter is not None else V_lco)
         tr = truth_lco(truth, V_truth, lc.duration, crit, lc.initial_deflection, dt=model.dt,
-                       sensor_rows=structure.Hs, sensor=structure.sensor)
-    prog.note(f"ROM LCO at V = {V_lco:.4f} (exact-order Hopf {V_hopf:.4f}): "
+                       sensor_rows=structure.Hs, sensor=structure.sensor,
+                       max_extensions=_MAX_EXTENSIONS)
+    prog.note(f"ROM LCO at V = {V_lco:.4f} (loop flutter {V_loop or float('nan'):.4f}, "
+              f"continuous exact-order Hopf {V_hopf:.4f}): "
               f"{sim.sensors.kind}, {sim.sensors.frequency_hz:.3f} Hz")
+    branches = _branches(cfg, truth, model, structure, prog) if lc.branch_points else {}
     return LcoResult(rom=sim, truth=tr, V=V_lco, V_hopf_exact_order=V_hopf,
-                     flutter_exact_order=fl_exact)
+                     flutter_exact_order=fl_exact, V_hopf_loop=V_loop, **branches)
+
+
+def _branches(cfg: RunConfig, truth, model, structure, prog) -> dict:
+    """The LCO branches of the ROM loop and of the truth (``lco.branch_points`` points
+    each; no truth branch on a wing file), or the reason a branch could not be started."""
+    settings = LCOSettings(max_points=cfg.lco.branch_points, sensor_kind=structure.sensor)
+    scale, unit = speed_convention(truth) if truth is not None else (1.0, "speed index")
+    ms = truth.modal_structure() if truth is not None else structure
+    out = {}
+    computations = [] if truth is None else [
+        ("truth_branch", lambda: lco_branch(truth, cfg.flutter.V_range, settings,
+                                            problem="truth"))]
+    for key, compute in (
+            *computations,
+            ("rom_branch", lambda: rom_lco_branch(
+                model, structure, cfg.flutter.V_range, settings, mode_names=ms.mode_names,
+                sensor_names=structure.sensor_names, problem="ROM loop", speed_scale=scale,
+                speed_unit=unit, time_unit=ms.time_unit))):
+        try:
+            out[key] = compute()
+        except (ConfigError, ConvergenceError) as exc:
+            prog.note(f"no {key.replace('_', ' ')}: {exc}")
+    if "truth_branch" in out and "rom_branch" in out:
+        # the ROM loop's outputs are the truth's quantities: give them the truth's units
+        units = dict(zip(out["truth_branch"].outputs, out["truth_branch"].output_units))
+        rb = out["rom_branch"]
+        out["rom_branch"] = replace(rb, output_units=tuple(
+            units.get(n, u) for n, u in zip(rb.outputs, rb.output_units)))
+    return out
+
+
+#: most continuations of an LCO simulation that still grows
+_MAX_EXTENSIONS = 5
+
+
+def _loop_hopf(model, structure, vrange, n_grid: int) -> float | None:
+    """Speed of the first Neimark--Sacker point of the sampled-data ROM loop in ``vrange``
+    (the spectral radius of its linearisation at rest crossing one), or None."""
+    F = rom_loop_map(model, structure)
+    s, V = ca.SX.sym("s", int(F.size1_in(0))), ca.SX.sym("V")
+    jac = ca.Function("loop_jacobian", [s, V], [ca.jacobian(F(s, V), s)])
+    zero = np.zeros(int(F.size1_in(0)))
+
+    def radius(v: float) -> float:
+        lam = np.linalg.eigvals(np.asarray(jac(zero, v), float))
+        osc = lam[np.abs(lam.imag) > 1e-9]
+        return float(np.max(np.abs(osc))) - 1.0 if osc.size else -1.0
+
+    grid = np.linspace(max(vrange[0], 1e-3), vrange[1], n_grid)
+    r = np.array([radius(v) for v in grid])
+    if r[0] >= 0:
+        return None
+    up = np.flatnonzero((r[:-1] < 0) & (r[1:] >= 0))
+    if up.size == 0:
+        return None
+    k = int(up[0])
+    return float(brentq(radius, grid[k], grid[k + 1], xtol=1e-10))
 
 
 def _rate(timepts, X) -> float:

@@ -15,8 +15,14 @@ def _tracking(obj):
     return (obj.tracking, obj) if hasattr(obj, "tracking") else (obj, None)
 
 
-def plot_vg_vf(result, *, branches=None, hz: bool = True, ax=None) -> Figure:
+def plot_vg_vf(result, *, branches=None, hz: bool = True, ax=None, mode_names=None,
+               speed_label: str = "speed index V") -> Figure:
     """V–g and V–f plot: damping ratio ``ζ = −Re λ/|λ|`` and frequency of every branch against V.
+
+    With a :class:`~casflutter.aeroelastic.FlutterResult` the branches that grow out of a
+    structural mode are drawn in colour and named by their mode (numbered from 1); the
+    branches of the aerodynamic lag states are drawn faint and grey, with one legend entry,
+    and the axes are scaled to the structural branches (every mode's frequency in view).
 
     Parameters
     ----------
@@ -28,6 +34,10 @@ def plot_vg_vf(result, *, branches=None, hz: bool = True, ax=None) -> Figure:
         Frequency axis in Hz (else rad/s).
     ax : pair of Axes, optional
         Where to draw (damping, frequency); a new figure otherwise.
+    mode_names : sequence of str, optional
+        Names of the structural modes, added to their legend entries.
+    speed_label : str
+        Label of the speed axis.
 
     Returns
     -------
@@ -35,36 +45,65 @@ def plot_vg_vf(result, *, branches=None, hz: bool = True, ax=None) -> Figure:
     """
     tr, res = _tracking(result)
     if ax is None:
-        fig, (ag, af) = plt.subplots(2, 1, sharex=True, figsize=(6.5, 6.0))
+        fig, (ag, af) = plt.subplots(2, 1, sharex=True, figsize=(8.6, 6.4))
     else:
         ag, af = ax
         fig = ag.figure
     bs = tr.upper_branches() if branches is None else np.asarray(branches)
-    freq = tr.frequency_hz if hz else tr.frequency
-    for b in bs:
-        lab = f"branch {b}"
-        if res is not None:
-            lab += f" (mode {res.origin[b] + 1})" if res.origin[b] >= 0 else " (aero)"
-        line, = ag.plot(tr.V, tr.damping_ratio[:, b], label=lab)
-        af.plot(tr.V, np.abs(freq[:, b]), color=line.get_color())
+    freq = np.abs(tr.frequency_hz if hz else tr.frequency)
+    zeta = tr.damping_ratio
+    structural, aero_drawn = [], False
+    for b in sorted(bs, key=lambda b: (res.origin[b] if res is not None and res.origin[b] >= 0
+                                       else 10 ** 6, b)):
+        origin = int(res.origin[b]) if res is not None else -2
+        if origin == -1:            # an aerodynamic lag state: faint, one legend entry
+            kw = dict(color="0.6", lw=0.7, alpha=0.5, zorder=1,
+                      label=None if aero_drawn else "aerodynamic lag states")
+            aero_drawn = True
+            ag.plot(tr.V, zeta[:, b], **kw)
+            af.plot(tr.V, freq[:, b], color="0.6", lw=0.7, alpha=0.5, zorder=1)
+            continue
+        if origin >= 0:
+            name = (f" ({mode_names[origin]})" if mode_names is not None
+                    and origin < len(mode_names) else "")
+            lab = f"mode {origin + 1}{name}"
+        else:
+            lab = f"branch {b + 1}"
+        structural.append(b)
+        line, = ag.plot(tr.V, zeta[:, b], lw=1.5, label=lab, zorder=3)
+        af.plot(tr.V, freq[:, b], color=line.get_color(), lw=1.5, zorder=3)
     ag.axhline(0.0, color="k", lw=0.8)
     if res is not None:
         for c in res.crossings:
             style = "--" if c.kind == "flutter" else ":"
             for a in (ag, af):
-                a.axvline(c.V, color="r" if c.direction == "destabilizing" else "g", ls=style, lw=0.8)
+                a.axvline(c.V, color="r" if c.direction == "destabilizing" else "g", ls=style,
+                          lw=0.8)
         if res.Vf is not None:
-            ag.set_title(f"Vf = {res.Vf:.6g}, {res.frequency_hz:.4g} Hz (mode {res.flutter_mode + 1})"
-                         if res.flutter_mode is not None and res.flutter_mode >= 0
-                         else f"Vf = {res.Vf:.6g}, {res.frequency_hz:.4g} Hz")
+            mode = (f" (mode {res.flutter_mode + 1})"
+                    if res.flutter_mode is not None and res.flutter_mode >= 0 else "")
+            ag.set_title(f"flutter: Vf = {res.Vf:.4g}, {res.frequency_hz:.3g} Hz{mode}",
+                         fontsize="medium")
         else:
-            ag.set_title(res.status.replace("_", " "))
+            ag.set_title(res.status.replace("_", " "), fontsize="medium")
+        if structural and aero_drawn:
+            # the structural branches set the scales; the lag states may run far off
+            fs, zs = freq[:, structural], zeta[:, structural]
+            af.set_ylim(0.0, 1.12 * float(np.nanmax(fs)))
+            lo, hi = float(np.nanmin(zs)), float(np.nanmax(zs))
+            pad = 0.1 * max(hi - lo, 1e-3)
+            ag.set_ylim(min(lo, 0.0) - pad, hi + pad)
     ag.set_ylabel("damping ratio ζ = −Re λ / |λ|")
     af.set_ylabel("frequency [Hz]" if hz else "frequency [rad/s]")
-    af.set_xlabel("speed index V")
-    ag.legend(fontsize="small")
+    af.set_xlabel(speed_label)
     ag.grid(True, alpha=0.3)
     af.grid(True, alpha=0.3)
+    if ax is None:     # the legend beside the plots, clear of the branches
+        ag.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0),
+                  borderaxespad=0.0)
+        fig.tight_layout()
+    else:
+        ag.legend(fontsize="small", loc="best")
     return fig
 
 
@@ -94,9 +133,22 @@ def plot_root_locus(result, *, branches=None, ax=None) -> Figure:
     return fig
 
 
+def _last_cycles(t, X, freq_hz: float, cycles: int):
+    """The samples of the last ``cycles`` periods (all when the frequency is unknown)."""
+    if not np.isfinite(freq_hz) or freq_hz <= 0:
+        return t, X
+    keep = t >= t[-1] - cycles / freq_hz
+    return t[keep], X[keep]
+
+
 def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | None = None,
-             truth=None) -> Figure:
+             truth=None, labels=None, cycles: int = 6, title: str | None = None) -> Figure:
     """LCO time history and spectrum (paper Fig. 9).
+
+    One row per channel and a spectrum row.  With the truth's response the ROM's is drawn
+    in the left column and the truth's in the right one, each over its own last ``cycles``
+    periods with the same vertical scale per row, so that both wave forms and amplitudes
+    can be read and compared.
 
     Parameters
     ----------
@@ -105,53 +157,72 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
     which : {"sensors", "modes"}
         Plot the sensor outputs zm or the modal displacements u.
     channels : sequence of int, optional
-        Channels to draw (default all).
+        0-based channels to draw (default all).
     fmax_hz : float, optional
         Upper limit of the spectrum axis (default 4× the fundamental).
     truth : casflutter.truth.TruthLco, optional
         The truth's own response beside the ROM's (sensor outputs only), from
-        :func:`casflutter.truth.truth_lco`; drawn dashed.
+        :func:`casflutter.truth.truth_lco`.
+    labels : sequence of str, optional
+        Axis label per channel with its unit (default ``sensor 1``, ``mode 1``, ...).
+    cycles : int
+        Periods shown of each time history (the whole record when it has no frequency).
+    title : str, optional
+        Figure title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     if which not in ("sensors", "modes"):
         raise ValueError(f"which={which!r}; choose 'sensors' or 'modes'")
     X = sim.zm if which == "sensors" else sim.u
     an = sim.sensors if which == "sensors" else sim.modes
-    chans = range(X.shape[1]) if channels is None else channels
-    name = "zm" if which == "sensors" else "u"
-    fig, (at, afr) = plt.subplots(2, 1, figsize=(7.0, 6.0))
-    for j in chans:
-        at.plot(sim.timepts, X[:, j], lw=0.8, label=f"{name}[{j}]")
-    if an is not None and np.isfinite(an.window[0]):
-        at.axvspan(an.window[0], an.window[1], color="0.9", zorder=0)
-    at.set_xlabel("time [s]")
-    at.set_ylabel(which)
-    title = f"V = {sim.V:g}: {an.kind}" if an is not None else f"V = {sim.V:g}"
-    if an is not None and an.kind == "lco":
-        title += f", fundamental {an.frequency_hz:.4g} Hz"
+    chans = list(range(X.shape[1]) if channels is None else channels)
+    word = "sensor" if which == "sensors" else "mode"
+    labels = list(labels) if labels is not None else []
+    names = [labels[j] if j < len(labels) else f"{word} {j + 1}" for j in chans]
+    pairs = [("ROM loop", sim.timepts, X, an, sim.V)]
     if truth is not None and which == "sensors":
-        ta = truth.analysis
-        for j in chans:
-            at.plot(truth.timepts, truth.zm[:, j], lw=0.8, ls="--", label=f"truth zm[{j}]")
-        title += f"; truth at V = {truth.V:.4g}: {ta.kind}"
-        if ta.kind == "lco":
-            title += f", {ta.frequency_hz:.4g} Hz"
-        if truth.t_start > 0:
-            title += f" (its last {truth.timepts[-1]:.3g} s after {truth.t_start:.3g} s)"
-        if ta.spectrum.size:
-            afr.plot(ta.spectrum_freq_hz, ta.spectrum, lw=0.9, ls="--", label="truth")
-    at.set_title(title, fontsize="medium")
-    at.legend(fontsize="small", ncol=3)
-    if an is not None and an.spectrum.size:
-        afr.plot(an.spectrum_freq_hz, an.spectrum, lw=0.9, label="ROM")
-        if truth is not None:
-            afr.legend(fontsize="small")
-        if np.isfinite(an.frequency_hz):
-            afr.axvline(an.frequency_hz, color="r", ls="--", lw=0.8)
-            afr.set_xlim(0, fmax_hz or 4 * an.frequency_hz)
-    afr.set_xlabel("frequency [Hz]")
-    afr.set_ylabel(f"|FFT| of {name}[{an.dominant if an is not None else 0}] (window)")
-    for a in (at, afr):
-        a.grid(True, alpha=0.3)
+        pairs.append(("truth", truth.timepts, truth.zm, truth.analysis, truth.V))
+    ncol = len(pairs)
+    fig, axes = plt.subplots(len(chans) + 1, ncol, figsize=(5.2 * ncol + 1.2, 2.1 * len(chans) + 2.6),
+                             squeeze=False, sharey="row")
+    for col, (label, t, Z, a, V) in enumerate(pairs):
+        f = a.frequency_hz if a is not None else float("nan")
+        tt, ZZ = _last_cycles(t, Z, f, cycles)
+        head = f"{label} at V = {V:.4g}: {a.kind if a is not None else ''}"
+        if a is not None and a.kind == "lco":
+            head += f", {f:.3g} Hz"
+        axes[0, col].set_title(head, fontsize="medium")
+        for row, j in enumerate(chans):
+            ax = axes[row, col]
+            ax.plot(tt, ZZ[:, j], color="C0" if col == 0 else "k", lw=1.0)
+            if a is not None and j < len(a.amplitude) and a.kind == "lco":
+                ax.text(0.99, 0.95, f"amplitude {a.amplitude[j]:.4g}", transform=ax.transAxes,
+                        ha="right", va="top", fontsize="small",
+                        bbox=dict(fc="white", ec="none", alpha=0.8))
+            if col == 0:
+                ax.set_ylabel(names[row], fontsize="small")
+            ax.grid(True, alpha=0.3)
+        axes[len(chans) - 1, col].set_xlabel(
+            "time [s]" + (f" (last {cycles} periods)" if np.isfinite(f) and f > 0 else ""))
+        afr = axes[len(chans), col]
+        dom = a.dominant if a is not None else 0
+        if a is not None and a.spectrum.size:
+            afr.plot(a.spectrum_freq_hz, a.spectrum, color="C0" if col == 0 else "k", lw=0.9)
+            if np.isfinite(f):
+                afr.axvline(f, color="r", ls="--", lw=0.8)
+        fmax = fmax_hz or (4 * an.frequency_hz if an is not None
+                           and np.isfinite(an.frequency_hz) else None)
+        if fmax:
+            afr.set_xlim(0, fmax)
+        afr.set_xlabel("frequency [Hz]")
+        dom_name = names[chans.index(dom)] if dom in chans else f"{word} {dom + 1}"
+        afr.set_ylabel("|FFT|", fontsize="small")
+        afr.set_title(f"spectrum of {dom_name.split(' [')[0]}", fontsize="small")
+        afr.grid(True, alpha=0.3)
+    fig.suptitle(title or "Fig. 9: limit-cycle oscillation", fontsize="large")
     fig.tight_layout()
     return fig
 

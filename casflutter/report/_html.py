@@ -36,8 +36,26 @@ def _fmt(x, digits=4):
     return html.escape(str(x))
 
 
-def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflutter run") -> str:
-    """HTML text of the report (figures read from PNG files and embedded as base64)."""
+def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflutter run",
+                captions: dict[str, str] | None = None) -> str:
+    """HTML text of the report (figures read from PNG files and embedded as base64).
+
+    Parameters
+    ----------
+    summary : dict
+        The run's summary (``summary.json``).
+    figures : dict
+        Figure name -> PNG path.
+    title : str
+        Page title.
+    captions : dict, optional
+        Figure name -> caption; a figure without one is captioned by its file name.
+
+    Returns
+    -------
+    str
+    """
+    captions = captions or {}
     s = summary
     fl, ctrl = s.get("flutter") or {}, s.get("controller") or {}
     lco, sup = s.get("lco") or {}, s.get("suppression") or {}
@@ -71,8 +89,16 @@ def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflu
     imgs = []
     for name, path in figures.items():
         data = base64.b64encode(Path(path).read_bytes()).decode("ascii")
-        imgs.append(f'<figure><img alt="{html.escape(name)}" src="data:image/png;base64,{data}">'
-                    f"<figcaption>{html.escape(name)}</figcaption></figure>")
+        caption = captions.get(name) or Path(path).name
+        imgs.append(f'<figure><img alt="{html.escape(caption)}" '
+                    f'src="data:image/png;base64,{data}">'
+                    f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+    lco_text = ""
+    if lco.get("amplitude") is not None and lco.get("truth_amplitude") is not None:
+        lco_text = (f"<p>LCO amplitude per sensor (half peak to peak), each model a little "
+                    f"above its own flutter speed: ROM {_fmt(lco['amplitude'])} at "
+                    f"V = {_fmt(lco.get('V'))}, truth {_fmt(lco['truth_amplitude'])} at "
+                    f"V = {_fmt(lco.get('truth_V'))}.</p>")
     timings = s.get("timings_s", {})
     trows = "\n".join(f"<tr><td>{html.escape(k)}</td><td>{v:.2f}</td></tr>"
                       for k, v in timings.items() if isinstance(v, (int, float)))
@@ -91,6 +117,7 @@ figcaption{{font-size:90%;color:#555}}</style></head><body>
 <p>ROM fit error per mode [%]: {fit}. Truth flutter: V = {_fmt(ft.get('V'))},
 {_fmt(ft.get('freq_hz'))} Hz. Controller: verified γ = {_fmt(ctrl.get('gamma'))},
 small-gain interval of V {_fmt(ctrl.get('small_gain_V'))}, exact stable interval {_fmt(ctrl.get('stable_V'))}.</p>
+{lco_text}
 <h2>Figures</h2>
 {''.join(imgs)}
 <h2>Timings [s]</h2>

@@ -160,7 +160,7 @@ def _legend_proxies(ax) -> None:
 
 
 def plot_bifurcation_pair(truth_branch, rom_branch, outputs=None, *,
-                          frequency: bool = True) -> Figure:
+                          frequency: bool = True, speed_range=None) -> Figure:
     """The truth's and the ROM's bifurcation diagrams side by side (same outputs, same axes
     ranges), e.g. for the seed wing's report.
 
@@ -172,6 +172,9 @@ def plot_bifurcation_pair(truth_branch, rom_branch, outputs=None, *,
         Default: the outputs both branches have, sensors first.
     frequency : bool
         Add the frequency row.
+    speed_range : (float, float), optional
+        Speed axis limits in the problem's unit (default: both branches with a margin on
+        each side).
 
     Returns
     -------
@@ -185,14 +188,18 @@ def plot_bifurcation_pair(truth_branch, rom_branch, outputs=None, *,
     fig, axes = plt.subplots(n, 2, sharex=False, sharey="row", figsize=(11.0, 2.6 * n + 0.8),
                              squeeze=False)
     for col, (br, label) in enumerate(((truth_branch, "truth"), (rom_branch, "ROM loop"))):
+        unit = f" {br.speed_unit}" if br.speed_unit == "m/s" else ""
         plot_bifurcation(br, outputs, frequency=frequency, ax=axes[:, col],
                          title=f"{label}: {br.hopf.kind} "
-                               f"{'Neimark-Sacker' if br.hopf.discrete else 'Hopf'} at "
-                               f"{float(br.speed(br.hopf.V)):.4g}")
-    lo = min(float(truth_branch.speed(truth_branch.vrange[0])),
-             float(rom_branch.speed(rom_branch.vrange[0])))
-    hi = max(float(truth_branch.speed(truth_branch.vrange[1])),
-             float(rom_branch.speed(rom_branch.vrange[1])))
+                               f"{'Neimark-Sacker' if br.hopf.discrete else 'Hopf'} point at "
+                               f"{float(br.speed(br.hopf.V)):.4g}{unit}")
+    if speed_range is None:
+        speeds = [float(br.speed(v)) for br in (truth_branch, rom_branch)
+                  for v in [br.hopf.V, *(p.V for p in br.points)]]
+        span = max(speeds) - min(speeds)
+        lo, hi = min(speeds) - 0.15 * span, max(speeds) + 0.1 * span
+    else:
+        lo, hi = (float(v) for v in speed_range)
     for a in axes.ravel():
         a.set_xlim(lo, hi)
     fig.tight_layout()

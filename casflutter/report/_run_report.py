@@ -14,9 +14,11 @@ import numpy as np
 from ..aeroelastic import simulate_loop
 from ._flutter_plots import plot_lco, plot_pole_loci, plot_vg_vf
 from ._html import html_report
+from ._labels import sensor_labels
+from ._lco_plots import plot_bifurcation_pair
 from ._pipeline_plots import plot_flap_pulses, plot_gain_ramp, plot_hankel, plot_rom_fit
 
-__all__ = ["write_figures", "write_html", "flap_pulse_comparison"]
+__all__ = ["write_figures", "write_html", "flap_pulse_comparison", "figure_captions"]
 
 
 def _save(fig, path: Path) -> Path:
@@ -66,8 +68,22 @@ def flap_pulse_comparison(truth, model, structure, V: float, *, dt: float,
             "rom_zm": sim_r.zm}
 
 
+def _sensor_labels(result) -> list[str]:
+    """Axis labels of the run's sensors with their units (the truth's units when the run
+    reads the truth's own sensor rows)."""
+    st = result.system.structure
+    wing_units = getattr(result.problem, "sensor_units", None)
+    if isinstance(wing_units, tuple) and not result.config.sensors.rows:
+        # a wing file gives the unit of each sensor's reading itself
+        return [f"{n} [{u or '-'}]" for n, u in zip(st.sensor_names, wing_units)]
+    units = (() if result.config.sensors.rows or result.truth is None
+             else result.truth.sensor_units())
+    return sensor_labels(st.sensor_names, units, st.sensor, st.time_unit)
+
+
 def write_figures(out: Path, result) -> dict:
-    """Paper Fig. 7–11 (and the Hankel singular values) of a run as PNG files.
+    """Paper Fig. 7–11, the V–g/V–f plot, the Hankel singular values and (when the run
+    computed them) the LCO branches as PNG files.
 
     Parameters
     ----------
@@ -94,36 +110,131 @@ def write_figures(out: Path, result) -> dict:
             files["vg_vf"] = _save(plot_vg_vf(result.flutter), out / "vg_vf.png")
         return files
     model = result.identification.model
-    files["fig7_rom_fit"] = _save(plot_rom_fit(model, result.data), out / "fig7_rom_fit.png")
+    st = result.system.structure
+    labels = _sensor_labels(result)
+    files["fig7_rom_fit"] = _save(plot_rom_fit(model, result.data, fit=result.fit,
+                                               mode_names=st.mode_names,
+                                               time_unit=st.time_unit),
+                                  out / "fig7_rom_fit.png")
     real = result.realization
     files["hankel"] = _save(plot_hankel(real.hankel_singular_values, real.order),
                             out / "hankel_singular_values.png")
     if result.truth is not None:   # a wing file has no truth to compare with
-        fp = flap_pulse_comparison(result.truth, model, result.system.structure,
-                                   result.config.data.V0, dt=model.dt)
+        fp = flap_pulse_comparison(result.truth, model, st, result.config.data.V0, dt=model.dt)
         files["fig8_flap_pulses"] = _save(plot_flap_pulses(fp["timepts"], fp["truth_zm"],
-                                                           fp["rom_zm"], fp["v"]),
+                                                           fp["rom_zm"], fp["v"], labels,
+                                                           time_unit=st.time_unit),
                                           out / "fig8_flap_pulses.png")
     if result.lco is not None:
-        files["fig9_lco"] = _save(plot_lco(result.lco.rom, truth=result.lco.truth),
-                                  out / "fig9_lco.png")
-    files["vg_vf"] = _save(plot_vg_vf(result.flutter), out / "vg_vf.png")
+        lco = result.lco
+        pct = 100 * (result.config.lco.speed_factor - 1)
+        files["fig9_lco"] = _save(plot_lco(
+            lco.rom, truth=lco.truth, labels=labels,
+            title=f"Fig. 9: LCO of each model {pct:.3g} % above its own flutter speed"),
+            out / "fig9_lco.png")
+        if lco.truth_branch is not None and lco.rom_branch is not None:
+            files["lco_branches"] = _save(plot_bifurcation_pair(lco.truth_branch,
+                                                                lco.rom_branch),
+                                          out / "lco_branches.png")
+    files["vg_vf"] = _save(plot_vg_vf(result.flutter, mode_names=st.mode_names),
+                           out / "vg_vf.png")
     vr = result.config.flutter.V_range
     Vg = np.linspace(max(vr[0], 1e-3), vr[1], 60)
     fig10 = plot_pole_loci(result.system, Vg, controller=result.controller)
     # the structural region (far aerodynamic and controller poles would set the scale)
-    w_max = 1.3 * float(np.max(result.system.structure.omega))
+    w_max = 1.3 * float(np.max(st.omega))
     fig10.axes[0].set_xlim(-0.25 * w_max / 2, 0.1 * w_max / 2)
     fig10.axes[0].set_ylim(0.0, w_max)
     files["fig10_pole_loci"] = _save(fig10, out / "fig10_pole_loci.png")
     if result.suppression is not None:
-        sim = result.suppression.simulation
-        files["fig11_gain_ramp"] = _save(plot_gain_ramp(sim.timepts, sim.zm, sim.gain, sim.v),
-                                         out / "fig11_gain_ramp.png")
+        sup = result.suppression
+        sim = sup.simulation
+        ss = result.config.suppression
+        t0 = float(sim.timepts[0]) + ss.settle
+        dom = sup.dominant_sensor
+        amp = sup.open_loop_amplitude[dom] if sup.open_loop_amplitude else None
+        limit = None if ss.flap_limit is None else float(np.degrees(ss.flap_limit))
+        files["fig11_gain_ramp"] = _save(plot_gain_ramp(
+            sim.timepts, sim.zm, sim.gain, sim.v, labels,
+            phases=(t0, t0 + ss.ramp, t0 + ss.ramp + ss.hold), open_loop_amplitude=amp,
+            dominant=dom, time_unit=st.time_unit, flap_limit_deg=limit,
+            title=f"Fig. 11: suppression of the truth's LCO at V = {sup.V:.4g}"),
+            out / "fig11_gain_ramp.png")
     return files
 
 
-def write_html(out: Path, summary: dict, figures: dict) -> Path:
+def figure_captions(result) -> dict:
+    """A caption per figure of :func:`write_figures`, for the report.
+
+    Parameters
+    ----------
+    result : casflutter.pipeline.RunResult
+        The run.
+
+    Returns
+    -------
+    dict
+        Figure name -> caption.
+    """
+    cfg = result.config
+    if result.identification is None:   # a GAF wing file: the RFA's V-g/V-f only
+        return {"vg_vf": "V–g and V–f of ΣAE(V) with Σf frozen at the flutter airspeed.",
+                "vg_vf_airspeed": ("V–g and V–f of the RFA's ΣAE(U) against the airspeed: the "
+                                   "structural branches.")}
+    cap = {
+        "fig7_rom_fit": (
+            "Fig. 7. Generalised aerodynamic forces y_i of the truth's chirp records (black) "
+            "and the ROM's free run from the same inputs (dashed), one mode per panel. "
+            f"Error = 100 ||y - ŷ|| / ||y|| after the first {result.fit.skip} samples, on the "
+            "record shown and over all records (the number of the fit table)."),
+        "hankel": ("Hankel singular values of the linearised ROM; the dashed line is the "
+                   f"order nf = {result.realization.order} of Σf."),
+        "fig8_flap_pulses": (
+            f"Fig. 8. Sensor response to a sequence of flap pulses at V0 = {cfg.data.V0:g}: "
+            "the ROM in the loop with Σs (dashed) against the truth (black)."),
+        "vg_vf": ("V–g and V–f of ΣAE (the ROM's linear aeroelastic system): the branches of "
+                  "the structural modes in colour (numbered from 1), the aerodynamic lag "
+                  "states in grey; the red dashed line marks flutter."),
+        "fig10_pole_loci": ("Fig. 10. Poles of ΣAE over the speed range, open loop (x) and "
+                            "with the controller (o)."),
+    }
+    if result.lco is not None:
+        lco = result.lco
+        sens = lco.rom.sensors
+        rom_a = ", ".join(f"{a:.4g}" for a in sens.amplitude) if sens is not None else "-"
+        tr = lco.truth
+        V_rom = lco.V_hopf_loop if lco.V_hopf_loop is not None else lco.V_hopf_exact_order
+        Vt = None if result.flutter_truth is None else result.flutter_truth.Vf
+        f = cfg.lco.speed_factor
+        text = (f"Fig. 9. Limit-cycle oscillation of the ROM loop at V = {lco.V:.4g} ({f:g} "
+                f"x its own flutter speed {V_rom:.4g}, that of the sampled-data loop)")
+        if tr is not None:
+            tr_a = ", ".join(f"{a:.4g}" for a in tr.amplitude)
+            text += (f" and of the truth at V = {tr.V:.4g} ({f:g} x its flutter speed "
+                     f"{float('nan') if Vt is None else Vt:.4g}); sensor amplitudes (half "
+                     f"peak to peak) ROM {rom_a}, truth {tr_a}.")
+        else:
+            text += f"; sensor amplitudes (half peak to peak) {rom_a}."
+        cap["fig9_lco"] = text
+        cap["lco_branches"] = (
+            "LCO branches from the flutter points, continued in the airspeed: the truth "
+            "(left, orthogonal collocation) and the ROM loop (right, invariant circles of the "
+            "sampled-data map). Stable cycles solid, unstable dashed; the open circle marks "
+            "the flutter (Hopf / Neimark–Sacker) point.")
+    if result.suppression is not None:
+        sup = result.suppression
+        att = ("-" if sup.attenuation_percent is None
+               else f"{sup.attenuation_percent:.1f} %")
+        cap["fig11_gain_ramp"] = (
+            f"Fig. 11. Suppression of the truth's established LCO at V = {sup.V:.4g}: the "
+            "controller gain is ramped 0 -> 1, held and released (shaded: open loop and full "
+            "gain; dashed: the LCO amplitude before the ramp; dotted: the flap travel). "
+            f"Attenuation {att} (RMS of the dominant sensor); the LCO returns on release: "
+            f"{'yes' if sup.lco_returns else 'no'}.")
+    return cap
+
+
+def write_html(out: Path, summary: dict, figures: dict, captions: dict | None = None) -> Path:
     """``report.html`` with every figure embedded.
 
     Parameters
@@ -134,11 +245,13 @@ def write_html(out: Path, summary: dict, figures: dict) -> Path:
         The run's summary (``summary.json``).
     figures : dict
         Figure name -> PNG path.
+    captions : dict, optional
+        Figure name -> caption (:func:`figure_captions`).
 
     Returns
     -------
     Path
     """
     path = Path(out) / "report.html"
-    path.write_text(html_report(summary, figures), encoding="utf-8")
+    path.write_text(html_report(summary, figures, captions=captions), encoding="utf-8")
     return path

@@ -3,7 +3,8 @@
 The paper drives a full-order CFD solver with band-limited chirps on the modal
 displacements and records the generalised aerodynamic forces ``y``.  Here a truth simulator
 plays the CFD solver: one record per input channel (each modal displacement, then the flap),
-that channel following :func:`casflutter.data.chirp_motion` and the others at rest.
+that channel following :func:`casflutter.data.chirp_motion` (or the same chirp at several
+amplitudes in turn) and the others at rest.
 
 Grid velocities.  A CFD solver advances in time steps and computes the grid velocity and
 acceleration of prescribed motion from the displacement samples by backward differences;
@@ -15,6 +16,14 @@ the unit circle to imitate the phase lead.  The records therefore use second-ord
 backward-difference (BDF2) derivatives (:func:`casflutter.data.backward_derivatives`), as a
 second-order implicit CFD code would; the resulting ``O((omega dt)^2)`` derivative error is
 part of the ROM error.
+
+Amplitude range.  A linear aerodynamic operator makes the chirp amplitude a scale only, but
+the polynomial terms of a nonlinear ROM (paper eq. 2-4) are fitted where the records move:
+records of small amplitude leave them free to do anything at the amplitude of an LCO.
+:attr:`RecordSettings.levels` repeats each record's chirp at several amplitudes
+(:func:`casflutter.data.stepped_chirp_motion`), and :attr:`RecordSettings.amplitude` may
+differ per channel, so that each modal displacement is driven up to and past its amplitude
+on the LCO the ROM is meant to reproduce.
 
 Coupling delay.  In a loosely coupled CFD time march the flow of step ``k`` sees the grid of
 step ``k - 1``: the force lags the motion by one sample, the reason for the paper's input
@@ -29,7 +38,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .._settings import finite_numbers
-from ..data import IOData, Record, backward_derivatives, check_band, chirp_motion
+from ..data import IOData, Record, backward_derivatives, check_band, stepped_chirp_motion
 from ..errors import ConfigError
 
 __all__ = ["RecordSettings", "truth_records"]
@@ -48,12 +57,18 @@ class RecordSettings:
     dt: float = 0.002
     """Sampling time."""
     duration: float = 8.0
-    """Length of each record (at least 200 samples)."""
+    """Length of each chirp (at least 200 samples); a record holds one chirp per level."""
     band: tuple = (0.2, 60.0)
     """Chirp band ``(f_low, f_high)`` [cycles per time unit], below the Nyquist frequency."""
-    amplitude: float = 0.01
-    """Chirp amplitude of each modal displacement [per unit modal coordinate] / the flap
-    [rad]; the linear aerodynamics make it a scale only."""
+    amplitude: float | tuple = 0.01
+    """Chirp amplitude of the modal displacements [per unit modal coordinate] and the flap
+    [rad]: one number for every channel, or one per channel (the modes in order, then the
+    flap).  The linear aerodynamics make it a scale only; a nonlinear truth's records should
+    reach the amplitudes of the response the ROM must reproduce (module docstring)."""
+    levels: tuple = (1.0,)
+    """Amplitude factors of consecutive chirps in each record: the record holds
+    ``len(levels)`` chirps of ``duration`` each, chirp ``k`` at ``levels[k] * amplitude``
+    (:func:`casflutter.data.stepped_chirp_motion`)."""
     taper: float = 0.1
     """Raised-cosine taper fraction at each end of a record, in (0, 0.5]."""
     flap: bool = True
@@ -63,12 +78,34 @@ class RecordSettings:
     loosely coupled CFD time march of the paper."""
 
     def __post_init__(self):
-        for name in ("V0", "dt", "duration", "amplitude"):
+        for name in ("V0", "dt", "duration"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) \
                     or not math.isfinite(value) or not value > 0:
                 raise ConfigError(f"{name} = {value!r}: must be > 0")
             object.__setattr__(self, name, float(value))
+        amp = self.amplitude
+        if isinstance(amp, (list, tuple, np.ndarray)):
+            amp = finite_numbers("amplitude", list(amp), len(amp),
+                                 what="one amplitude per channel (modes, then the flap)")
+            if not amp or not all(a > 0 for a in amp):
+                raise ConfigError(f"amplitude = {list(self.amplitude)!r}: every amplitude "
+                                  "must be > 0")
+        elif isinstance(amp, bool) or not isinstance(amp, (int, float)) \
+                or not math.isfinite(amp) or not amp > 0:
+            raise ConfigError(f"amplitude = {amp!r}: must be > 0 (one number, or one per "
+                              "channel: the modes, then the flap)")
+        else:
+            amp = float(amp)
+        object.__setattr__(self, "amplitude", amp)
+        levels = self.levels
+        if not isinstance(levels, (list, tuple, np.ndarray)) or len(levels) == 0:
+            raise ConfigError(f"levels = {levels!r}: give a list of amplitude factors, e.g. "
+                              "[0.25, 0.5, 1.0]")
+        levels = finite_numbers("levels", list(levels), len(levels), what="amplitude factors > 0")
+        if not all(x > 0 for x in levels):
+            raise ConfigError(f"levels = {list(self.levels)!r}: every factor must be > 0")
+        object.__setattr__(self, "levels", levels)
         band = finite_numbers("band", self.band, 2, what="[f_low, f_high] in Hz")
         check_band(band, self.dt)
         object.__setattr__(self, "band", band)
@@ -88,15 +125,42 @@ class RecordSettings:
 
     @property
     def n_samples(self) -> int:
-        """Samples per record, ``round(duration / dt)``."""
-        return int(round(self.duration / self.dt))
+        """Samples per record, ``len(levels) * round(duration / dt)``."""
+        return len(self.levels) * int(round(self.duration / self.dt))
+
+    def channel_amplitudes(self, n_channels: int) -> tuple[float, ...]:
+        """Peak chirp amplitude of each of ``n_channels`` channels (before the levels).
+
+        Parameters
+        ----------
+        n_channels : int
+            Number of excited channels (the modes, then the flap).
+
+        Returns
+        -------
+        tuple of float
+            One amplitude per channel.
+
+        Raises
+        ------
+        ConfigError
+            Per-channel amplitudes whose number is not ``n_channels``.
+        """
+        if isinstance(self.amplitude, tuple):
+            if len(self.amplitude) != n_channels:
+                raise ConfigError(f"amplitude has {len(self.amplitude)} entries for "
+                                  f"{n_channels} channels (the modes, then the flap): give "
+                                  f"{n_channels} or one number")
+            return self.amplitude
+        return (self.amplitude,) * n_channels
 
 
 def truth_records(truth, settings: RecordSettings | None = None, **changes) -> IOData:
     """Chirp records of a truth simulator at the speed index ``settings.V0``.
 
     One record per input channel (each modal displacement, then the flap): that channel
-    follows :func:`casflutter.data.chirp_motion`, the others are held at zero, and the
+    follows :func:`casflutter.data.stepped_chirp_motion` (one chirp per level, at its
+    amplitude times each level), the others are held at zero, and the
     forces ``y`` come from ``truth.aero_forces`` with BDF2 grid velocities, delayed by
     ``coupling_delay`` samples (module docstring).
 
@@ -112,13 +176,15 @@ def truth_records(truth, settings: RecordSettings | None = None, **changes) -> I
     Returns
     -------
     IOData
-        ``N`` (or ``N + 1`` with the flap) records of ``round(duration / dt)`` samples;
-        ``meta`` holds ``V``, ``band`` and ``derivatives``.
+        ``N`` (or ``N + 1`` with the flap) records of ``settings.n_samples`` samples;
+        ``meta`` holds ``V``, ``band``, ``derivatives``, ``amplitude`` (per channel) and
+        ``levels``.
 
     Raises
     ------
     ConfigError
-        An invalid setting (named), e.g. a band above the Nyquist frequency.
+        An invalid setting (named), e.g. a band above the Nyquist frequency or a number of
+        per-channel amplitudes that is not the number of channels.
 
     See Also
     --------
@@ -138,13 +204,14 @@ def truth_records(truth, settings: RecordSettings | None = None, **changes) -> I
     N = truth.n_modes
     K, dt = s.n_samples, s.dt
     t = np.arange(K) * dt
-    chirp, _, _ = chirp_motion(t, s.band, s.amplitude, s.taper)
-    names = truth.modal_structure().mode_names
     n_in = N + (1 if s.flap else 0)
+    amps = s.channel_amplitudes(n_in)
+    chirp, _, _ = stepped_chirp_motion(t, s.band, s.levels, s.taper)
+    names = truth.modal_structure().mode_names
     recs = []
     for j in range(n_in):
         w = np.zeros((K, N + 1))
-        w[:, j] = chirp
+        w[:, j] = amps[j] * chirp
         d1, d2 = backward_derivatives(w, dt)
         y = truth.aero_forces(t, w[:, :N], w[:, N], s.V0, udot=d1[:, :N], uddot=d2[:, :N],
                               vdot=d1[:, N], vddot=d2[:, N])
@@ -154,4 +221,6 @@ def truth_records(truth, settings: RecordSettings | None = None, **changes) -> I
         recs.append(Record(y, w[:, :N], w[:, N] if s.flap else None, name=f"chirp {label}"))
     return IOData(tuple(recs), dt, output_names=tuple(f"y[{n}]" for n in names),
                   u_names=tuple(f"u[{n}]" for n in names), v_name="v",
-                  meta={"V": float(s.V0), "band": tuple(s.band), "derivatives": "BDF2"})
+                  meta={"V": float(s.V0), "band": tuple(s.band), "derivatives": "BDF2",
+                        "amplitude": tuple(float(a) for a in amps),
+                        "levels": tuple(s.levels)})

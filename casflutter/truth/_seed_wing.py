@@ -569,6 +569,8 @@ class SeedWing(AeroelasticTruth):
                 "coordinate_names": tuple(f"u{i + 1} ({n})" for i, n in enumerate(SEED_MODE_NAMES)),
                 "sensor_rows": np.asarray(SEED_SENSOR_ROWS, float),
                 "sensor_names": ("Acc1 (bending/torsion)", "Acc2 (lateral)"),
+                # Hs u: the tip store's deflections [m] (the shapes are per unit u)
+                "sensor_units": ("m", "m"),
                 "sensor": "acceleration",
                 "time_unit": "s",
                 "speed_index": "V = U / U_ref, U_ref = 28.9 m/s (Table I)"}

@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from casflutter.data import backward_derivatives, check_band, chirp_excitation, chirp_motion
-from casflutter.errors import ConfigError
+from casflutter.data import (backward_derivatives, check_band, chirp_excitation, chirp_motion,
+                             stepped_chirp_motion)
+from casflutter.errors import ConfigError, DataError
 
 
 def test_chirp_derivatives_are_exact():
@@ -48,3 +49,28 @@ def test_both_chirps_refuse_a_band_above_nyquist_alike(call):
 def test_a_band_that_is_not_increasing_is_refused(band):
     with pytest.raises(ConfigError, match="band"):
         check_band(band)
+
+
+def test_stepped_chirp_is_the_chirp_once_per_level():
+    """Each segment is the single chirp over its own samples scaled by its level, so the
+    record starts and ends every segment at rest and its derivatives stay exact."""
+    t = np.arange(3000) * 0.01
+    levels = (0.1, 0.5, 1.0)
+    s, sd, sdd = stepped_chirp_motion(t, (0.1, 5.0), levels, taper=0.1)
+    edges = (0, 1000, 2000, 3000)
+    for k, a in enumerate(levels):
+        seg = slice(edges[k], edges[k + 1])
+        ref = chirp_motion(t[seg], (0.1, 5.0), a, 0.1)
+        for got, want in zip((s, sd, sdd), ref):
+            assert_allclose(got[seg], want, rtol=0, atol=0)
+        assert np.max(np.abs(s[seg])) == pytest.approx(a, rel=0.01)
+        assert abs(s[edges[k]]) < 1e-15 and abs(sd[edges[k]]) < 1e-12
+    # one level is the plain chirp
+    assert_allclose(stepped_chirp_motion(t, (0.1, 5.0), [0.3])[0], chirp_motion(t, (0.1, 5.0), 0.3)[0])
+
+
+@pytest.mark.parametrize("levels, error", [((), ConfigError), ((1.0, float("nan")), ConfigError),
+                                            ("ab", ConfigError), ((1.0,) * 40, DataError)])
+def test_stepped_chirp_refuses_bad_levels(levels, error):
+    with pytest.raises(error, match="levels|chirps"):
+        stepped_chirp_motion(np.arange(100) * 0.01, (0.1, 5.0), levels)

@@ -60,11 +60,27 @@ def test_the_study_has_a_typed_field_per_stage(study):
     assert isinstance(r.suppression, SuppressionResult)
     assert r.closed_loop is None and r.parametric is None and r.flutter_frozen is None
     # the stages read one another's results: the LFT sits at the ROM's flutter speed, the
-    # LCO a little above the exact-order Hopf point, the suppression above the truth's
+    # LCO a little above the flutter point of the sampled-data loop the ROM runs in, the
+    # suppression above the truth's
     assert r.lft.Vf == r.flutter.Vf
-    assert r.lco.V == pytest.approx(r.config.lco.speed_factor * r.lco.V_hopf_exact_order)
+    assert r.lco.V == pytest.approx(r.config.lco.speed_factor * r.lco.V_hopf_loop)
     assert r.suppression.V == pytest.approx(r.config.suppression.speed_factor * r.Vf_truth)
     assert r.controller.nstates == r.config.controller.order == 1
+
+
+def test_the_rom_lco_speed_is_above_its_loops_own_flutter_point(study):
+    """The LCO stage's flutter point of the ROM loop is the Neimark-Sacker point that the LCO
+    continuation finds on the same map (an independent search: its own grid, its own
+    crossing), and it is not the continuous exact-order ΣAE's Hopf speed: the sampling moves
+    it by more than the 5 % the LCO is simulated above it (a speed above the continuous
+    point lies below the loop's, where the ROM's response decays)."""
+    from casflutter.lco import LCOSettings, rom_lco_branch
+
+    r = study
+    branch = rom_lco_branch(r.identification.model, r.system.structure, r.config.flutter.V_range,
+                            LCOSettings(max_points=3, n_grid=241))
+    assert r.lco.V_hopf_loop == pytest.approx(branch.hopf.V, rel=1e-6)
+    assert r.lco.V_hopf_loop > r.config.lco.speed_factor * r.lco.V_hopf_exact_order
 
 
 def test_summary_keeps_the_keys_of_summary_json(study):

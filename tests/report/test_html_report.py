@@ -48,3 +48,11 @@ def test_figures_are_embedded(tmp_path):
     text = html_report(SUMMARY, {"fig7_rom_fit": path})
     data = re.search(r'src="data:image/png;base64,([^"]+)"', text).group(1)
     assert base64.b64decode(data) == path.read_bytes()
+
+
+def test_lco_amplitudes_of_rom_and_truth_are_stated():
+    s = dict(SUMMARY, lco=dict(SUMMARY["lco"], amplitude=[124.2, 86.3], V=1.248,
+                               truth_amplitude=[134.7, 94.5], truth_V=1.139))
+    text = html_report(s, {})
+    assert "ROM (124.2, 86.3) at V = 1.248, truth (134.7, 94.5) at V = 1.139" in text
+    assert "LCO amplitude per sensor" not in html_report(SUMMARY, {})
