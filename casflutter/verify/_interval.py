@@ -156,8 +156,8 @@ def stability_interval(A0: np.ndarray, A1: np.ndarray, *, nominal: float = 0.0,
     imag_tol : float
         A pencil eigenvalue μ counts as real when ``|Im μ| ≤ imag_tol |μ|``.
     check_tol : float
-        An end is accepted when the spectral abscissa of ``A(δ)`` there is within
-        ``check_tol · max(1, ||A(δ)||)`` of 0; otherwise the next candidate is tried.
+        Relative width to which an end the pencils missed is bisected (the ends are chosen
+        by the stability of the pieces between candidates, see :func:`_pick_ends`).
 
     Returns
     -------
@@ -196,25 +196,58 @@ def stability_interval(A0: np.ndarray, A1: np.ndarray, *, nominal: float = 0.0,
 
 def _pick_ends(kinds: dict[float, str], matrix, nominal: float, method: str,
                check_tol: float) -> StabilityInterval:
-    """Nearest verified candidate on each side of 0 (candidates are offsets from
-    ``nominal``; ``matrix(t)`` is ``A(nominal + t)`` or None where the loop is ill posed)."""
+    """The interval's ends among the candidates (offsets from ``nominal``; ``matrix(t)`` is
+    ``A(nominal + t)``, or None where the loop is not well posed).
+
+    Stability can change only at a candidate, so between two consecutive candidates the loop
+    is stable everywhere or nowhere: each open piece is judged at its midpoint, walking out
+    from the nominal value, and an end is the first candidate beyond which the loop is not
+    stable.  A candidate where nothing crosses (a numerical root of an ill-conditioned
+    pencil) only splits a stable piece in two and is passed over.  Judging the pieces, not
+    the candidates, keeps the decision away from the ends themselves, where the spectral
+    abscissa is zero to within the eigenvalue error of ``A`` (large when ``||A||`` is).  In
+    the first piece found unstable the boundary is located by bisection to ``check_tol``
+    relative width, on the stable side: it is the candidate where the piece starts when the
+    pencils found the crossing, and otherwise (an ill-conditioned pencil that missed it, whose
+    eigenvalue came out complex) the end is the bisected point, labelled ``"bisection"``.
+    """
     cands = np.array(sorted(kinds))
 
-    def accept(t: float) -> tuple[bool, float]:
+    def stable(t: float) -> bool:
         At = matrix(t)
-        if At is None:                       # loop not well posed: a genuine end
-            return True, math.nan
-        a = spectral_abscissa(At)
-        return abs(a) <= check_tol * max(1.0, float(np.linalg.norm(At))), a
+        return At is not None and spectral_abscissa(At) < 0
+
+    def abscissa(t: float) -> float:
+        At = matrix(t)
+        return math.nan if At is None else spectral_abscissa(At)
 
     ends = {}
-    for side, pool in (("upper", cands[cands > 0]), ("lower", cands[cands < 0][::-1])):
-        ends[side] = (math.inf if side == "upper" else -math.inf, math.nan, "none")
-        for t in pool:
-            ok, a = accept(float(t))
-            if ok:
-                ends[side] = (float(t), a, kinds[float(t)])
+    for side, sign, pool in (("upper", 1.0, cands[cands > 0]),
+                             ("lower", -1.0, cands[cands < 0][::-1])):
+        end = (sign * math.inf, math.nan, "none")
+        prev = 0.0
+        for i, t in enumerate(list(pool) + [None]):
+            far = prev + sign * max(1.0, 2 * abs(prev)) if t is None else float(t)
+            if not stable(0.5 * (prev + far)):
+                # the stability boundary lies in [prev, midpoint): at the candidate prev when
+                # the pencils found it, elsewhere when they missed it; bisection finds it
+                # either way, on the stable side
+                lo, hi = prev, 0.5 * (prev + far)
+                while abs(hi - lo) > check_tol * max(1.0, abs(hi)):
+                    mid = 0.5 * (lo + hi)
+                    lo, hi = (mid, hi) if stable(mid) else (lo, mid)
+                at_candidate = prev != 0.0 and abs(lo - prev) <= 4 * check_tol * max(1.0,
+                                                                                     abs(prev))
+                end = ((prev, abscissa(prev), kinds[prev]) if at_candidate
+                       else (lo, abscissa(lo), "bisection"))
                 break
+            if t is None:
+                break
+            prev = float(t)
+            if matrix(prev) is None:       # loop not well posed here: a genuine end
+                end = (prev, math.nan, kinds[prev])
+                break
+        ends[side] = end
     (tu, au, ku), (tl, al, kl) = ends["upper"], ends["lower"]
     return StabilityInterval(
         lower=nominal + tl, upper=nominal + tu, nominal=float(nominal),

@@ -4,6 +4,7 @@ cases and a dense eigenvalue sweep; small-gain interval against its formula."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -103,3 +104,51 @@ def test_small_gain_interval_formula():
     with pytest.raises(ConfigError):
         small_gain_interval(-1.0, 1.2)
     assert speed_interval(-3.0, math.inf, 1.0) == (0.0, math.inf)
+
+
+def test_a_root_where_nothing_crosses_is_passed_over_even_with_a_huge_norm():
+    """A candidate where no eigenvalue crosses (a numerical root of an ill-conditioned
+    pencil, as the RFA loop of the Goland wing gives: ||A|| ~ 1e13) splits a stable piece
+    and is not an end; the end is the true crossing of the damping term at δ = 1.  Before,
+    an end was accepted wherever |spectral abscissa| <= 1e-6 ||A||, i.e. anywhere here."""
+    from casflutter.verify._interval import _pick_ends
+
+    A0 = np.zeros((3, 3))
+    A0[0, 1], A0[1, 0], A0[1, 1], A0[2, 2] = 1.0, -1.0, -1.0, -1e13
+    A1 = np.zeros((3, 3))
+    A1[1, 1] = 1.0                       # damping 1 - δ: a complex pair crosses at δ = 1
+    kinds = {-1e-6: "complex pair", 1e-6: "complex pair", 1.0: "complex pair"}
+    r = _pick_ends(kinds, lambda t: A0 + t * A1, 0.0, "bialternate", 1e-6)
+    assert r.upper == 1.0 and r.crossing_upper == "complex pair"
+    assert r.lower == -np.inf
+    # a crossing the candidates miss inside the first piece is found by bisection, on the
+    # stable side
+    r = _pick_ends({3.0: "complex pair"}, lambda t: A0 + t * A1, 0.0, "bialternate", 1e-9)
+    assert 1.0 - 1e-8 < r.upper <= 1.0 and r.crossing_upper == "bisection"
+
+
+def test_exact_interval_of_the_goland_rfa_loop_matches_a_dense_sweep():
+    """The Goland wing's RFA loop (plant.json and controller.json of
+    ``casflutter run problems/goland_gaf/run.toml``; ||A|| ~ 1e13 from nearly coincident lag
+    roots) gave a degenerate 'exact' interval [Vf - 1e-6, Vf + 1e-6] before the ends were
+    chosen by the stability of the pieces.  The exact ends must be where a dense eigenvalue
+    sweep (an independent computation) changes sign, to the sweep's step."""
+    from casflutter.verify import speed_sweep, verify_controller
+    from casflutter.verify._io import load_controller, load_plant
+
+    here = Path(__file__).parent / "data"
+    p = load_plant(here / "goland_rfa_plant.json")
+    K = load_controller(here / "goland_rfa_controller.json")
+    rep = verify_controller(p.sys, K, p.nmeas, p.ncon, Vf=p.Vf, n_delta=p.n_delta)
+    lo, hi = rep.exact_V
+    assert rep.stable and lo < rep.small_gain_V[0] and hi > rep.small_gain_V[1]
+    step = 1e-3
+    for end in (lo, hi):
+        V = np.array([end - step, end + step])
+        a = speed_sweep(p.sys, K, p.nmeas, p.ncon, Vf=p.Vf, n_delta=p.n_delta,
+                        V=V).spectral_abscissa
+        inside = a[1] if end == lo else a[0]
+        outside = a[0] if end == lo else a[1]
+        assert inside < 0 < outside, (end, a)
+    # the interval is wide: about (0.89, 1.37) Vf, not a point
+    assert hi - lo > 0.4 * p.Vf

@@ -101,6 +101,8 @@ def test_goland_gaf_study_designs_and_verifies_a_controller_on_the_rfa_lft():
     assert r.Vf == pytest.approx(r.rfa_flutter.Vf / U_ref, rel=1e-6)
     assert r.controller is not None and r.verification is not None
     assert np.all(r.rom_sweep.stable)
+    lo, hi = r.verification.exact_V          # the exact interval holds the swept speeds
+    assert lo < 1.05 * r.Vf and hi > 1.1 * r.Vf
     for f in (1.05, 1.1):
         A = r.rfa_system.state_matrix(f * r.rfa_flutter.Vf)
         assert np.max(np.linalg.eigvals(A).real) > 0
