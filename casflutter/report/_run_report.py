@@ -72,7 +72,8 @@ def _sensor_labels(result) -> list[str]:
     """Axis labels of the run's sensors with their units (the truth's units when the run
     reads the truth's own sensor rows)."""
     st = result.system.structure
-    units = () if result.config.sensors.rows else result.truth.sensor_units()
+    units = (() if result.config.sensors.rows or result.truth is None
+             else result.truth.sensor_units())
     return sensor_labels(st.sensor_names, units, st.sensor, st.time_unit)
 
 
@@ -93,10 +94,20 @@ def write_figures(out: Path, result) -> dict:
         Figure name -> path.
     """
     out = Path(out)
+    files = {}
+    if result.identification is None:   # a GAF wing file: no records, ROM or ERA
+        if result.rfa_flutter is not None:
+            fl = result.rfa_flutter     # the structural branches, not the lag roots
+            modes = [b for b in fl.tracking.upper_branches() if fl.origin[b] >= 0]
+            fig = plot_vg_vf(fl, branches=modes, hz=False)
+            fig.axes[-1].set_xlabel("airspeed U [m/s]")
+            files["vg_vf_airspeed"] = _save(fig, out / "vg_vf_airspeed.png")
+        if result.flutter is not None:
+            files["vg_vf"] = _save(plot_vg_vf(result.flutter), out / "vg_vf.png")
+        return files
     model = result.identification.model
     st = result.system.structure
     labels = _sensor_labels(result)
-    files = {}
     files["fig7_rom_fit"] = _save(plot_rom_fit(model, result.data, fit=result.fit,
                                                mode_names=st.mode_names,
                                                time_unit=st.time_unit),
@@ -104,11 +115,13 @@ def write_figures(out: Path, result) -> dict:
     real = result.realization
     files["hankel"] = _save(plot_hankel(real.hankel_singular_values, real.order),
                             out / "hankel_singular_values.png")
-    fp = flap_pulse_comparison(result.truth, model, st, result.config.data.V0, dt=model.dt)
-    files["fig8_flap_pulses"] = _save(plot_flap_pulses(fp["timepts"], fp["truth_zm"],
-                                                       fp["rom_zm"], fp["v"], labels,
-                                                       time_unit=st.time_unit),
-                                      out / "fig8_flap_pulses.png")
+    if result.truth is not None:   # a wing file has no truth to compare with
+        fp = flap_pulse_comparison(result.truth, model, st, result.config.data.V0,
+                                   dt=model.dt)
+        files["fig8_flap_pulses"] = _save(plot_flap_pulses(fp["timepts"], fp["truth_zm"],
+                                                           fp["rom_zm"], fp["v"], labels,
+                                                           time_unit=st.time_unit),
+                                          out / "fig8_flap_pulses.png")
     if result.lco is not None:
         lco = result.lco
         pct = 100 * (result.config.lco.speed_factor - 1)
@@ -161,6 +174,10 @@ def figure_captions(result) -> dict:
         Figure name -> caption.
     """
     cfg = result.config
+    if result.identification is None:
+        return {"vg_vf": "V–g and V–f of ΣAE: the structural modes numbered from 1.",
+                "vg_vf_airspeed": "V–g and V–f of the RFA system over the airspeed: the "
+                                  "structural branches."}
     cap = {
         "fig7_rom_fit": (
             "Fig. 7. Generalised aerodynamic forces y_i of the truth's chirp records (black) "
@@ -182,14 +199,16 @@ def figure_captions(result) -> dict:
         lco = result.lco
         sens = lco.rom.sensors
         rom_a = ", ".join(f"{a:.4g}" for a in sens.amplitude) if sens is not None else "-"
-        tr_a = ", ".join(f"{a:.4g}" for a in lco.truth.amplitude)
+        tr_a = ("-" if lco.truth is None
+                else ", ".join(f"{a:.4g}" for a in lco.truth.amplitude))
         V_rom = lco.V_hopf_loop if lco.V_hopf_loop is not None else lco.V_hopf_exact_order
-        Vt = result.flutter_truth.Vf
+        Vt = None if result.flutter_truth is None else result.flutter_truth.Vf
         f = cfg.lco.speed_factor
+        V_tr = float("nan") if lco.truth is None else lco.truth.V
         cap["fig9_lco"] = (
             f"Fig. 9. Limit-cycle oscillation of the ROM loop at V = {lco.V:.4g} ({f:g} x "
             f"its own flutter speed {V_rom:.4g}, that of the sampled-data loop) and of the "
-            f"truth at V = {lco.truth.V:.4g} ({f:g} x its flutter speed "
+            f"truth at V = {V_tr:.4g} ({f:g} x its flutter speed "
             f"{float('nan') if Vt is None else Vt:.4g}); sensor amplitudes (half peak to "
             f"peak) ROM {rom_a}, truth {tr_a}.")
         cap["lco_branches"] = (
