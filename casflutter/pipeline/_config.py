@@ -201,7 +201,7 @@ class LcoSection:
     speed_factor: float = 1.05
     """Simulate at ``speed_factor`` times each model's own Hopf speed: exactly at the Hopf
     point the linear damping is zero and the approach to the LCO is infinitely slow."""
-    branch_points: int = 0
+    branch_points: int = 20
     """Points of the ROM loop's and the truth's LCO branches from their flutter points
     (:mod:`casflutter.lco`, the bifurcation diagrams of the report); 0: none."""
 

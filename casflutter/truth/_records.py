@@ -131,6 +131,15 @@ class RecordSettings:
     def channel_amplitudes(self, n_channels: int) -> tuple[float, ...]:
         """Peak chirp amplitude of each of ``n_channels`` channels (before the levels).
 
+        Parameters
+        ----------
+        n_channels : int
+            Number of input channels (the modes, then the flap).
+
+        Returns
+        -------
+        tuple of float
+
         Raises
         ------
         ConfigError
