@@ -67,7 +67,8 @@ from ..design import SynthesisOptions, design_flutter_controller
 from ..errors import CasflutterError, ConfigError, ConvergenceError
 from ..ident import (IdentificationResult, IdentificationSettings, fit_report, identify,
                      identify_common_denominator)
-from ..lco import LCOSettings, lco_branch, rom_lco_branch, rom_loop_map, speed_convention
+from ..lco import (LCOSettings, lco_branch, rom_lco_branch, rom_loop_map,
+                   speed_convention)
 from ..realize import ParametricROM, RFASettings, fit_rfa, realize, speed_nodes
 from ..truth import (AeroelasticTruth, GAFProblem, RecordSettings, WingProblem,
                      closed_loop_truth, frozen_aero_truth, suppression_run,
@@ -503,20 +504,20 @@ def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth, prog) 
 
 def _branches(cfg: RunConfig, truth, model, structure, prog) -> dict:
     """The LCO branches of the ROM loop and of the truth (``lco.branch_points`` points
-    each), or the reason a branch could not be started."""
+    each; no truth branch on a wing file), or the reason a branch could not be started."""
     settings = LCOSettings(max_points=cfg.lco.branch_points, sensor_kind=structure.sensor)
     scale, unit = speed_convention(truth) if truth is not None else (1.0, "speed index")
-    ms = structure
+    ms = truth.modal_structure() if truth is not None else structure
     out = {}
+    computations = [] if truth is None else [
+        ("truth_branch", lambda: lco_branch(truth, cfg.flutter.V_range, settings,
+                                            problem="truth"))]
     for key, compute in (
-            ("truth_branch", None if truth is None else lambda: lco_branch(
-                truth, cfg.flutter.V_range, settings, problem="truth")),
+            *computations,
             ("rom_branch", lambda: rom_lco_branch(
                 model, structure, cfg.flutter.V_range, settings, mode_names=ms.mode_names,
                 sensor_names=structure.sensor_names, problem="ROM loop", speed_scale=scale,
                 speed_unit=unit, time_unit=ms.time_unit))):
-        if compute is None:
-            continue
         try:
             out[key] = compute()
         except (ConfigError, ConvergenceError) as exc:

@@ -154,8 +154,11 @@ def sensor_units(problem, structure, custom_rows: bool) -> tuple[str, ...]:
     """
     n = int(structure.n_sensors)
     base = ("",) * n
-    if not custom_rows and callable(getattr(problem, "sensor_units", None)):
-        got = tuple(problem.sensor_units())
+    given = getattr(problem, "sensor_units", None)
+    if not custom_rows and isinstance(given, tuple) and len(given) == n:
+        return given          # a wing file gives the unit of each reading itself
+    if not custom_rows and callable(given):
+        got = tuple(given())
         if len(got) == n:
             base = got
     t = structure.time_unit

@@ -72,6 +72,10 @@ def _sensor_labels(result) -> list[str]:
     """Axis labels of the run's sensors with their units (the truth's units when the run
     reads the truth's own sensor rows)."""
     st = result.system.structure
+    wing_units = getattr(result.problem, "sensor_units", None)
+    if isinstance(wing_units, tuple) and not result.config.sensors.rows:
+        # a wing file gives the unit of each sensor's reading itself
+        return [f"{n} [{u or '-'}]" for n, u in zip(st.sensor_names, wing_units)]
     units = (() if result.config.sensors.rows or result.truth is None
              else result.truth.sensor_units())
     return sensor_labels(st.sensor_names, units, st.sensor, st.time_unit)
@@ -116,8 +120,7 @@ def write_figures(out: Path, result) -> dict:
     files["hankel"] = _save(plot_hankel(real.hankel_singular_values, real.order),
                             out / "hankel_singular_values.png")
     if result.truth is not None:   # a wing file has no truth to compare with
-        fp = flap_pulse_comparison(result.truth, model, st, result.config.data.V0,
-                                   dt=model.dt)
+        fp = flap_pulse_comparison(result.truth, model, st, result.config.data.V0, dt=model.dt)
         files["fig8_flap_pulses"] = _save(plot_flap_pulses(fp["timepts"], fp["truth_zm"],
                                                            fp["rom_zm"], fp["v"], labels,
                                                            time_unit=st.time_unit),
@@ -174,10 +177,10 @@ def figure_captions(result) -> dict:
         Figure name -> caption.
     """
     cfg = result.config
-    if result.identification is None:
-        return {"vg_vf": "V–g and V–f of ΣAE: the structural modes numbered from 1.",
-                "vg_vf_airspeed": "V–g and V–f of the RFA system over the airspeed: the "
-                                  "structural branches."}
+    if result.identification is None:   # a GAF wing file: the RFA's V-g/V-f only
+        return {"vg_vf": "V–g and V–f of ΣAE(V) with Σf frozen at the flutter airspeed.",
+                "vg_vf_airspeed": ("V–g and V–f of the RFA's ΣAE(U) against the airspeed: the "
+                                   "structural branches.")}
     cap = {
         "fig7_rom_fit": (
             "Fig. 7. Generalised aerodynamic forces y_i of the truth's chirp records (black) "
@@ -199,18 +202,20 @@ def figure_captions(result) -> dict:
         lco = result.lco
         sens = lco.rom.sensors
         rom_a = ", ".join(f"{a:.4g}" for a in sens.amplitude) if sens is not None else "-"
-        tr_a = ("-" if lco.truth is None
-                else ", ".join(f"{a:.4g}" for a in lco.truth.amplitude))
+        tr = lco.truth
         V_rom = lco.V_hopf_loop if lco.V_hopf_loop is not None else lco.V_hopf_exact_order
         Vt = None if result.flutter_truth is None else result.flutter_truth.Vf
         f = cfg.lco.speed_factor
-        V_tr = float("nan") if lco.truth is None else lco.truth.V
-        cap["fig9_lco"] = (
-            f"Fig. 9. Limit-cycle oscillation of the ROM loop at V = {lco.V:.4g} ({f:g} x "
-            f"its own flutter speed {V_rom:.4g}, that of the sampled-data loop) and of the "
-            f"truth at V = {V_tr:.4g} ({f:g} x its flutter speed "
-            f"{float('nan') if Vt is None else Vt:.4g}); sensor amplitudes (half peak to "
-            f"peak) ROM {rom_a}, truth {tr_a}.")
+        text = (f"Fig. 9. Limit-cycle oscillation of the ROM loop at V = {lco.V:.4g} ({f:g} "
+                f"x its own flutter speed {V_rom:.4g}, that of the sampled-data loop)")
+        if tr is not None:
+            tr_a = ", ".join(f"{a:.4g}" for a in tr.amplitude)
+            text += (f" and of the truth at V = {tr.V:.4g} ({f:g} x its flutter speed "
+                     f"{float('nan') if Vt is None else Vt:.4g}); sensor amplitudes (half "
+                     f"peak to peak) ROM {rom_a}, truth {tr_a}.")
+        else:
+            text += f"; sensor amplitudes (half peak to peak) {rom_a}."
+        cap["fig9_lco"] = text
         cap["lco_branches"] = (
             "LCO branches from the flutter points, continued in the airspeed: the truth "
             "(left, orthogonal collocation) and the ROM loop (right, invariant circles of the "

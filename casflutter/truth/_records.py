@@ -134,11 +134,12 @@ class RecordSettings:
         Parameters
         ----------
         n_channels : int
-            Number of input channels (the modes, then the flap).
+            Number of excited channels (the modes, then the flap).
 
         Returns
         -------
         tuple of float
+            One amplitude per channel.
 
         Raises
         ------

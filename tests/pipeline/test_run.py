@@ -126,8 +126,9 @@ def test_exports_carry_names_units_speeds_and_reproduce_the_verification(reduced
     assert c["time_base"] == {"domain": "continuous", "dt": None, "time_unit": "s",
                               "frequency_unit": "rad/s"}
     assert [i["name"] for i in c["inputs"]] == list(truth.modal_structure().sensor_names)
-    # acceleration sensors; the seed wing's rows read the tip store's deflection in metres
-    assert all(i["unit"] == "m/s^2" for i in c["inputs"])
+    # acceleration sensors: the unit of the truth's rows (tip deflections) per second squared
+    assert [i["unit"] for i in c["inputs"]] == [f"{u}/s^2" for u in truth.sensor_units()]
+    assert truth.sensor_units() == ("m", "m")
     assert c["outputs"] == [{"name": "flap deflection command", "signal": "v", "unit": "rad"}]
     assert c["sign_convention"].startswith("v = K zm")
     Vf = s["flutter"]["V"]

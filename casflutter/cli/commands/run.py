@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import json
 
+from ..._outputs import check_output_path
+
 
 def _speed(block) -> str:
     """``V = 1.2 (speed index), U = 34.7 m/s, q = 737 Pa`` of a flutter block."""
@@ -22,8 +24,10 @@ def _main(args) -> int:
     from ...pipeline import load_config, run
 
     cfg = load_config(args.config)   # validated before any work starts
-    # the output folder is checked (and refused when not empty without --overwrite) before
-    # any work, and written atomically at the end
+    # a path that cannot be a folder is refused before the package's stages are even
+    # imported; the driver then refuses a non-empty folder without --overwrite, before any
+    # work, and writes the outputs atomically at the end
+    check_output_path(args.out, what="--out", kind="dir")
     res = run(cfg, out_dir=args.out, seed=args.seed, quiet=args.quiet,
               overwrite=args.overwrite)
     s = res.summary()
