@@ -364,7 +364,12 @@ class _Phase:
             Hc = np.array([c.grad for c in con]).reshape(len(con), prob.n)
             cv = np.minimum(np.array([c.value for c in con]), 0.0)
             if H is None:
-                gscale = float(np.max(np.linalg.norm(G, axis=1)))
+                # curvature scale from the cuts active now (within 1 % of the top value): a
+                # far-away piece with a huge gradient (an ill-conditioned eigenvalue) would
+                # otherwise shrink every step to nothing
+                top = float(np.max(fv))
+                act = fv >= top - 0.01 * max(abs(f), abs(top), 1e-12)
+                gscale = float(np.max(np.linalg.norm(G[act], axis=1)))
                 H = max(1e-8, 0.1 * gscale / delta0) * np.eye(prob.n)
                 fresh = True
             step = self.qp.solve(H, fv, G, cv, Hc, delta * free)
