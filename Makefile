@@ -19,7 +19,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	MPLBACKEND=Agg $(VENV)/bin/casflutter run
+	MPLBACKEND=Agg $(VENV)/bin/casflutter run --overwrite
 
 test: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m pytest -m "not slow" -n 2 tests

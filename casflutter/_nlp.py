@@ -9,7 +9,14 @@ through :func:`solve_newton`.
 
 from __future__ import annotations
 
+import contextlib
+import difflib
+import functools
+import io
+import math
+import re
 import time
+import types
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
@@ -18,10 +25,11 @@ import numpy as np
 from scipy.linalg import lu_factor, lu_solve
 from scipy.sparse.linalg import splu
 
-from .errors import ConvergenceError
+from .errors import ConfigError, ConvergenceError
 
 __all__ = ["NLPResult", "NLPSolver", "make_solver", "solve_nlp", "DEFAULT_IPOPT_OPTIONS",
-           "RootResult", "solve_newton"]
+           "RootResult", "solve_newton", "IpoptOption", "ipopt_option_list",
+           "check_solver_options"]
 
 #: Quiet Ipopt defaults; every key may be overridden through ``options``.
 DEFAULT_IPOPT_OPTIONS: dict[str, Any] = {
@@ -152,6 +160,217 @@ def solve_nlp(nlp: Mapping[str, Any], x0, *, options: Mapping[str, Any] | None =
               name: str = "nlp", **kwargs) -> NLPResult:
     """Build and solve once. Keyword arguments are those of :meth:`NLPSolver.__call__`."""
     return make_solver(nlp, options, name)(x0, **kwargs)
+
+
+# ---- the option list of the installed Ipopt ---------------------------------------------
+@dataclass(frozen=True)
+class IpoptOption:
+    """One option of Ipopt, as its own documentation states it.
+
+    Attributes
+    ----------
+    name : str
+        Ipopt's name (without the ``ipopt.`` prefix of CasADi).
+    kind : str
+        ``"real"``, ``"integer"`` or ``"string"``.
+    low, high : float or None
+        Bounds of a number (None: unbounded on that side).
+    low_strict, high_strict : bool
+        Whether the bound itself is excluded.
+    values : tuple of str
+        The settings of a string option (empty: any string).
+    """
+
+    name: str
+    kind: str
+    low: float | None = None
+    high: float | None = None
+    low_strict: bool = False
+    high_strict: bool = False
+    values: tuple = ()
+
+    def allowed(self) -> str:
+        """What the option accepts, in words (``"a real number with 0 < tol"``).
+
+        Returns
+        -------
+        str
+        """
+        if self.kind == "string":
+            if not self.values:
+                return "a string"
+            return "one of " + ", ".join(f'"{v}"' for v in self.values)
+        what = "an integer" if self.kind == "integer" else "a real number"
+        parts = []
+        if self.low is not None:
+            parts.append(f"{self.low:g} {'<' if self.low_strict else '<='} ")
+        parts.append(self.name)
+        if self.high is not None:
+            parts.append(f" {'<' if self.high_strict else '<='} {self.high:g}")
+        return what if len(parts) == 1 else f"{what} with {''.join(parts)}"
+
+    def accepts(self, value) -> bool:
+        """Whether ``value`` (a TOML/Python value) is a valid setting.
+
+        Returns
+        -------
+        bool
+        """
+        if self.kind == "string":
+            return isinstance(value, str) and (not self.values or value in self.values)
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            return False
+        if self.kind == "integer" and not isinstance(value, int):
+            return False
+        if not math.isfinite(value):
+            return False
+        if self.low is not None and (value < self.low or (self.low_strict and value == self.low)):
+            return False
+        return not (self.high is not None
+                    and (value > self.high or (self.high_strict and value == self.high)))
+
+
+_NUMBER = r"([-+]?[0-9.]+(?:e[-+]?[0-9]+)?|[-+]?10<sup>[-+]?[0-9]+</sup>)"
+
+
+def _doc_number(text: str) -> float:
+    power = re.fullmatch(r"([-+]?)10<sup>([-+]?[0-9]+)</sup>", text)
+    if power:
+        return float(f"{power.group(1)}1e{power.group(2)}")
+    return float(text)
+
+
+def _parse_ipopt_doc(doc: str) -> dict[str, IpoptOption]:
+    """Ipopt's ``print_options_documentation`` output (doxygen mode) -> its options."""
+    table = {}
+    for block in re.split(r"\\anchor OPT_", doc)[1:]:
+        name = re.match(r"\w+", block).group(0)
+        kind = re.search(r"this (real|integer|string) option", block)
+        if kind is None:
+            continue
+        kind = kind.group(1)
+        if kind == "string":
+            values = tuple(v for v in re.findall(r"(?m)^ - ([^:\s]+):", block) if v != "*")
+            star = re.search(r"(?m)^ - \*:", block) is not None
+            table[name] = IpoptOption(name, kind, values=() if star else values)
+            continue
+        low = high = None
+        low_strict = high_strict = False
+        rng = re.search(rf"(?:{_NUMBER} (<|&le;) )?{re.escape(name)}(?: (<|&le;) {_NUMBER})? and "
+                        "its default", block)
+        if rng:
+            if rng.group(1) is not None:
+                low, low_strict = _doc_number(rng.group(1)), rng.group(2) == "<"
+            if rng.group(4) is not None:
+                high, high_strict = _doc_number(rng.group(4)), rng.group(3) == "<"
+        table[name] = IpoptOption(name, kind, low, high, low_strict, high_strict)
+    return table
+
+
+def _tiny_solver(options: Mapping[str, Any]) -> str:
+    """Build (never solve) a one-variable Ipopt NLP with ``options``; Ipopt's console output
+    (CasADi routes it through ``sys.stdout``) is returned instead of printed."""
+    x = ca.SX.sym("x")
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        ca.nlpsol("option_check", "ipopt", {"x": x, "f": x * x},
+                  {"print_time": False, "ipopt.sb": "yes", **options})
+    return out.getvalue()
+
+
+@functools.lru_cache(maxsize=1)
+def ipopt_option_list() -> Mapping[str, IpoptOption]:
+    """The options of the installed Ipopt, from its own documentation.
+
+    Ipopt prints the documentation of every option (type, valid range, settings, advanced
+    ones included) when a solver is built with ``print_options_documentation``; the list is
+    read once per process (a fraction of a second, no solve).
+
+    Returns
+    -------
+    mapping of str to IpoptOption
+    """
+    doc = _tiny_solver({"ipopt.print_options_documentation": "yes",
+                        "ipopt.print_advanced_options": "yes",
+                        "ipopt.print_options_mode": "doxygen"})
+    return types.MappingProxyType(_parse_ipopt_doc(doc))
+
+
+def _flat(options: Mapping[str, Any]) -> dict[str, Any]:
+    flat = {}
+    for key, value in options.items():
+        if key == "ipopt" and isinstance(value, Mapping):  # CasADi's nested form
+            flat.update({f"ipopt.{k}": v for k, v in value.items()})
+        else:
+            flat[str(key)] = value
+    return flat
+
+
+def check_solver_options(options: Mapping[str, Any] | None, key: str = "options") -> dict:
+    """Check NLP options against the installed solver before any work.
+
+    ``ipopt.NAME`` keys are checked against Ipopt's own option list
+    (:func:`ipopt_option_list`: name, type, range, settings); the other keys are CasADi's
+    ``nlpsol`` options, checked by building (never solving) a one-variable NLP with them.
+    Options Ipopt accepts but leaves out of its documentation (``ipopt.sb``) are accepted the
+    same way.
+
+    Parameters
+    ----------
+    options : mapping
+        Flat options (``{"ipopt.tol": 1e-8, "print_time": False}``), or CasADi's nested
+        ``{"ipopt": {...}}``.
+    key : str
+        Name of the setting that holds them, for the messages (``"solver.ipopt"``).
+
+    Returns
+    -------
+    dict
+        The flat options.
+
+    Raises
+    ------
+    ConfigError
+        An unknown option (with the closest known names), or a value of the wrong type or
+        outside the option's range (with what is allowed).
+    """
+    flat = _flat(options or {})
+    listed = ipopt_option_list() if any(k.startswith("ipopt.") for k in flat) else {}
+    other = {}
+    for name, value in flat.items():
+        if not name.startswith("ipopt."):
+            other[name] = value
+            continue
+        opt = listed.get(name[6:])
+        if opt is None:
+            try:
+                _tiny_solver({name: value})
+            except RuntimeError:
+                near = difflib.get_close_matches(name[6:], list(listed), n=3)
+                hint = (f"; did you mean {', '.join('ipopt.' + n for n in near)}?" if near
+                        else "; see Ipopt's option list (print_options_documentation)")
+                raise ConfigError(f"{key}: unknown Ipopt option {name!r} = {value!r}{hint}"
+                                  ) from None
+            continue
+        if not opt.accepts(value):
+            raise ConfigError(f"{key}: Ipopt option {name!r} = {value!r} is not allowed: "
+                              f"give {opt.allowed()}")
+    if other:
+        try:
+            _tiny_solver(other)
+        except RuntimeError as exc:
+            msg = str(exc)
+            unknown = re.search(r"Unknown option: (\S+)", msg)
+            if unknown:
+                near = re.findall(r'> "(\w+)"', msg)[:3]
+                hint = f"; did you mean {', '.join(near)}?" if near else ""
+                raise ConfigError(f"{key}: unknown solver option {unknown.group(1)!r} (neither "
+                                  f"CasADi's nlpsol nor Ipopt's, which take the prefix "
+                                  f"'ipopt.'){hint}") from None
+            detail = msg.strip().splitlines()[-1] if msg.strip() else msg
+            raise ConfigError(f"{key}: solver options {other!r} are not accepted by CasADi's "
+                              f"nlpsol ({detail})") from None
+    return flat
 
 
 # ---- square nonlinear systems (collocation of periodic orbits, invariant circles) --------

@@ -6,7 +6,7 @@ message starts with the field's name (``"dt = -0.1: must be > 0"``).  :func:`bui
 turns a table (a TOML file's content, or part of it) into such a class:
 
 1. unknown keys fail with the list of allowed ones;
-2. each value is checked against the field's annotation (number, integer, boolean, string,
+2. each value is checked against the field's annotation (a finite number, integer, boolean, string,
    list, tuple, table, an optional value, a union, or a nested settings class, which is
    built recursively) and converted where TOML has no own type (a list for a tuple);
 3. the class is constructed, so its own checks run; their messages are prefixed with the
@@ -70,7 +70,7 @@ def _check_type(path: str, value, typ):
                 return _check_type(path, value, member)
             except ConfigError as exc:
                 errors.append(str(exc))
-        raise errors[0] if len(errors) == 1 else ConfigError(
+        raise ConfigError(errors[0]) if len(errors) == 1 else ConfigError(
             f"{path}: expected one of {typ}, got {_kind(value)}")
     if origin is typing.Literal:
         allowed = typing.get_args(typ)
@@ -85,6 +85,8 @@ def _check_type(path: str, value, typ):
     if base is float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ConfigError(f"{path}: expected a number, got {_kind(value)}")
+        if not math.isfinite(value):
+            raise ConfigError(f"{path} = {value!r}: expected a finite number (no nan or inf)")
         return float(value)
     if base is int:
         if isinstance(value, bool) or not isinstance(value, int):

@@ -11,6 +11,7 @@ inputs give bit-identical outputs whatever the environment says.
 from __future__ import annotations
 
 import functools
+import importlib
 from contextlib import contextmanager
 from typing import Callable, Iterator, TypeVar
 
@@ -18,12 +19,28 @@ from threadpoolctl import threadpool_limits
 
 __all__ = ["single_threaded", "deterministic"]
 
+#: Modules whose import loads a BLAS/OpenMP pool of its own (numpy, scipy and slycot, which
+#: python-control loads, each bundle an OpenBLAS).
+_POOL_MODULES = ("numpy", "scipy.linalg", "slycot")
+
 F = TypeVar("F", bound=Callable)
+
+
+def _load_pools() -> None:
+    """Load every BLAS pool casflutter uses: threadpoolctl limits only the libraries loaded
+    when the limit is set, and one loaded later inside the block (a command's import of
+    scipy) would keep the thread count of the environment."""
+    for name in _POOL_MODULES:
+        try:
+            importlib.import_module(name)
+        except ImportError:  # slycot is optional
+            pass
 
 
 @contextmanager
 def single_threaded() -> Iterator[None]:
     """Limit every BLAS/OpenMP pool to one thread inside the block (restored afterwards)."""
+    _load_pools()
     with threadpool_limits(limits=1):
         yield
 

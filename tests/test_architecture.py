@@ -145,3 +145,22 @@ def test_the_user_path_loads_from_the_top_lazily():
             "else:\n"
             "    raise SystemExit('no AttributeError')\n")
     subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
+
+
+def test_realize_stays_the_function_after_its_stage_is_imported():
+    """``casflutter.realize`` names both the stage and its function: after anything imports the
+    stage (here the loop stage, which uses it), ``cf.realize(model)`` still realises a model
+    and ``import casflutter.realize as rz`` still gives the stage's other functions."""
+    code = ("import inspect, numpy as np\n"
+            "import casflutter.aeroelastic\n"
+            "import casflutter as cf\n"
+            "import casflutter.realize as rz\n"
+            "from casflutter.realize._realize import realize\n"
+            "truth = cf.load_problem('typical_section')\n"
+            "data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1))\n"
+            "model = cf.identify_common_denominator(data).model\n"
+            "a, b = cf.realize(model), realize(model)\n"
+            "assert np.array_equal(a.sigma_f.A, b.sigma_f.A) and a.order == b.order == 8\n"
+            "assert inspect.signature(cf.realize) == inspect.signature(realize)\n"
+            "assert rz.era is casflutter.realize._realize.era\n")
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)

@@ -221,11 +221,25 @@ def find_flutter(system, V_range=None, *, V_grid=None, n_grid: int = 101, mode_s
     FlutterResult
         ``status == "no_crossing"`` and ``Vf is None`` when nothing crosses in the range.
 
+    See Also
+    --------
+    track_eigenvalues : the eigenvalue branches it follows.
+    build_lft : the LFT at the flutter speed found here.
+    lco_branch : the LCO branch from the Hopf point.
+
     Notes
     -----
     Crossings are detected as sign changes of Re λ of a branch between neighbouring grid
     points, so a branch that crosses and re-crosses inside one grid interval (a very narrow
     hump) is missed: use a grid finer than the narrowest hump of interest.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section")
+    >>> f = cf.find_flutter(truth, (0.5, 3.0))
+    >>> f.status, round(f.Vf, 4), round(f.omega_f, 4)
+    ('flutter', 2.1704, 0.6443)
     """
     fn = as_matrix_fn(system)
     if V_grid is None:

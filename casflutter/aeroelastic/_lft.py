@@ -85,6 +85,11 @@ class AeroelasticLFT:
         Accelerometers with a flap feed-through give ``D22 = Vf² α Hs df ≠ 0``.  Design a
         controller K̃ on the shifted measurement ``z̃m = zm − D22 v`` with this plant, then
         use :meth:`physical_controller` to get the K that acts on the real ``zm``.
+
+        Returns
+        -------
+        control.StateSpace
+            ``P`` with its control-to-measurement block ``D22`` set to zero.
         """
         D = np.array(self.P.D, dtype=float)
         D[-self.nmeas:, -self.ncon:] = 0.0
@@ -96,6 +101,16 @@ class AeroelasticLFT:
 
         With ``v = K̃ (zm − D22 v)``: ``K = (I + K̃ D22)⁻¹ K̃`` (a positive-feedback
         interconnection, exact including the algebraic loop).
+
+        Parameters
+        ----------
+        K_shifted : control.StateSpace
+            ``K̃``, designed on :meth:`plant_without_d22`.
+
+        Returns
+        -------
+        control.StateSpace
+            ``K`` from the real ``zm`` to ``v``.
         """
         Kt = control.ss(K_shifted)
         if np.allclose(self.D22, 0.0):
@@ -108,6 +123,16 @@ class AeroelasticLFT:
 
         Returns ΣAE at ``V² = Vf² + dV`` as a ``control.StateSpace`` with inputs
         ``[w, v]`` and outputs ``zm`` (compare :meth:`AeroelasticLoop.statespace`).
+
+        Parameters
+        ----------
+        dV : float
+            ``ΔV = V² − Vf²``.
+
+        Returns
+        -------
+        control.StateSpace
+            ΣAE at ``V² = Vf² + dV``.
         """
         N = self.n_delta
         Bf_, Bw = self.B1bar[:, :N], np.hstack([self.B1bar[:, N:], self.B2])
@@ -135,6 +160,22 @@ def build_lft(system: AeroelasticSystem, Vf: float) -> AeroelasticLFT:
     Returns
     -------
     AeroelasticLFT
+
+    See Also
+    --------
+    synthesize : the controller designed on the LFT's plant.
+    verify_controller : the small-gain and exact speed ranges on it.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section")
+    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
+    >>> rom = cf.identify_common_denominator(data).model
+    >>> system = cf.AeroelasticSystem.from_parts(cf.realize(rom).sigma_f, truth.modal_structure())
+    >>> lft = cf.build_lft(system, cf.find_flutter(system, (0.5, 3.0)).Vf)
+    >>> lft.nmeas, lft.ncon, lft.n_delta
+    (2, 1, 2)
     """
     if Vf is None or not np.isfinite(Vf):
         raise ConfigError(f"Vf must be a finite speed index, got {Vf!r} (no flutter found?)")

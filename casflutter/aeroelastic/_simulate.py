@@ -151,6 +151,22 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
     Returns
     -------
     LoopSimulation
+
+    See Also
+    --------
+    find_flutter : the speed above which the loop diverges or settles on an LCO.
+    rom_lco_branch : the ROM loop's LCO branch by continuation.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section")
+    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
+    >>> rom = cf.identify_common_denominator(data).model
+    >>> structure = truth.modal_structure()
+    >>> sim = cf.simulate_loop(rom, structure, 1.5, 500, xs0=structure.displaced_state(1, 0.01))
+    >>> sim.zm.shape, bool(abs(sim.zm[-50:]).max() < 0.1 * abs(sim.zm[:50]).max())
+    ((500, 2), True)
     """
     s = structure
     N, m = s.n_modes, s.n_sensors

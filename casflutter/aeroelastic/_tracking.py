@@ -160,6 +160,19 @@ def track_eigenvalues(matrix_fn, V_grid, *, min_score: float = 0.9, max_refine: 
     Returns
     -------
     EigenTracking
+
+    See Also
+    --------
+    find_flutter : the flutter speed from the tracked branches.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section")
+    >>> tr = cf.track_eigenvalues(truth.state_matrix, np.linspace(0.5, 3.0, 51))
+    >>> tr.eigenvalues.shape[0]
+    51
     """
     fn = as_matrix_fn(matrix_fn)
     V_grid = np.asarray(V_grid, dtype=float).ravel()

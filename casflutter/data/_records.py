@@ -161,6 +161,9 @@ class IOData:
         displacements); default ``y1, y2, ...`` and ``u1, u2, ...``.
     v_name : str, optional
         Name of the flap input ``v``.
+    meta : dict, optional
+        Free-form provenance (e.g. the truth and speed the records were taken at); not
+        compared by ``==``.
 
     Examples
     --------
@@ -226,6 +229,25 @@ class IOData:
                     **kw) -> "IOData":
         """One record from arrays ``y (K, N)``, ``u (K, N)``, ``v (K,)``.
 
+        Parameters
+        ----------
+        y : array_like, shape (K, N)
+            Outputs (generalised forces).
+        u : array_like, shape (K, N), optional
+            Modal-displacement inputs.
+        v : array_like, shape (K,), optional
+            Flap input.
+        dt : float
+            Sampling time [s].
+        name : str
+            Label of the record.
+        **kw
+            ``output_names``, ``u_names``, ``v_name``, ``meta`` of :class:`IOData`.
+
+        Returns
+        -------
+        IOData
+
         Raises
         ------
         DataError
@@ -239,6 +261,18 @@ class IOData:
         """Load from an ``.npz`` with arrays ``y`` and optionally ``u``, ``v``, ``dt``.
 
         Several records: ``y_0, u_0, v_0, y_1, ...`` (suffix ``_<index>``).
+
+        Parameters
+        ----------
+        path : str or path
+            The ``.npz`` file.
+        dt : float, optional
+            Sampling time [s] when the file holds no ``dt`` array (a ``dt`` given here wins).
+
+        Returns
+        -------
+        IOData
+            One record per ``y`` (or ``y_<index>``) array, named after the file.
 
         Raises
         ------
@@ -273,7 +307,13 @@ class IOData:
         return out
 
     def to_npz(self, path) -> None:
-        """Write in the format read by :meth:`from_npz`."""
+        """Write in the format read by :meth:`from_npz`.
+
+        Parameters
+        ----------
+        path : str or path
+            The ``.npz`` file to write (``numpy.savez`` adds the suffix if missing).
+        """
         arrays = {"dt": np.array(self.dt)}
         for i, r in enumerate(self.records):
             arrays[f"y_{i}"] = r.y
@@ -290,6 +330,8 @@ class IOData:
 
         Parameters
         ----------
+        path : str or path
+            The CSV file.
         y, u : list of str
             Column names of the outputs and modal inputs.
         v : str, optional
@@ -298,6 +340,11 @@ class IOData:
             Column of time stamps, from which ``dt`` is taken (must be uniform).
         dt : float, optional
             Sampling time when there is no time column.
+
+        Returns
+        -------
+        IOData
+            One record named after the file, the channels named after the columns.
 
         Raises
         ------
@@ -381,6 +428,8 @@ class IOData:
 
         Parameters
         ----------
+        path : str or path
+            The ``.mat`` file.
         y, u, v : str
             Variable names; matrices may be stored channels-by-samples or samples-by-channels
             (the longer axis is taken as time).
@@ -388,6 +437,13 @@ class IOData:
             Sampling time, or the name of a variable holding it.
         fs : str, optional
             Name of a variable holding the sampling *frequency* (``dt = 1/fs``), e.g. ``"Fs"``.
+        output_names : sequence of str, optional
+            Names of the outputs (default ``y1, y2, ...``).
+
+        Returns
+        -------
+        IOData
+            One record named after the file.
 
         Raises
         ------
@@ -445,7 +501,17 @@ class IOData:
         return sum(r.n_samples for r in self.records)
 
     def scales(self) -> tuple[np.ndarray, np.ndarray | None, float | None]:
-        """RMS of each channel over all records (1 where a channel is identically zero)."""
+        """RMS of each channel over all records (1 where a channel is identically zero).
+
+        Returns
+        -------
+        sy : ndarray, shape (N,)
+            Output scales.
+        su : ndarray, shape (N,) or None
+            Modal-input scales (None without ``u``).
+        sv : float or None
+            Flap-input scale (None without ``v``).
+        """
         def rms(arrs):
             a = np.concatenate(arrs, axis=0)
             s = np.sqrt(np.mean(a ** 2, axis=0))
@@ -456,20 +522,62 @@ class IOData:
         return sy, su, sv
 
     def scaled(self, sy, su=None, sv=None) -> "IOData":
-        """Copy with every channel divided by its scale."""
+        """Copy with every channel divided by its scale.
+
+        Parameters
+        ----------
+        sy : array_like, shape (N,)
+            Output scales.
+        su : array_like, shape (N,), optional
+            Modal-input scales (required when the records have ``u``).
+        sv : float, optional
+            Flap-input scale (required when the records have ``v``).
+
+        Returns
+        -------
+        IOData
+            The scaled records, same names and metadata.
+        """
         recs = tuple(Record(r.y / sy, None if r.u is None else r.u / su,
                             None if r.v is None else r.v / sv, r.name) for r in self.records)
         return IOData(recs, self.dt, self.output_names, self.u_names, self.v_name, self.meta)
 
     def window(self, start: int, stop: int | None = None) -> "IOData":
-        """Samples ``start:stop`` of every record (e.g. to drop transient periods)."""
+        """Samples ``start:stop`` of every record (e.g. to drop transient periods).
+
+        Parameters
+        ----------
+        start : int
+            First sample kept.
+        stop : int, optional
+            One past the last sample kept (default: the end).
+
+        Returns
+        -------
+        IOData
+        """
         cut = lambda x: None if x is None else x[start:stop]  # noqa: E731
         recs = tuple(Record(r.y[start:stop], cut(r.u), cut(r.v), r.name) for r in self.records)
         return IOData(recs, self.dt, self.output_names, self.u_names, self.v_name, self.meta)
 
     def decimated(self, factor: int) -> "IOData":
         """Every channel low-pass filtered (zero phase, ``scipy.signal.decimate``) and kept
-        every ``factor``-th sample; ``dt`` grows by ``factor``."""
+        every ``factor``-th sample; ``dt`` grows by ``factor``.
+
+        Parameters
+        ----------
+        factor : int
+            Decimation factor (>= 1; 1 returns the data unchanged).
+
+        Returns
+        -------
+        IOData
+
+        Raises
+        ------
+        DataError
+            ``factor`` is not a positive integer.
+        """
         from scipy.signal import decimate
 
         if not isinstance(factor, int) or factor < 1:
@@ -482,7 +590,22 @@ class IOData:
                       self.meta)
 
     def split(self, fraction: float) -> tuple["IOData", "IOData"]:
-        """Split every record at ``fraction`` of its length into (estimation, validation)."""
+        """Split every record at ``fraction`` of its length into (estimation, validation).
+
+        Parameters
+        ----------
+        fraction : float
+            Share of each record in the first part, in (0, 1).
+
+        Returns
+        -------
+        estimation, validation : IOData
+
+        Raises
+        ------
+        DataError
+            ``fraction`` outside (0, 1).
+        """
         if not 0 < fraction < 1:
             raise DataError(f"split fraction {fraction} must be in (0, 1)")
         a, b = [], []

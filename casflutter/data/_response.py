@@ -157,6 +157,20 @@ def analyze_response(timepts, X, *, window: float = 0.3, tol: float = 0.05,
     Returns
     -------
     ResponseAnalysis
+
+    See Also
+    --------
+    truth_lco : the truth's own response at a speed, classified by this function.
+    simulate_loop : the ROM loop's response.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import casflutter as cf
+    >>> t = np.arange(0.0, 60.0, 0.01)
+    >>> lco = cf.analyze_response(t, 0.3 * np.sin(2 * np.pi * 1.5 * t)[:, None])
+    >>> lco.kind, round(lco.frequency_hz, 2), round(float(lco.amplitude[0]), 2)
+    ('lco', 1.5, 0.3)
     """
     t = np.asarray(timepts, dtype=float)
     X = np.asarray(X, dtype=float)

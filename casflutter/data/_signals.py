@@ -90,6 +90,18 @@ def chirp_excitation(n_samples: int, dt: float, n_channels: int = 1, *,
         A band that is not increasing or reaches the Nyquist frequency (:func:`check_band`).
     DataError
         Fewer than 4 samples.
+
+    See Also
+    --------
+    chirp_motion : one chirp with its exact derivatives.
+    truth_records : chirp records of a truth simulator.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> u = cf.chirp_excitation(2000, 0.01, n_channels=2, band=(1.0, 20.0), seed=0)
+    >>> u.shape, bool(abs(u).max() <= 1.0)
+    ((2000, 2), True)
     """
     f0, f1 = check_band(band, dt)
     if n_samples < 4:
@@ -152,6 +164,20 @@ def chirp_motion(timepts, band: tuple[float, float], amplitude: float = 1.0,
     ConfigError
         A taper outside (0, 0.5] or a band that is not increasing or reaches the Nyquist
         frequency of the sampling (:func:`check_band`).
+
+    See Also
+    --------
+    chirp_excitation : decorrelated chirps for several channels.
+    truth_records : records of a truth driven by such motions.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import casflutter as cf
+    >>> t = np.linspace(0.0, 10.0, 2001)
+    >>> x, xdot, xddot = cf.chirp_motion(t, band=(0.1, 2.0), amplitude=0.01)
+    >>> x.shape == xdot.shape == xddot.shape == t.shape
+    True
     """
     t = np.asarray(timepts, dtype=float).ravel()
     if t.size < 4 or np.any(np.diff(t) <= 0):

@@ -502,6 +502,20 @@ def synthesize(plants, nmeas: int, ncon: int, order: int, *, starts: int = 3, se
         If the plants do not fit together or with ``nmeas``, ``ncon``.
     ConfigError
         If an option is invalid.
+
+    See Also
+    --------
+    build_lft : the aeroelastic plant of eq. 14.
+    verify_controller : the independent check of the result.
+
+    Examples
+    --------
+    >>> import control
+    >>> import casflutter as cf
+    >>> P = control.ss([[1.0]], [[1.0, 1.0]], [[1.0], [1.0]], [[0.0, 0.0], [0.0, 0.0]])
+    >>> res = cf.synthesize(P, nmeas=1, ncon=1, order=0, starts=1, seed=0)
+    >>> res.success, bool(res.spectral_abscissa < 0)
+    (True, True)
     """
     t_start = time.perf_counter()
     if isinstance(options, Mapping):

@@ -88,6 +88,20 @@ def identify_common_denominator(data: IOData, na: int = 2,
     ------
     DataError
         No ``u`` input, too few samples, or a rank-deficient (non-exciting) regression.
+
+    See Also
+    --------
+    identify : the nonlinear HWL ROM.
+    realize : Σf of the identified model.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section")
+    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
+    >>> cd = cf.identify_common_denominator(data, na=2, nb=6)
+    >>> cd.stable, bool(cd.relative_residual < 1e-6)
+    (True, True)
     """
     t0 = time.perf_counter()
     if not data.has_u:

@@ -161,7 +161,19 @@ class IdentificationSettings:
     @classmethod
     def build(cls, settings=None, **kwargs) -> "IdentificationSettings":
         """Settings from an instance and/or keyword overrides; unknown keys are a
-        :class:`~casflutter.errors.ConfigError` listing the known ones."""
+        :class:`~casflutter.errors.ConfigError` listing the known ones.
+
+        Parameters
+        ----------
+        settings : IdentificationSettings, optional
+            Settings to start from (default: the defaults).
+        **kwargs
+            Fields to replace, by name.
+
+        Returns
+        -------
+        IdentificationSettings
+        """
         names = [f.name for f in fields(cls)]
         unknown = sorted(set(kwargs) - set(names))
         if unknown:
@@ -236,6 +248,20 @@ def fit_report(model: HWLModel, data: IOData, mode: str = "simulation",
     ------
     ConfigError
         ``mode`` is neither ``"simulation"`` nor ``"prediction"``.
+
+    See Also
+    --------
+    identify : the identification whose result carries this report.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section")
+    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
+    >>> rom = cf.identify_common_denominator(data).model
+    >>> fit = cf.fit_report(rom, data)
+    >>> bool(fit.error_percent.max() < 1.0)
+    True
     """
     if mode not in ("simulation", "prediction"):
         raise ConfigError(f"fit_report mode={mode!r} is not allowed: use 'simulation' or "
@@ -324,7 +350,13 @@ class IdentificationResult:
         return self.model.n_params
 
     def summary(self) -> str:
-        """Human-readable report with the fit table."""
+        """Human-readable report with the fit table.
+
+        Returns
+        -------
+        str
+            Orders, solver status, costs, times and the fit error per output.
+        """
         m = self.model
         stage2 = (f"{self.settings.criterion}, {self.solver}" if self.settings.refine
                   else "skipped")
@@ -483,13 +515,27 @@ def identify(data: IOData, orders=(3, 1, 1, 1, 2, 2), *,
         Orders missing, not integers, out of range or inconsistent with the data.
     ConvergenceError
         Stage 2 did not converge, or the identified model's free run diverges on the
-        estimation data (status ``Unstable_Free_Run``); the result is attached as ``.result``.
+        estimation data (status ``Unstable_Free_Run``), or its free-run fit is not a finite
+        number for some output (status ``Non_Finite_Fit``); the result is attached as
+        ``.result``.
+
+    See Also
+    --------
+    identify_common_denominator : the linear ROM with one scalar denominator.
+    fit_report : the free-run or prediction fit of a model on records.
+    realize : the continuous linear ROM Σf of the identified model.
 
     Examples
     --------
-    >>> from casflutter.ident import identify            # doctest: +SKIP
-    >>> res = identify(data, (3, 1, 1, 1, 2, 2), criterion="simulation")  # doctest: +SKIP
-    >>> print(res.summary())                             # doctest: +SKIP
+    A known two-mode HWL model with the paper's orders, recovered from its chirp records:
+
+    >>> from casflutter.ident import random_hwl_model, synthetic_data
+    >>> import casflutter as cf
+    >>> known = random_hwl_model(2, (3, 1, 1, 1, 2, 2), seed=1)
+    >>> data = synthetic_data(known, 2000, seed=2)
+    >>> result = cf.identify(data, (3, 1, 1, 1, 2, 2))
+    >>> result.success, bool(max(result.fit.error_percent) < 0.1)
+    (True, True)
     """
     settings = IdentificationSettings.build(settings, **kwargs)
     # single-threaded BLAS: the factorisations here are too small to gain from threads on a
@@ -602,6 +648,10 @@ def _identify(data, orders, settings: IdentificationSettings, initial) -> Identi
         warnings.simplefilter("ignore", UnstableModelWarning)
         fit = fit_report(model, data, "simulation")
     pfit = fit_report(model, data, "prediction")
+    non_finite = [name for name, e, r in zip(model.output_names, fit.error_percent, fit.nrmse)
+                  if not (np.isfinite(e) and np.isfinite(r))]
+    if non_finite and where is None:  # a fit that cannot be scored is never a success
+        success, status = False, "Non_Finite_Fit"
     result = IdentificationResult(
         model=model, initial_model=initial_model, fit=fit, prediction_fit=pfit, success=success,
         return_status=status, iterations=iters, cost=float(cost), cost_initial=float(cost0),
@@ -617,6 +667,13 @@ def _identify(data, orders, settings: IdentificationSettings, initial) -> Identi
             f"{iters} iterations); "
             + ("use criterion='simulation', " if settings.criterion == "prediction" else "")
             + "lower the orders or add regularization", result)
+    if non_finite:
+        raise ConvergenceError(
+            f"the identified model's free-run fit is not a finite number for output(s) "
+            f"{', '.join(map(str, non_finite))} (error % "
+            f"{', '.join(f'{e:.4g}' for e in fit.error_percent)}; stage 2: "
+            f"{settings.criterion} criterion, {iters} iterations); lower the orders, add "
+            "regularization or check that every output varies", result)
     if status in _ACCEPTABLE and settings.accept_acceptable:
         warnings.warn(f"stage 2 stopped at the acceptable level ({status}, {iters} iterations, "
                       f"cost {cost0:.3e} -> {cost:.3e}); the result is returned",

@@ -283,7 +283,9 @@ class HWLModel:
     dt : float
         Sampling time in seconds.
     output_names, u_names : tuple of str
-        Channel names of y and u; ``v_name`` of the flap.
+        Channel names of y and u.
+    v_name : str
+        Name of the flap input.
     """
 
     structure: HWLStructure
@@ -321,6 +323,38 @@ class HWLModel:
         The polynomial arrays ``alpha``, ``gamma``, ``beta`` include their leading
         coefficient, which must be 1 (the normalisation).  ``c`` (N,) is the optional
         constant term.
+
+        Parameters
+        ----------
+        orders : tuple or HWLOrders
+            ``(mu, na, nb, r, p, q)``.
+        A : array_like, shape (na, N, N)
+            Autoregressive matrices ``A^(m)``.
+        alpha : array_like, shape (q, N, N)
+            Output polynomial ``alpha`` (leading coefficient 1).
+        H, B : array_like, optional
+            Modal-input Markov and lag matrices ``H (mu, N, N)``, ``B (nb+1, N, N)`` (with ``u``).
+        gamma : array_like, optional
+            Modal-input polynomial ``gamma (p, N, N)`` (with ``u``).
+        h, b : array_like, optional
+            Flap-input Markov and lag vectors ``h (mu, N)``, ``b (nb+1, N)`` (with ``v``).
+        beta : array_like, optional
+            Flap-input polynomial ``beta (p, N)`` (with ``v``).
+        c : array_like, shape (N,), optional
+            Constant term.
+        dt : float
+            Sampling time [s].
+        **names
+            ``output_names``, ``u_names``, ``v_name``.
+
+        Returns
+        -------
+        HWLModel
+
+        Raises
+        ------
+        DataError
+            A polynomial whose leading coefficient is not 1.
         """
         A = np.asarray(A, dtype=float)
         N = A.shape[-1] if A.ndim == 3 and A.shape[0] else np.asarray(alpha).shape[-1]
@@ -344,7 +378,13 @@ class HWLModel:
         """Coefficient arrays with the paper's names: ``A (na,N,N)``, ``H (mu,N,N)``,
         ``B (nb+1,N,N)``, ``h (mu,N)``, ``b (nb+1,N)``, ``alpha (q,N,N)``, ``gamma (p,N,N)``,
         ``beta (p,N)`` (the polynomial arrays include the leading 1), and ``c (N,)`` when
-        the model has a constant term."""
+        the model has a constant term.
+
+        Returns
+        -------
+        dict of str to ndarray
+            The arrays by name.
+        """
         c = self.structure.unpack(self.theta)
         out = {}
         for name, mats in c.items():
@@ -359,7 +399,17 @@ class HWLModel:
         return out
 
     def with_theta(self, theta) -> "HWLModel":
-        """The same structure with new parameters."""
+        """The same structure with new parameters.
+
+        Parameters
+        ----------
+        theta : array_like
+            Free parameters in the order of :meth:`HWLStructure.blocks`.
+
+        Returns
+        -------
+        HWLModel
+        """
         return replace(self, theta=np.asarray(theta, dtype=float), _weights=None)
 
     # -- properties -----------------------------------------------------------------
@@ -427,6 +477,15 @@ class HWLModel:
         Since the autoregressive terms start at lag ``mu``, ``y(k)`` is predicted from data up
         to ``k - mu`` (and inputs up to ``k - r``).
 
+        Parameters
+        ----------
+        y : array_like, shape (K, N)
+            Measured outputs.
+        u : array_like, shape (K, N), optional
+            Modal inputs (when the model has them).
+        v : array_like, shape (K,), optional
+            Flap input (when the model has it).
+
         Returns
         -------
         ndarray, shape (K, N)
@@ -493,6 +552,20 @@ class HWLModel:
 
         Each history has ``max_lag + 1`` rows, row ``d`` holding the value at time ``k - d``
         (row 0 = time k; ``y_hist[0]`` is ignored).  ``v_hist`` has shape ``(max_lag + 1,)``.
+
+        Parameters
+        ----------
+        y_hist : array_like, shape (max_lag + 1, N)
+            Past outputs (row ``d`` at time ``k - d``).
+        u_hist : array_like, shape (max_lag + 1, N), optional
+            Past and present modal inputs.
+        v_hist : array_like, shape (max_lag + 1,), optional
+            Past and present flap inputs.
+
+        Returns
+        -------
+        ndarray, shape (N,)
+            ``y(k)``.
         """
         L = self.max_lag
         y_hist = np.asarray(y_hist, dtype=float).reshape(L + 1, self.n_modes)
@@ -512,6 +585,15 @@ class HWLModel:
 
         Inputs are ordered ``[u_1..u_N, v]`` (whichever exist).  ``G[r + d] = [H^(d), h^(d)]``
         for ``d < mu``: the Markov parameters are the model's own coefficients.
+
+        Parameters
+        ----------
+        n : int
+            Number of samples of the impulse response.
+
+        Returns
+        -------
+        ndarray, shape (n, N, n_inputs)
         """
         c = self.coefficients()
         N = self.n_modes
@@ -537,7 +619,13 @@ class HWLModel:
         return G
 
     def linear_model(self) -> "HWLModel":
-        """The linearisation about zero as an HWL model with p = q = 1."""
+        """The linearisation about zero as an HWL model with p = q = 1.
+
+        Returns
+        -------
+        HWLModel
+            ``{A, H, h, B, b}`` of this model with the polynomials reduced to their linear terms.
+        """
         o = self.orders
         c = self.coefficients()
         lin = HWLOrders(o.mu, o.na, o.nb, o.r, 1, 1)
@@ -558,6 +646,19 @@ class HWLModel:
         The HWL class is closed under this change of units: with the normalisation
         ``alpha^[1] = 1``, ``A~_ij = A_ij s_yj / s_yi`` and ``alpha~^[l]_ij = alpha^[l]_ij
         s_yj^(l-1)`` (likewise for gamma, beta).  Used to identify on unit-RMS data.
+
+        Parameters
+        ----------
+        y_scale : array_like, shape (N,)
+            Output scales.
+        u_scale : array_like, shape (N,), optional
+            Modal-input scales.
+        v_scale : float, optional
+            Flap-input scale.
+
+        Returns
+        -------
+        HWLModel
         """
         N = self.n_modes
         sy = np.broadcast_to(np.asarray(y_scale, float), (N,))
@@ -589,6 +690,21 @@ class HWLModel:
         renormalised so that its linear coefficient stays 1; the constants collect in the
         constant term ``c``, which the result always has.  A model identified on centred
         data is returned to raw units by ``shifted(-mean_y, -mean_u, -mean_v)``.
+
+        Parameters
+        ----------
+        y_shift : array_like, shape (N,)
+            Output shift.
+        u_shift : array_like, shape (N,), optional
+            Modal-input shift.
+        v_shift : float, optional
+            Flap-input shift.
+
+
+        Returns
+        -------
+        HWLModel
+            With a constant term.
 
         Raises
         ------
@@ -631,7 +747,13 @@ class HWLModel:
 
     # -- persistence ------------------------------------------------------------------
     def save(self, path) -> None:
-        """Write the model to an ``.npz`` file (orders, N, inputs, theta, dt, names)."""
+        """Write the model to an ``.npz`` file (orders, N, inputs, theta, dt, names).
+
+        Parameters
+        ----------
+        path : str or path
+            The ``.npz`` file to write.
+        """
         s = self.structure
         np.savez(path, format=np.array("casflutter.HWLModel/1"),
                  orders=np.array(s.orders.as_tuple()), n_modes=np.array(s.n_modes),
@@ -642,7 +764,17 @@ class HWLModel:
 
     @classmethod
     def load(cls, path) -> "HWLModel":
-        """Read a model written by :meth:`save`."""
+        """Read a model written by :meth:`save`.
+
+        Parameters
+        ----------
+        path : str or path
+            The ``.npz`` file.
+
+        Returns
+        -------
+        HWLModel
+        """
         with np.load(path, allow_pickle=False) as z:
             if "format" not in z.files or not str(z["format"]).startswith("casflutter.HWLModel"):
                 raise DataError(f"{path} is not a casflutter HWL model file")

@@ -78,6 +78,16 @@ class HWLOrders:
         Also accepts a mapping with those keys, a string ``"3,1,1,1,2,2"`` or an
         :class:`HWLOrders`.  Integer-valued floats are taken as integers.
 
+        Parameters
+        ----------
+        orders : tuple, mapping, str or HWLOrders
+            The six orders.
+
+
+        Returns
+        -------
+        HWLOrders
+
         Raises
         ------
         OrderError
@@ -105,7 +115,12 @@ class HWLOrders:
         return cls(*[_as_int(n, v) for n, v in zip(_NAMES, values)])
 
     def as_tuple(self) -> tuple[int, int, int, int, int, int]:
-        """``(mu, na, nb, r, p, q)``."""
+        """``(mu, na, nb, r, p, q)``.
+
+        Returns
+        -------
+        tuple of int
+        """
         return (self.mu, self.na, self.nb, self.r, self.p, self.q)
 
     @property
@@ -115,11 +130,21 @@ class HWLOrders:
         return max(ar, self.r + self.mu + self.nb)
 
     def ar_lags(self) -> list[int]:
-        """Output lags of the autoregressive terms ``A^(m)``, ``m = 1..na``: ``mu + m - 1``."""
+        """Output lags of the autoregressive terms ``A^(m)``, ``m = 1..na``: ``mu + m - 1``.
+
+        Returns
+        -------
+        list of int
+        """
         return [self.mu + m - 1 for m in range(1, self.na + 1)]
 
     def input_lags(self) -> list[int]:
-        """Input lags of ``[H^(0..mu-1), B^(0..nb)]`` (the same for ``h, b``)."""
+        """Input lags of ``[H^(0..mu-1), B^(0..nb)]`` (the same for ``h, b``).
+
+        Returns
+        -------
+        list of int
+        """
         return [self.r + d for d in range(self.mu)] + [self.r + self.mu + d for d in range(self.nb + 1)]
 
     def __str__(self) -> str:

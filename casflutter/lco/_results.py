@@ -83,7 +83,17 @@ class LCOSettings:
 
     @classmethod
     def from_mapping(cls, values: dict) -> "LCOSettings":
-        """Settings from a mapping (unknown keys raise ConfigError listing the valid ones)."""
+        """Settings from a mapping (unknown keys raise ConfigError listing the valid ones).
+
+        Parameters
+        ----------
+        values : mapping
+            Field values by name (e.g. a configuration's ``[lco]`` table).
+
+        Returns
+        -------
+        LCOSettings
+        """
         valid = [f.name for f in fields(cls)]
         unknown = [k for k in values if k not in valid]
         if unknown:
@@ -291,7 +301,18 @@ class LCOBranch:
         return self.hopf.kind
 
     def speed(self, V):
-        """Speed index -> the problem's speed unit."""
+        """Speed index -> the problem's speed unit.
+
+        Parameters
+        ----------
+        V : float or array_like
+            Speed index.
+
+        Returns
+        -------
+        float or ndarray
+            ``V`` times :attr:`speed_scale`, in :attr:`speed_unit`.
+        """
         return self.speed_scale * np.asarray(V, float) if np.ndim(V) else self.speed_scale * float(V)
 
     @property
@@ -310,17 +331,44 @@ class LCOBranch:
         return np.array([p.freq_hz for p in self.points])
 
     def amplitude(self, name: str) -> np.ndarray:
-        """Amplitudes of output ``name`` along the branch."""
+        """Amplitudes of output ``name`` along the branch.
+
+        Parameters
+        ----------
+        name : str
+            An output name (of :attr:`outputs`).
+
+        Returns
+        -------
+        ndarray
+            Peak amplitude at each branch point, in :meth:`unit_of` ``name``.
+        """
         if name not in self.outputs:
             raise ConfigError(f"unknown output {name!r}; outputs: {', '.join(self.outputs)}")
         return np.array([p.amplitude[name] for p in self.points])
 
     def unit_of(self, name: str) -> str:
-        """Unit of output ``name``."""
+        """Unit of output ``name``.
+
+        Parameters
+        ----------
+        name : str
+            An output name.
+
+        Returns
+        -------
+        str
+        """
         return self.output_units[self.outputs.index(name)]
 
     def to_dict(self) -> dict:
-        """The JSON document of ``casflutter lco`` (speeds in the problem's unit)."""
+        """The JSON document of ``casflutter lco`` (speeds in the problem's unit).
+
+        Returns
+        -------
+        dict
+            ``problem``, ``hopf``, ``kind``, ``branch``, ``folds`` and the units.
+        """
         h = self.hopf
         return {
             "problem": self.problem,

@@ -415,6 +415,20 @@ def rom_lco_branch(rom: HWLModel, structure: ModalStructure, vrange, settings: L
         No Neimark--Sacker point in the range (or unstable at its start), or a degenerate one.
     ConvergenceError
         The first invariant circle did not converge.
+
+    See Also
+    --------
+    lco_branch : the truth's branch, to compare with.
+    simulate_loop : one long simulation of the ROM loop.
+
+    Examples
+    --------
+    With ``model`` an identified HWL ROM and ``structure`` its Σs (as in :func:`simulate_loop`),
+    over speed indices 0.8 to 1.6 (minutes for the seed wing; :func:`run` does it from a
+    configuration's ``[lco]`` table):
+
+    >>> branch = cf.rom_lco_branch(model, structure, (0.8, 1.6))    # doctest: +SKIP
+    >>> branch.hopf.kind, [p.V for p in branch.points][:3]         # doctest: +SKIP
     """
     settings = LCOSettings() if settings is None else settings
     lo, hi = (float(v) for v in vrange)

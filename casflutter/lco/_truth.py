@@ -235,6 +235,19 @@ def lco_branch(truth, vrange=None, settings: LCOSettings | None = None,
         No range given and none in the definition, no Hopf point in it, or a linear truth.
     ConvergenceError
         The first orbit did not converge.
+
+    See Also
+    --------
+    rom_lco_branch : the same for the ROM loop.
+    truth_lco : one long simulation at one speed (the independent check).
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section", ["kappa2=3"])
+    >>> b = cf.lco_branch(truth, (1.5, 2.5), cf.LCOSettings(max_points=10))
+    >>> b.hopf.kind, round(b.hopf.V, 3)
+    ('supercritical', 2.17)
     """
     settings = LCOSettings() if settings is None else settings
     if vrange is None:

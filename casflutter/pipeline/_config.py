@@ -22,6 +22,9 @@ table          settings
 ``[solver]``   flat Ipopt options for every NLP
 ============== ==============================================================================
 
+The defaults of every key are the seed wing's study, ``problems/seed_wing/run.toml``: an
+empty configuration runs that study (a test keeps the two equal).
+
 ``stages`` lists the optional stages to run after the flutter search; the records, the ROM,
 Σf, ΣAE and the flutter speeds of the ROM and the truth always run.  Every value is checked
 before any work (:func:`casflutter._settings.build_settings`): unknown keys, wrong types and
@@ -33,6 +36,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from .._nlp import check_solver_options
 from .._resources import problems_dir, read_toml
 from .._settings import build_settings, finite_numbers, set_dotted
 from ..design import SynthesisOptions
@@ -44,7 +48,7 @@ from ..truth import (RecordSettings, SuppressionSettings, file_problem_names, lo
 
 __all__ = ["RunConfig", "ProblemSection", "DataSection", "RomSection", "FlutterSection",
            "LcoSection", "ControllerSettings", "VerifySection", "ClosedLoopSection",
-           "ParametricSection", "SensorsSection", "SolverSection", "STAGES", "load_config",
+           "SuppressionSection", "ParametricSection", "SensorsSection", "SolverSection", "STAGES", "load_config",
            "default_config_path", "config_path", "flutter_config"]
 
 #: Optional stages, in the order they run (``RunConfig.stages``).
@@ -70,7 +74,10 @@ class ProblemSection:
     """``[problem]``: which truth, and its parameter changes."""
 
     name: str = "seed_wing"
-    """A problem name (``casflutter problems``) or the path of a problem TOML file."""
+    """A problem name (``casflutter problems``) or the path of a problem TOML file: a rig
+    section, or a wing file without a simulator (``kind = "wing"`` with records, ``"gaf"``
+    with ``Q(ik)``; :class:`casflutter.truth.WingProblem`); a relative path is looked up
+    beside the configuration file first."""
     set: dict = field(default_factory=dict)
     """Parameter changes ``{name = value}``, checked by the truth's parameter class."""
 
@@ -117,6 +124,9 @@ class RomSection(IdentificationSettings):
 
     orders: list = field(default_factory=lambda: [3, 1, 1, 1, 2, 2])
     """HWL orders ``[mu, na, nb, r, p, q]`` (``method = "hwl"``; paper Table I)."""
+    regularization: float = 1e-6
+    """Tikhonov weight of stage 2 (:class:`casflutter.ident.IdentificationSettings`); the
+    seed wing's study keeps stage 2 converging on its weakly excited nonlinear terms."""
     nf: int | str = 15
     """Order of Σf (ERA, eq. 5), or ``"auto"`` for the exact (minimal) order."""
     method: str = "hwl"
@@ -152,6 +162,8 @@ class RomSection(IdentificationSettings):
         _integer("nb", self.nb, 1)
         _integer("v0_iterations", self.v0_iterations, 1)
         _positive("v0_rtol", self.v0_rtol)
+        object.__setattr__(self, "ipopt_options",
+                           check_solver_options(self.ipopt_options, "ipopt_options"))
 
 
 @dataclass(frozen=True)
@@ -159,9 +171,9 @@ class FlutterSection:
     """``[flutter]``: the Hopf search of :func:`casflutter.aeroelastic.find_flutter` on the
     ROM and the truth."""
 
-    V_range: tuple = (0.05, 2.5)
+    V_range: tuple = (0.3, 2.5)
     """Speed-index range ``[low, high]``."""
-    n_grid: int = 121
+    n_grid: int = 111
     """Points of the uniform V grid."""
     max_refine: int = 3
     """Largest number of grid refinements of the eigenvalue tracking (identical strips give
@@ -182,9 +194,9 @@ class LcoSection:
     """``[lco]``: the nonlinear ROM in the loop and the truth above their flutter speeds
     (paper Fig. 9), from a deflected flutter mode."""
 
-    duration: float = 20.0
+    duration: float = 10.0
     """Length of the simulations."""
-    initial_deflection: float = 0.05
+    initial_deflection: float = 0.01
     """Initial deflection of the flutter mode (also the tap of the suppression run)."""
     speed_factor: float = 1.05
     """Simulate at ``speed_factor`` times each model's own Hopf speed: exactly at the Hopf
@@ -220,6 +232,16 @@ class ControllerSettings(SynthesisOptions):
     """Decay rate [rad/s] required of ΣAE(V) at those speeds."""
     steps: int = 4
     """Continuation steps of the interval's upper end."""
+    strictly_proper: bool = True
+    """``Dk = 0`` (:class:`casflutter.design.SynthesisOptions`): the seed wing's
+    accelerometers see the flap directly, and any ``Dk`` makes its loop algebraically
+    singular at some speed above Vf."""
+    zero_start: bool = False
+    """The first start is the zero controller (otherwise every start is seeded random)."""
+    max_outer: int = 80
+    """Outer iterations per start (:class:`casflutter.design.SynthesisOptions`)."""
+    max_stab_rounds: int = 300
+    """Stabilisation rounds per start (:class:`casflutter.design.SynthesisOptions`)."""
 
     def __post_init__(self):
         super().__post_init__()
@@ -240,6 +262,7 @@ class ControllerSettings(SynthesisOptions):
         _integer("steps", self.steps, 1)
         if not self.interval_decay >= 0:
             raise ConfigError(f"interval_decay = {self.interval_decay!r}: must be >= 0")
+        object.__setattr__(self, "ipopt", check_solver_options(self.ipopt, "ipopt"))
 
 
 @dataclass(frozen=True)
@@ -351,11 +374,66 @@ class SolverSection:
     stage's own (``rom.ipopt_options``, ``controller.ipopt``)."""
 
     ipopt: dict = field(default_factory=dict)
+    """Options by CasADi name: ``ipopt.NAME`` is checked against the installed Ipopt's own
+    option list (name, type, range, settings), the others are CasADi's ``nlpsol`` options."""
+
+    def __post_init__(self):
+        object.__setattr__(self, "ipopt", check_solver_options(self.ipopt, "ipopt"))
+
+
+@dataclass(frozen=True)
+class SuppressionSection(SuppressionSettings):
+    """``[suppression]``: the gain-ramp run on the truth
+    (:class:`casflutter.truth.SuppressionSettings`) with the seed wing's study phases and the
+    flap servo of a wind-tunnel model (±15 deg, 300 deg/s)."""
+
+    settle: float = 6.0
+    """Open-loop time before the ramp."""
+    ramp: float = 3.0
+    """Length of the gain ramp 0 -> 1."""
+    hold: float = 6.0
+    """Closed-loop time at full gain."""
+    flap_limit: float | None = 0.2618
+    """Flap position limit [rad] (15 deg); from Python ``None`` for no limit."""
+    flap_rate_limit: float | None = 5.236
+    """Flap rate limit [rad/s] (300 deg/s); from Python ``None`` for no limit."""
 
 
 @dataclass(frozen=True)
 class RunConfig:
-    """The whole configuration of a run; each field is one TOML table (module docstring)."""
+    """The whole configuration of a run; each field is one TOML table (module docstring).
+
+    Attributes
+    ----------
+    problem : ProblemSection
+        ``[problem]``: the truth or problem file and its parameter changes.
+    data : DataSection
+        ``[data]``: the identification records.
+    rom : RomSection
+        ``[rom]``: the identification of the ROM and its realisation.
+    flutter : FlutterSection
+        ``[flutter]``: the flutter search.
+    lco : LcoSection
+        ``[lco]``: the LCO simulations and branches.
+    controller : ControllerSettings
+        ``[controller]``: the robust synthesis.
+    verify : VerifySection
+        ``[verify]``: the verification's speed grid.
+    closed_loop : ClosedLoopSection
+        ``[closed_loop]``: the closed-loop simulations on the ROM and the truth.
+    suppression : SuppressionSettings
+        ``[suppression]``: the gain ramp on the truth (paper Fig. 11).
+    parametric : ParametricSection
+        ``[parametric]``: the ROM interpolated in the speed.
+    sensors : SensorsSection
+        ``[sensors]``: the sensor rows and kind.
+    solver : SolverSection
+        ``[solver]``: Ipopt options.
+    seed : int
+        Seed of every random choice of the run.
+    stages : tuple of str
+        The optional stages to run (``"lco"``, ``"controller"``, ``"suppression"``, ...).
+    """
 
     problem: ProblemSection = field(default_factory=ProblemSection)
     data: DataSection = field(default_factory=DataSection)
@@ -365,7 +443,7 @@ class RunConfig:
     controller: ControllerSettings = field(default_factory=ControllerSettings)
     verify: VerifySection = field(default_factory=VerifySection)
     closed_loop: ClosedLoopSection = field(default_factory=ClosedLoopSection)
-    suppression: SuppressionSettings = field(default_factory=SuppressionSettings)
+    suppression: SuppressionSection = field(default_factory=SuppressionSection)
     parametric: ParametricSection = field(default_factory=ParametricSection)
     sensors: SensorsSection = field(default_factory=SensorsSection)
     solver: SolverSection = field(default_factory=SolverSection)
@@ -391,9 +469,27 @@ class RunConfig:
             raise ConfigError("stages: 'suppression' reads acceleration or displacement "
                               "sensors; set sensors.kind accordingly")
         object.__setattr__(self, "stages", tuple(s for s in STAGES if s in stages))
+        n_modes = self.problem.load().n_modes
         if self.sensors.rows:
-            check_sensor_rows(self.sensors.rows, self.problem.load().n_modes,
-                              key="sensors.rows", problem=self.problem.name)
+            check_sensor_rows(self.sensors.rows, n_modes, key="sensors.rows",
+                              problem=self.problem.name)
+        if self.rom.nf != "auto":
+            self._check_nf(n_modes)
+
+    def _check_nf(self, n_modes: int) -> None:
+        """``rom.nf`` at most the exact order of the ROM's linear part: N modes times its
+        largest lag (:func:`casflutter.realize.realize`); a larger Σf is not minimal."""
+        r = self.rom
+        if r.method == "hwl":
+            lag, of = HWLOrders.from_tuple(r.orders).max_lag, f"orders {list(r.orders)}"
+        else:  # common denominator: lags na of the outputs, nb of the inputs
+            lag, of = max(r.na, r.nb), f"na = {r.na}, nb = {r.nb}"
+        bound = n_modes * lag
+        if r.nf > bound:
+            raise ConfigError(
+                f"rom.nf = {r.nf}: at most {bound} here (the linear part of a ROM with {of} "
+                f"on the {n_modes} modes of {self.problem.name!r} has at most {n_modes} x "
+                f"{lag} = {bound} states: modes x largest lag); give 1..{bound} or \"auto\"")
 
     def to_dict(self) -> dict:
         """The configuration as nested plain values (``config.json``).
@@ -499,6 +595,18 @@ def default_config_path() -> Path:
     return config_path("seed_wing", "run")
 
 
+def _relative_problem(table: dict, path: Path) -> None:
+    """A ``[problem] name`` that is a path relative to the configuration file's folder (a
+    wing file beside its run configuration) becomes that path."""
+    prob = table.get("problem")
+    name = prob.get("name") if isinstance(prob, dict) else None
+    if not isinstance(name, str) or Path(name).is_absolute() or Path(name).exists():
+        return
+    near = path.parent / name
+    if near.is_file() or (near / "problem.toml").is_file():
+        prob["name"] = str(near)
+
+
 def load_config(path=None, *, updates=None, **overrides) -> RunConfig:
     """Read and validate a run configuration (default: the seed wing's).
 
@@ -522,9 +630,26 @@ def load_config(path=None, *, updates=None, **overrides) -> RunConfig:
     ------
     ConfigError
         A missing or malformed file, or any unknown or invalid key (named).
+
+    See Also
+    --------
+    run : runs the configuration.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> cfg = cf.load_config(updates={"controller.order": 2}, seed=3)
+    >>> cfg.controller.order, cfg.seed, cfg.problem.name
+    (2, 3, 'seed_wing')
     """
     path = Path(path) if path is not None else default_config_path()
     table = read_toml(path, "configuration file")
+    if table.get("kind") is not None:
+        raise ConfigError(f"{path} is a problem file (kind = {table['kind']!r}), not a run "
+                          "configuration: write a run configuration whose [problem] name is "
+                          f"this file (e.g. problems/example_wing/run.toml), or pass it as "
+                          "problem.name")
+    _relative_problem(table, path)
     table.update({k: v for k, v in overrides.items() if v is not None})
     for key, value in (updates or {}).items():
         set_dotted(table, RunConfig, key, value)

@@ -10,14 +10,17 @@ import control
 import numpy as np
 
 from ..aeroelastic import (AeroelasticLFT, AeroelasticSystem, FlutterResult, LoopSimulation,
-                           ParametricSystem)
+                           ParametricSystem, PKResult, RFASystem)
 from ..data import IOData
 from ..design import SynthesisResult
+from .._outputs import plain_json
 from ..ident import CommonDenominatorResult, FitReport, IdentificationResult
-from ..realize import ParametricROM, Realization
+from ..realize import ParametricROM, RationalApproximation, Realization
 from ..truth import AeroelasticTruth, SuppressionResult, TruthLco, TruthLoopSweep
 from ..verify import SpeedSweep, VerificationReport
 from ._config import RunConfig
+from ._exports import label_summary
+from ._units import speed_scale, speed_values
 
 __all__ = ["RunResult", "LcoResult", "ParametricResult", "SimulationCheck",
            "ClosedLoopChecks"]
@@ -31,8 +34,9 @@ class LcoResult:
     ----------
     rom : LoopSimulation
         The nonlinear ROM in the loop with Σs at ``V``.
-    truth : TruthLco
-        The truth's own response a little above its own flutter speed.
+    truth : TruthLco or None
+        The truth's own response a little above its own flutter speed (``None`` on a wing
+        file, which has no simulator).
     V : float
         Speed of the ROM simulation: ``lco.speed_factor`` times ``V_hopf_exact_order``.
     V_hopf_exact_order : float
@@ -43,7 +47,7 @@ class LcoResult:
     """
 
     rom: LoopSimulation
-    truth: TruthLco
+    truth: TruthLco | None
     V: float
     V_hopf_exact_order: float
     flutter_exact_order: FlutterResult
@@ -130,19 +134,8 @@ class ClosedLoopChecks:
     truth_simulation: SimulationCheck
 
 
-def _jsonable(x: Any):
-    """Plain JSON values: floats (non-finite as ``None``), ints, lists, dicts."""
-    if isinstance(x, dict):
-        return {k: _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, (np.floating, float)):
-        return None if not np.isfinite(x) else float(x)
-    if isinstance(x, (np.integer,)):
-        return int(x)
-    if isinstance(x, np.ndarray):
-        return _jsonable(x.tolist())
-    return x
+#: Plain JSON values (non-finite floats as ``None``).
+_jsonable = plain_json
 
 
 def _pair(t):
@@ -171,11 +164,13 @@ class RunResult:
     ----------
     config : RunConfig
         The configuration.
-    truth : AeroelasticTruth
-        The truth simulator.
-    data : IOData
-        The chirp records of the last identification.
-    identification : IdentificationResult or CommonDenominatorResult
+    truth : AeroelasticTruth or None
+        The truth simulator (``None`` on a wing file).
+    data : IOData or None
+        The chirp records of the last identification (``None`` on a GAF wing file, which
+        has ``Q(ik)`` instead of records; so are ``identification``, ``fit`` and
+        ``realization``).
+    identification : IdentificationResult or CommonDenominatorResult or None
         The ROM (``.model``).
     identification_history : tuple of (float, float)
         ``(V0, Vf_ROM)`` of every identification (more than one with ``rom.v0_iterations``).
@@ -184,9 +179,12 @@ class RunResult:
     realization : Realization
         Σf by ERA and Tustin (eq. 5).
     system : AeroelasticSystem
-        ΣAE(V) (eq. 8-9).
-    flutter, flutter_truth : FlutterResult
-        Flutter searches of the ROM and of the truth.
+        ΣAE(V) (eq. 8-9); on a GAF wing file with Σf of the RFA frozen at the flutter speed
+        (``None`` when the RFA has ``p`` terms: no proper Σf).
+    flutter : FlutterResult
+        Flutter search of the ROM.
+    flutter_truth : FlutterResult or None
+        Of the truth (``None`` on a wing file).
     flutter_frozen : FlutterResult or None
         Of the truth with its aerodynamics frozen at ``V0`` (stage ``frozen``).
     parametric : ParametricResult or None
@@ -213,18 +211,34 @@ class RunResult:
         Where the files were written.
     files : mapping
         Name -> path of every file written.
+    problem : object
+        What ``[problem]`` loaded: the truth, or a :class:`casflutter.truth.WingProblem`.
+    skipped : mapping
+        Stage (or part of a stage) -> why it did not run (the truth-only stages on a wing
+        file).
+    rfa : RationalApproximation or None
+        The RFA of a GAF wing file's ``Q(ik)``.
+    rfa_system : RFASystem or None
+        Its ΣAE(U) in the airspeed [m/s].
+    rfa_flutter : FlutterResult or None
+        The flutter search of ``rfa_system`` (speeds in m/s, frequencies in rad/s).
+    pk : PKResult or None
+        The p–k solution on the same ``Q(ik)`` (the independent check).
+    provenance : mapping
+        What produced the run (:func:`casflutter._outputs.provenance`: version, seed,
+        thread settings, libraries) and its start time (``started``).
     """
 
     config: RunConfig
-    truth: AeroelasticTruth
-    data: IOData
-    identification: IdentificationResult | CommonDenominatorResult
+    truth: AeroelasticTruth | None
+    data: IOData | None
+    identification: IdentificationResult | CommonDenominatorResult | None
     identification_history: tuple
-    fit: FitReport
-    realization: Realization
-    system: AeroelasticSystem
-    flutter: FlutterResult
-    flutter_truth: FlutterResult
+    fit: FitReport | None
+    realization: Realization | None
+    system: AeroelasticSystem | None
+    flutter: FlutterResult | None
+    flutter_truth: FlutterResult | None
     flutter_frozen: FlutterResult | None = None
     parametric: ParametricResult | None = None
     lco: LcoResult | None = None
@@ -238,40 +252,47 @@ class RunResult:
     timings: Mapping[str, float] = field(default_factory=dict)
     out_dir: Path | None = None
     files: Mapping[str, Path] = field(default_factory=dict)
+    problem: Any = None
+    skipped: Mapping[str, str] = field(default_factory=dict)
+    rfa: RationalApproximation | None = None
+    rfa_system: RFASystem | None = None
+    rfa_flutter: FlutterResult | None = None
+    pk: PKResult | None = None
+    provenance: Mapping[str, Any] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ flutter speeds
     @property
     def Vf(self) -> float | None:
         """The ROM's flutter speed index (the LFT's nominal speed)."""
-        return self.flutter.Vf
+        return None if self.flutter is None else self.flutter.Vf
 
     @property
     def Vf_truth(self) -> float | None:
         """The truth's flutter speed index."""
-        return self.flutter_truth.Vf
+        return None if self.flutter_truth is None else self.flutter_truth.Vf
 
     @property
     def rom_error(self) -> float | None:
         """``(Vf_rom - Vf_truth) / Vf_truth``."""
-        return _rel(self.flutter.Vf, self.flutter_truth.Vf)
+        return _rel(self.Vf, self.Vf_truth)
 
     @property
     def scaling_error(self) -> float | None:
         """``(Vf_frozen - Vf_truth) / Vf_truth``: the error the V² scaling alone causes."""
         return None if self.flutter_frozen is None else _rel(self.flutter_frozen.Vf,
-                                                             self.flutter_truth.Vf)
+                                                             self.Vf_truth)
 
     @property
     def identification_error(self) -> float | None:
         """``(Vf_rom - Vf_frozen) / Vf_frozen``: what identification and Tustin add."""
-        return None if self.flutter_frozen is None else _rel(self.flutter.Vf,
+        return None if self.flutter_frozen is None else _rel(self.Vf,
                                                              self.flutter_frozen.Vf)
 
     @property
     def parametric_error(self) -> float | None:
         """``(Vf_parametric - Vf_truth) / Vf_truth``."""
         return None if self.parametric is None else _rel(self.parametric.flutter.Vf,
-                                                         self.flutter_truth.Vf)
+                                                         self.Vf_truth)
 
     def explanation(self) -> str:
         """The ROM's flutter-speed error and its cause, in words.
@@ -282,7 +303,11 @@ class RunResult:
         """
         def pct(x):
             return "n/a" if x is None else f"{100 * x:+.3f}%"
-        text = (f"ROM identified at V0 = {self.config.data.V0:g}: Vf error "
+        V0 = speed_values(self.config.data.V0, speed_scale(
+            getattr(self, "problem", None) or self.truth))
+        air = (f" (U0 = {V0['airspeed_m_s']:.4g} m/s)" if V0.get("airspeed_m_s") is not None
+               else "")
+        text = (f"ROM identified at speed index V0 = {V0['speed_index']:g}{air}: Vf error "
                 f"{pct(self.rom_error)} vs the truth.")
         if self.flutter_frozen is not None:
             text += (f" The V² scaling of ΣAE freezes the aerodynamic time scale (reduced "
@@ -340,21 +365,26 @@ class RunResult:
             ``problem``, ``V0``, ``n_sensors``, ``orders``, ``n_params``,
             ``fit_error_percent``, ``nf``, ``ns``, ``nae``, ``flutter``, ``flutter_truth``,
             ``lco``, ``controller``, ``suppression`` (``None`` when the stage did not run),
-            ``timings_s``, ``seed``; and, for the stages that ran, ``v0_history``,
+            ``timings_s``, ``seed``; ``skipped`` (stage -> reason) when a stage was
+            skipped; and, for the stages that ran, ``v0_history``,
             ``flutter_frozen``, ``flutter_parametric``, ``verification`` and
             ``closed_loop``.
         """
-        cfg, model = self.config, self.identification.model
+        cfg = self.config
+        model = None if self.identification is None else self.identification.model
+        structure = (self.system.structure if self.system is not None
+                     else self.rfa_system.structure)
         out = {
             "problem": cfg.problem.name,
-            "V0": cfg.data.V0,
-            "n_sensors": int(self.system.structure.n_sensors),
-            "orders": list(model.orders.as_tuple()),
-            "n_params": model.n_params,
-            "fit_error_percent": list(self.fit.error_percent),
-            "nf": self.realization.order,
-            "ns": 2 * model.n_modes,
-            "nae": int(self.system.state_matrix(0.0).shape[0]),
+            "V0": cfg.data.V0 if model is not None else None,
+            "n_sensors": int(structure.n_sensors),
+            "orders": None if model is None else list(model.orders.as_tuple()),
+            "n_params": None if model is None else model.n_params,
+            "fit_error_percent": None if self.fit is None else list(self.fit.error_percent),
+            "nf": None if self.realization is None else self.realization.order,
+            "ns": 2 * structure.n_modes,
+            "nae": (None if self.system is None
+                    else int(self.system.state_matrix(0.0).shape[0])),
             "flutter": _flutter_summary(self.flutter),
             "flutter_truth": _flutter_summary(self.flutter_truth),
             "lco": self._lco_summary(),
@@ -371,6 +401,8 @@ class RunResult:
             "timings_s": dict(self.timings),
             "seed": cfg.seed,
         }
+        if self.skipped:
+            out["skipped"] = dict(self.skipped)
         if cfg.rom.v0_iterations > 1:
             out["v0_history"] = [list(map(float, p)) for p in self.identification_history]
         if self.flutter_frozen is not None:
@@ -386,6 +418,11 @@ class RunResult:
                 "synthesis_gammas": [float(g) for g in self.synthesis.gammas],
                 "synthesis_converged": bool(self.synthesis.converged),
                 "success": self.success}
+        U_ref = getattr(self.problem, "U_ref", None)
+        if U_ref is not None and out["flutter"] is not None and out["flutter"]["V"] is not None:
+            out["flutter"]["airspeed_m_s"] = out["flutter"]["V"] * U_ref
+        if self.rfa is not None:
+            out["rfa"] = self._rfa_summary()
         if self.closed_loop is not None:
             cl = self.closed_loop
             out["closed_loop"] = {
@@ -395,7 +432,25 @@ class RunResult:
                                           "open_eig_rate": s.open_eig_rate,
                                           "closed_eig_rate": s.closed_eig_rate}
                                 for s in (cl.rom_simulation, cl.truth_simulation)}}
-        return _jsonable(out)
+        return _jsonable(label_summary(out, self))
+
+    def _rfa_summary(self) -> dict:
+        """The RFA, its flutter in m/s and rad/s and the p–k check (GAF wing files)."""
+        r, fl, pk = self.rfa, self.rfa_flutter, self.pk
+        mode = fl.flutter_mode if fl is not None else None
+        return {
+            "method": r.method, "n_lags": int(r.n_lags), "poly_order": int(r.poly_order),
+            "lag_roots": [float(g) for g in r.gamma], "n_lag_states": int(r.n_lag_states),
+            "fit_error": float(r.fit_error),
+            "max_element_error": float(np.max(r.error_rel)),
+            "flutter": None if fl is None or fl.Vf is None else {
+                "airspeed_m_s": float(fl.Vf), "omega_rad_s": float(fl.omega_f),
+                "k": float(fl.omega_f) * r.b / float(fl.Vf),
+                "mode": None if mode is None or mode < 0 else int(mode) + 1},
+            "pk": None if pk is None or not pk.found else {
+                "airspeed_m_s": float(pk.flutter_speed), "omega_rad_s": float(pk.flutter_omega),
+                "k": float(pk.flutter_k), "mode": int(pk.flutter_mode) + 1},
+            "units": {"airspeed": "m/s", "omega": "rad/s", "k": "omega b / U"}}
 
     def _lco_summary(self) -> dict | None:
         if self.lco is None:
@@ -404,8 +459,10 @@ class RunResult:
         sens = sim.sensors if sim.sensors is not None else sim.modes
         return {"V": self.lco.V, "V_hopf_exact_order": self.lco.V_hopf_exact_order,
                 "freq_hz": sens.frequency_hz, "amplitude": list(sens.amplitude),
-                "kind": sens.kind, "truth_V": tr.V, "truth_freq_hz": tr.freq_hz,
-                "truth_amplitude": list(tr.amplitude), "truth_kind": tr.kind}
+                "kind": sens.kind, "truth_V": None if tr is None else tr.V,
+                "truth_freq_hz": None if tr is None else tr.freq_hz,
+                "truth_amplitude": None if tr is None else list(tr.amplitude),
+                "truth_kind": None if tr is None else tr.kind}
 
     def _controller_summary(self) -> dict | None:
         if self.verification is None:

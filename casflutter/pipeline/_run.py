@@ -22,6 +22,20 @@ identification speed and the flutter speed agree.  Then the optional ``stages``:
   truth's linear closed loop over speed;
 - ``suppression`` — the truth with the controller gain ramped 0 -> 1 and released (Fig. 11).
 
+A wing file without a simulator (``[problem] name`` a ``kind = "wing"`` file: modal data,
+sensors and records, :class:`casflutter.truth.WingProblem`) runs the same stages on its records
+at its own ``V0``; the stages that need the truth (its flutter search, ``frozen``,
+``parametric``, the truth's LCO, ``closed_loop``, ``suppression``) are skipped with a logged
+note and listed in ``RunResult.skipped``.
+
+A wing file with frequency-domain aerodynamics (``kind = "gaf"``: modal data and ``Q(ik)``,
+:class:`casflutter.truth.GAFProblem`) replaces stages 1-5 by the rational-function
+approximation (``rfa``, :func:`casflutter.realize.fit_rfa`), the flutter search of ΣAE(U) in
+the airspeed with the p–k solution on the same table beside it (``flutter``), and Σf of the
+RFA frozen at the flutter speed with ΣAE(V) (``realize``, ``structure``); the ``controller``
+stage then runs on that ΣAE (the LFT of eq. 14 is exact at Vf).  The RFA is linear: ``lco`` is
+skipped with the truth-only stages.
+
 Two configurations ship with the package: ``problems/seed_wing/run.toml`` (the paper's
 study, ``casflutter run``) and ``problems/typical_section/flutter_check.toml`` (an order-2
 controller designed on the ROM identified at its own flutter speed and checked on the
@@ -30,7 +44,7 @@ truth); ``problems/NAME/flutter.toml`` are the ROM routes of ``casflutter flutte
 
 from __future__ import annotations
 
-import json
+import logging
 import sys
 import time
 from contextlib import contextmanager
@@ -39,27 +53,37 @@ from pathlib import Path
 
 import control
 import numpy as np
-from scipy.io import savemat
 
 from .._linalg import spectral_abscissa
+from .._outputs import provenance, utc_now
 from .._settings import settings_as
-from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, build_lft,
+from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, RFASystem,
+                           build_lft, pk_flutter,
                            find_flutter, simulate_loop)
 from ..data import envelope_growth_rate
 from ..design import SynthesisOptions, design_flutter_controller
-from ..errors import CasflutterError
+from ..errors import CasflutterError, ConfigError
 from ..ident import (IdentificationResult, IdentificationSettings, fit_report, identify,
                      identify_common_denominator)
-from ..realize import ParametricROM, realize, speed_nodes
-from ..report import write_figures, write_html
-from ..truth import (RecordSettings, closed_loop_truth, frozen_aero_truth, suppression_run,
+from ..realize import ParametricROM, RFASettings, fit_rfa, realize, speed_nodes
+from ..truth import (AeroelasticTruth, GAFProblem, RecordSettings, WingProblem,
+                     closed_loop_truth, frozen_aero_truth, suppression_run,
                      truth_lco, truth_loop_matrix, truth_loop_sweep, truth_records)
-from ..verify import controller_to_json, speed_sweep, verify_controller
+from ..verify import speed_sweep, verify_controller
 from ._config import RunConfig, load_config
+from ._exports import check_output_folder, log_flags, write_outputs
 from ._result import (ClosedLoopChecks, LcoResult, ParametricResult, RunResult,
-                      SimulationCheck, _jsonable)
+                      SimulationCheck)
 
 __all__ = ["run"]
+
+log = logging.getLogger("casflutter.pipeline")
+
+#: stages (and parts of stages) that need a truth simulator, skipped on a wing file
+_TRUTH_ONLY = {"flutter_truth": "the truth's flutter search", "frozen": "stage 'frozen'",
+               "parametric": "stage 'parametric' (records at several speeds)",
+               "truth_lco": "the truth's LCO of stage 'lco'",
+               "closed_loop": "stage 'closed_loop'", "suppression": "stage 'suppression'"}
 
 
 class _Progress:
@@ -88,11 +112,108 @@ class _Progress:
             print(f"      {text}", file=sys.stderr, flush=True)
 
 
-def _stage_names(cfg: RunConfig) -> list[str]:
+def _stage_names(cfg: RunConfig, skipped=()) -> list[str]:
     names = ["data", "rom", "realize", "structure", "flutter"]
     for s in cfg.stages:
-        names += ["lft", "controller", "verify"] if s == "controller" else [s]
+        if s not in skipped:
+            names += ["lft", "controller", "verify"] if s == "controller" else [s]
     return names
+
+
+def _same_sensors(cfg: RunConfig, wing) -> None:
+    """The run's ``[sensors] kind`` must be the wing file's (its rows are read that way)."""
+    if cfg.sensors.kind != wing.structure.sensor:
+        raise ConfigError(f"sensors.kind = {cfg.sensors.kind!r} of the run configuration "
+                          f"differs from sensors.kind = {wing.structure.sensor!r} of the wing "
+                          f"file {wing.path}; set [sensors] kind = "
+                          f"\"{wing.structure.sensor}\" in the run configuration")
+
+
+def _gaf_setup(cfg: RunConfig, gaf: GAFProblem) -> tuple[RFASettings, dict]:
+    """The RFA settings of a GAF wing file and the stages it skips; checked before any work."""
+    try:
+        settings = RFASettings(**gaf.rfa)
+    except ConfigError as exc:
+        raise ConfigError(f"[gaf] of the wing file {gaf.path}: {exc}") from None
+    if "controller" in cfg.stages and settings.poly_order != 0:
+        raise ConfigError(f"stages: 'controller' on the GAF problem {gaf.name!r} needs the "
+                          "frozen Σf of eq. 5, which is proper only without p, p^2 terms; set "
+                          f"gaf.poly_order = 0 in {gaf.path} (now {settings.poly_order}) or "
+                          "drop the controller stage")
+    _same_sensors(cfg, gaf)
+    why = f"needs a truth simulator; the wing file {gaf.name!r} has Q(ik) only"
+    skipped = {k: f"{v}: {why}" for k, v in _TRUTH_ONLY.items()
+               if k in {"flutter_truth"} | set(cfg.stages)}
+    if "lco" in cfg.stages:
+        skipped["lco"] = ("stage 'lco': the RFA of Q(ik) is linear (no LCO); it needs "
+                          "records of a nonlinear model or a truth simulator")
+    for text in skipped.values():
+        log.info("skipped %s", text)
+    return settings, skipped
+
+
+def _pk_modes(gaf: GAFProblem, U_lo: float) -> tuple[int, ...]:
+    """The modes p–k can follow from ``U_lo``: in-vacuo reduced frequency ``omega b / U_lo``
+    within 0.8 of the table's largest ``k`` (the iteration must stay inside the table)."""
+    k_vac = gaf.structure.omega * gaf.table.b / U_lo
+    modes = tuple(int(i) for i in np.flatnonzero(k_vac <= 0.8 * gaf.table.k[-1]))
+    return modes or (0,)
+
+
+def _run_gaf(cfg: RunConfig, gaf: GAFProblem, settings: RFASettings, structure, prog,
+             out: dict) -> None:
+    """Stages of a GAF wing file (module docstring): RFA, flutter in m/s with p–k, frozen Σf
+    and ΣAE(V), and the controller stage on it."""
+    U_lo, U_hi = gaf.U_range
+    with prog.stage("rfa"):
+        rfa = fit_rfa(gaf.table, settings)
+        rsys = RFASystem(rfa, structure, gaf.U_ref)
+    prog.note(f"{rfa.summary()}")
+    with prog.stage("flutter"):
+        fl_U = find_flutter(rsys, (U_lo, U_hi), n_grid=gaf.n_grid,
+                            max_refine=cfg.flutter.max_refine)
+        pk = pk_flutter(gaf.table, structure, np.linspace(U_lo, U_hi, 29),
+                        modes=_pk_modes(gaf, U_lo))
+    prog.note(f"RFA ΣAE(U): Uf = {fl_U.Vf if fl_U.Vf is not None else float('nan'):.4f} m/s, "
+              f"{fl_U.omega_f if fl_U.omega_f is not None else float('nan'):.4f} rad/s; p–k: "
+              f"{pk.flutter_speed if pk.found else float('nan'):.4f} m/s")
+    if fl_U.Vf is None:
+        raise CasflutterError(f"the RFA system of {gaf.name!r} has no flutter crossing in "
+                              f"U ∈ [{U_lo:g}, {U_hi:g}] m/s: {fl_U.message}; widen "
+                              "gaf.U_range")
+    out.update(rfa=rfa, rfa_system=rsys, rfa_flutter=fl_U, pk=pk)
+    if settings.poly_order != 0:   # no proper Σf: the flutter route ends here
+        out.update(system=None, flutter=None)
+        return
+    Vf = float(fl_U.Vf) / gaf.U_ref
+    with prog.stage("realize"):
+        sigma_f = rsys.frozen_sigma_f(float(fl_U.Vf))
+    with prog.stage("structure"):
+        system = AeroelasticSystem.from_parts(sigma_f, structure, warn_unstable=False)
+        flutter = find_flutter(system, cfg.flutter.V_range, n_grid=cfg.flutter.n_grid,
+                               max_refine=cfg.flutter.max_refine)
+    if flutter.Vf is None or abs(flutter.Vf / Vf - 1) > 1e-3:
+        prog.note(f"warning: ΣAE(V) of Σf frozen at Uf flutters at V = {flutter.Vf} in "
+                  f"{cfg.flutter.V_range}, not at Uf / U_ref = {Vf:.6g}; the LFT is built at "
+                  "Uf / U_ref, where the frozen system is exact")
+    out.update(system=system, flutter=flutter, gaf_Vf=Vf)
+
+
+def _wing_setup(cfg: RunConfig, wing: WingProblem) -> tuple[RunConfig, dict]:
+    """A wing file's configuration (``data.V0`` the records' speed) and the truth-only stages
+    it skips, ``{stage: reason}``; checked before any work."""
+    if cfg.rom.v0_iterations > 1:
+        raise ConfigError(f"rom.v0_iterations = {cfg.rom.v0_iterations}: the records of the "
+                          f"wing file {wing.path} are taken at one speed (V0 = {wing.V0:g}); "
+                          "set rom.v0_iterations = 1")
+    _same_sensors(cfg, wing)
+    why = f"needs a truth simulator; the wing file {wing.name!r} has records only"
+    wanted = {"flutter_truth"} | set(cfg.stages) | ({"truth_lco"} if "lco" in cfg.stages
+                                                     else set())
+    skipped = {k: f"{v}: {why}" for k, v in _TRUTH_ONLY.items() if k in wanted}
+    for text in skipped.values():
+        log.info("skipped %s", text)
+    return replace(cfg, data=replace(cfg.data, V0=float(wing.V0))), skipped
 
 
 def _mode(res: FlutterResult) -> int:
@@ -114,7 +235,7 @@ def _identify(data, cfg: RunConfig):
 
 
 def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int | None = None,
-        quiet: bool = False, write: bool = True) -> RunResult:
+        quiet: bool = False, write: bool = True, overwrite: bool = False) -> RunResult:
     """Run the stages of a configuration (module docstring) and write its outputs.
 
     Parameters
@@ -122,13 +243,17 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
     config : RunConfig, path or None
         Configuration (default: the seed wing's ``problems/seed_wing/run.toml``).
     out_dir : path, optional
-        Output folder (default ``casflutter-run``).
+        Output folder (default ``casflutter-run``), checked before any work and written
+        atomically with its ``manifest.json`` (:mod:`casflutter.pipeline._exports`).
     seed : int, optional
         Overrides ``config.seed``.
     quiet : bool
         No progress on stderr.
     write : bool
-        Write files (summary, figures, report, ROM, controller).
+        Write files (summary, figures, report, ROM, controller and plant, manifest).
+    overwrite : bool
+        Replace an existing non-empty output folder (as a whole); without it such a folder
+        is refused before any work.
 
     Returns
     -------
@@ -138,36 +263,77 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
     ------
     ConfigError
         An invalid configuration (before any work).
+    OutputError
+        An output folder that cannot be written, or exists and is not empty without
+        ``overwrite`` (before any work).
     CasflutterError
         No ROM flutter in ``flutter.V_range`` when a later stage needs it (or no truth
         flutter for the closed-loop stage), or a simulation that blew up.
     casflutter.errors.SynthesisError
         No synthesis start stabilised the design plants.
 
+    See Also
+    --------
+    load_config : the configuration it runs.
+
     Examples
     --------
-    >>> import casflutter as cf                                  # doctest: +SKIP
-    >>> result = cf.run(cf.load_config(), write=False)           # doctest: +SKIP
-    >>> result.flutter.Vf, result.verification.exact_V           # doctest: +SKIP
+    The typical section's flutter route (records, linear ROM, Σf, flutter) without writing files:
+
+    >>> import casflutter as cf
+    >>> from casflutter.pipeline import config_path
+    >>> config = cf.load_config(config_path("typical_section", "flutter"), updates={"stages": []})
+    >>> result = cf.run(config, write=False, quiet=True)
+    >>> round(result.flutter.Vf, 4)
+    2.2589
+
+    The paper's study on the seed wing (about a minute): ``cf.run(cf.load_config())``.
     """
     cfg = config if isinstance(config, RunConfig) else load_config(config)
     if seed is not None:
         cfg = replace(cfg, seed=int(seed))
-    prog = _Progress(quiet, _stage_names(cfg))
-    truth = cfg.problem.load()
-    structure = truth.modal_structure().with_sensors(cfg.sensors.rows or None, cfg.sensors.kind)
+    target = check_output_folder(out_dir, overwrite=overwrite) if write else None
+    info = {**provenance(seed=cfg.seed), "started": utc_now()}
+    problem = cfg.problem.load()
+    truth = problem if isinstance(problem, AeroelasticTruth) else None
+    skipped: dict = {}
+    if isinstance(problem, WingProblem):
+        cfg, skipped = _wing_setup(cfg, problem)
+    elif isinstance(problem, GAFProblem):
+        rfa_settings, skipped = _gaf_setup(cfg, problem)
+    elif truth is None:
+        raise ConfigError(f"problem.name = {cfg.problem.name!r} is a {type(problem).__name__}, "
+                          "which casflutter.pipeline.run does not take; give a truth problem "
+                          "or a wing file (kind = \"wing\")")
+    names = _stage_names(cfg, skipped)
+    if isinstance(problem, GAFProblem):
+        names = ["rfa", "flutter", "realize", "structure"] + names[5:]
+    prog = _Progress(quiet, names)
+    for text in skipped.values():
+        prog.note(f"skipped {text}")
+    structure = problem.modal_structure().with_sensors(cfg.sensors.rows or None,
+                                                       cfg.sensors.kind)
     rows = cfg.sensors.rows or None
     records = settings_as(cfg.data, RecordSettings)
     vr = cfg.flutter.V_range
     flutter_kw = dict(n_grid=cfg.flutter.n_grid, max_refine=cfg.flutter.max_refine)
     needs_vf = cfg.rom.v0_iterations > 1 or bool(set(cfg.stages) & {"lco", "controller"})
-    out: dict = {"config": cfg, "truth": truth}
+    out: dict = {"config": cfg, "truth": truth, "problem": problem, "skipped": skipped}
+    if isinstance(problem, GAFProblem):
+        _run_gaf(cfg, problem, rfa_settings, structure, prog, out)
+        Vf = out.pop("gaf_Vf", None)
+        out.update(data=None, identification=None, identification_history=(), fit=None,
+                   realization=None, flutter_truth=None)
+        if "controller" in cfg.stages and "controller" not in skipped:
+            _controller_stages(cfg, out["system"], Vf, prog, out)
+        return _finish(out, prog, target, write, overwrite, info)
 
     # 1-5: records, ROM, Σf, ΣAE, flutter; repeated at the ROM's own flutter speed
     V0, history = cfg.data.V0, []
     for it in range(cfg.rom.v0_iterations):
         with prog.stage("data"):
-            data = truth_records(truth, records, V0=V0)
+            data = (truth_records(truth, records, V0=V0) if truth is not None
+                    else problem.records)
         with prog.stage("rom"):
             ident, model = _identify(data, cfg)
         with prog.stage("realize"):
@@ -182,7 +348,8 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
             last = (it == cfg.rom.v0_iterations - 1 or Vf is None
                     or abs(Vf - V0) <= cfg.rom.v0_rtol * Vf)
             if last:
-                flutter_truth = find_flutter(truth, vr, **flutter_kw)
+                flutter_truth = (find_flutter(truth, vr, **flutter_kw) if truth is not None
+                                 else None)
             if Vf is None and needs_vf:
                 raise CasflutterError(f"the ROM identified at V0 = {V0:.4g} has no flutter "
                                       f"crossing in V ∈ {vr}: {flutter.message}; widen "
@@ -195,16 +362,16 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
            else fit_report(model, data, "simulation"))
     prog.note(f"{model}; fit error % " + ", ".join(f"{e:.3f}" for e in fit.error_percent))
     prog.note(f"ROM Vf = {Vf if Vf is not None else float('nan'):.4f}; truth Vf = "
-              f"{flutter_truth.Vf if flutter_truth.flutter else float('nan'):.4f}")
+              f"{flutter_truth.Vf if flutter_truth and flutter_truth.flutter else float('nan'):.4f}")
     out.update(data=data, identification=ident, identification_history=tuple(history),
                fit=fit, realization=real, system=system, flutter=flutter,
                flutter_truth=flutter_truth)
     crit = _mode(flutter)
 
-    if "frozen" in cfg.stages:
+    if "frozen" in cfg.stages and "frozen" not in skipped:
         with prog.stage("frozen"):
             out["flutter_frozen"] = find_flutter(frozen_aero_truth(truth, V0), vr, **flutter_kw)
-    if "parametric" in cfg.stages:
+    if "parametric" in cfg.stages and "parametric" not in skipped:
         with prog.stage("parametric"):
             speeds = speed_nodes(vr, cfg.parametric.n_speeds)
             prom = ParametricROM(speeds, tuple(
@@ -217,33 +384,12 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
         with prog.stage("lco"):
             out["lco"] = _lco(cfg, truth, model, structure, flutter, flutter_truth, prog)
     if "controller" in cfg.stages:
-        with prog.stage("lft"):
-            lft = build_lft(system, Vf)
-        with prog.stage("controller"):
-            c = cfg.controller
-            options = replace(settings_as(c, SynthesisOptions),
-                              ipopt={**cfg.solver.ipopt, **c.ipopt})
-            # γ of the LFT at Vf (eq. 14-16), each design plant with its own loop shift, and
-            # ΣAE(V) kept stable over controller.interval; K acts on the physical sensors
-            design = design_flutter_controller(
-                system, Vf, c.order, speeds=tuple(c.speeds), interval=tuple(c.interval),
-                n_speeds=c.n_speeds, decay=c.interval_decay, steps=c.steps, starts=c.starts,
-                seed=cfg.seed, options=options)
-            syn, K = design.synthesis, design.controller
-        with prog.stage("verify"):
-            ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
-            if cfg.verify.sweep:
-                lo, hi = cfg.verify.sweep
-                out["rom_sweep"] = speed_sweep(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf,
-                                               n_delta=lft.n_delta,
-                                               V=np.linspace(lo * Vf, hi * Vf,
-                                                             cfg.verify.n_sweep))
-        out.update(lft=lft, synthesis=syn, controller=K, verification=ver)
-    if "closed_loop" in cfg.stages:
+        _controller_stages(cfg, system, Vf, prog, out)
+    if "closed_loop" in cfg.stages and "closed_loop" not in skipped:
         with prog.stage("closed_loop"):
             out["closed_loop"] = _closed_loop(cfg, truth, model, system, out["lft"],
                                               out["controller"], flutter, flutter_truth, rows)
-    if "suppression" in cfg.stages:
+    if "suppression" in cfg.stages and "suppression" not in skipped:
         with prog.stage("suppression"):
             # the truth flutters at its own speed: suppress its LCO there (paper Fig. 11 was
             # measured on the real wing at an LCO condition)
@@ -263,12 +409,45 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
                 truth, out["controller"], float(V_ref), cfg.suppression, dt=model.dt,
                 mode=crit, deflection=cfg.lco.initial_deflection, sensor_rows=rows,
                 sensor=cfg.sensors.kind, x0=x0)
+    return _finish(out, prog, target, write, overwrite, info)
+
+
+def _controller_stages(cfg: RunConfig, system, Vf: float, prog, out: dict) -> None:
+    """The LFT at Vf (eq. 10-15), the fixed-order synthesis (§III.C) and the verification."""
+    with prog.stage("lft"):
+        lft = build_lft(system, Vf)
+    with prog.stage("controller"):
+        c = cfg.controller
+        options = replace(settings_as(c, SynthesisOptions),
+                          ipopt={**cfg.solver.ipopt, **c.ipopt})
+        # γ of the LFT at Vf (eq. 14-16), each design plant with its own loop shift, and
+        # ΣAE(V) kept stable over controller.interval; K acts on the physical sensors
+        design = design_flutter_controller(
+            system, Vf, c.order, speeds=tuple(c.speeds), interval=tuple(c.interval),
+            n_speeds=c.n_speeds, decay=c.interval_decay, steps=c.steps, starts=c.starts,
+            seed=cfg.seed, options=options)
+        syn, K = design.synthesis, design.controller
+    with prog.stage("verify"):
+        ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
+        if cfg.verify.sweep:
+            lo, hi = cfg.verify.sweep
+            out["rom_sweep"] = speed_sweep(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf,
+                                           n_delta=lft.n_delta,
+                                           V=np.linspace(lo * Vf, hi * Vf, cfg.verify.n_sweep))
+    out.update(lft=lft, synthesis=syn, controller=K, verification=ver)
+
+
+def _finish(out: dict, prog, target: Path | None, write: bool, overwrite: bool,
+            info: dict) -> RunResult:
+    """The result with its timings and provenance, and its files (written atomically into
+    ``target``) when ``write``."""
     timings = dict(prog.timings)
     timings["total"] = time.perf_counter() - prog.t0
-    result = RunResult(**out, timings=timings)
+    result = RunResult(**out, timings=timings, provenance=info)
+    log_flags(result)
     if write:
-        target = Path(out_dir or "casflutter-run")
-        result = replace(result, out_dir=target, files=_write_outputs(target, result))
+        result = replace(result, out_dir=target,
+                         files=write_outputs(target, result, overwrite=overwrite))
     return result
 
 
@@ -291,10 +470,12 @@ def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth, prog) 
     crit = _mode(flutter)
     sim = simulate_loop(model, structure, V_lco, int(round(lc.duration / model.dt)),
                         xs0=structure.displaced_state(crit, lc.initial_deflection))
-    V_truth = (float(flutter_truth.Vf) * lc.speed_factor if flutter_truth.flutter is not None
-               else V_lco)
-    tr = truth_lco(truth, V_truth, lc.duration, crit, lc.initial_deflection, dt=model.dt,
-                   sensor_rows=structure.Hs, sensor=structure.sensor)
+    tr = None
+    if truth is not None:
+        V_truth = (float(flutter_truth.Vf) * lc.speed_factor
+                   if flutter_truth.flutter is not None else V_lco)
+        tr = truth_lco(truth, V_truth, lc.duration, crit, lc.initial_deflection, dt=model.dt,
+                       sensor_rows=structure.Hs, sensor=structure.sensor)
     prog.note(f"ROM LCO at V = {V_lco:.4f} (exact-order Hopf {V_hopf:.4f}): "
               f"{sim.sensors.kind}, {sim.sensors.frequency_hz:.3f} Hz")
     return LcoResult(rom=sim, truth=tr, V=V_lco, V_hopf_exact_order=V_hopf,
@@ -348,33 +529,3 @@ def _closed_loop(cfg: RunConfig, truth, model, system, lft, K, flutter, flutter_
                                 spectral_abscissa(A_cl))
     return ClosedLoopChecks(truth_sweep=sweep, rom_simulation=rom_sim,
                             truth_simulation=truth_sim)
-
-
-def _write_outputs(out: Path, result: RunResult) -> dict:
-    """``summary.json``, ``rom.npz``, the controller (JSON and .mat), ``config.json``, the
-    figures and ``report.html``."""
-    out.mkdir(parents=True, exist_ok=True)
-    files = {}
-    summary = result.summary()
-    tmp = out / "summary.json.tmp"
-    with open(tmp, "w") as fh:
-        json.dump(summary, fh, indent=2)
-    tmp.replace(out / "summary.json")
-    files["summary"] = out / "summary.json"
-    result.identification.model.save(out / "rom.npz")
-    files["rom"] = out / "rom.npz"
-    K = result.controller
-    if K is not None:
-        with open(out / "controller.json", "w") as fh:
-            json.dump(controller_to_json(K), fh, indent=2)
-        files["controller_json"] = out / "controller.json"
-        savemat(out / "controller.mat", {"A": np.asarray(K.A), "B": np.asarray(K.B),
-                                          "C": np.asarray(K.C), "D": np.asarray(K.D)})
-        files["controller_mat"] = out / "controller.mat"
-    with open(out / "config.json", "w") as fh:
-        json.dump(_jsonable(result.config.to_dict()), fh, indent=2)
-    files["config"] = out / "config.json"
-    figs = write_figures(out, result)
-    files.update(figs)
-    files["report"] = write_html(out, summary, figs)
-    return files

@@ -125,6 +125,20 @@ def canonical_realization(model) -> control.StateSpace:
     DimensionError
         If the model has no lag (``max_lag = 0``): a static map needs no states; use its
         ``Bbar_0`` directly.
+
+    See Also
+    --------
+    realize : the balanced (ERA) realisation and Σf.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section")
+    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
+    >>> rom = cf.identify_common_denominator(data).model
+    >>> sys_d = cf.canonical_realization(rom)
+    >>> sys_d.dt, sys_d.ninputs, sys_d.noutputs
+    (0.1, 3, 2)
     """
     Abar, Bbar = lag_coefficients(model)
     L = Abar.shape[0] - 1

@@ -8,7 +8,9 @@ denominator (:func:`casflutter.ident.identify_common_denominator`) have the same
 their coefficients — the denominator ``a_m`` and the input matrices, the latter multiplied by
 ``V^2`` so that the interpolated quantity is the dimensional force operator, free of the
 ``1/V^2`` of the apparent mass — are interpolated in V by the barycentric polynomial through
-the nodes.  The interpolated model is realised by the block observer-canonical form
+the nodes (second barycentric form with weights computed in a fixed order, so that the same
+ROMs give the same bits in every process: scipy's interpolator permutes the nodes at random
+when it computes the weights).  The interpolated model is realised by the block observer-canonical form
 (:func:`casflutter.realize.canonical_matrices`), a fixed-dimension realisation that is a
 continuous function of the coefficients, and the inverse Tustin transform; ΣAE(V)
 (:class:`casflutter.aeroelastic.ParametricSystem`) then has continuous eigenvalues and
@@ -21,7 +23,6 @@ from dataclasses import dataclass, field
 
 import control
 import numpy as np
-from scipy.interpolate import BarycentricInterpolator
 
 from ..errors import ConfigError
 from ..ident import CommonDenominatorResult, HWLModel
@@ -51,6 +52,30 @@ def speed_nodes(V_range, n: int) -> np.ndarray:
     lo, hi = map(float, V_range)
     x = np.cos(np.pi * np.arange(n)[::-1] / (n - 1))
     return lo + 0.5 * (hi - lo) * (x + 1.0)
+
+
+class _Barycentric:
+    """The polynomial through ``(x_j, y_j)`` (rows of ``y``), second barycentric form.
+
+    The weights ``w_j = 1 / prod_{k != j} (x_j - x_k)`` are formed with the differences
+    scaled by the capacity of the interval (``(max - min) / 4``), which keeps the products
+    near one, in a fixed order; evaluation sums with numpy's (deterministic) reductions.
+    """
+
+    def __init__(self, x, y):
+        self.x = np.asarray(x, dtype=float)
+        self.y = np.asarray(y, dtype=float)
+        d = (self.x[:, None] - self.x[None, :]) * (4.0 / (self.x[-1] - self.x[0]))
+        np.fill_diagonal(d, 1.0)
+        self.w = 1.0 / np.prod(d, axis=1)
+
+    def __call__(self, t: float) -> np.ndarray:
+        diff = float(t) - self.x
+        hit = np.flatnonzero(diff == 0.0)
+        if hit.size:
+            return self.y[hit[0]].copy()
+        c = self.w / diff
+        return np.sum(c.reshape((-1,) + (1,) * (self.y.ndim - 1)) * self.y, axis=0) / np.sum(c)
 
 
 @dataclass(frozen=True)
@@ -92,8 +117,7 @@ class ParametricROM:
         object.__setattr__(self, "identifications", ids)
         # interpolate a_m, and V^2 times the input coefficients (dimensional forces)
         th_scaled = theta * V[:, None] ** 2
-        object.__setattr__(self, "_interp", (BarycentricInterpolator(V, a),
-                                             BarycentricInterpolator(V, th_scaled)))
+        object.__setattr__(self, "_interp", (_Barycentric(V, a), _Barycentric(V, th_scaled)))
 
     @property
     def template(self) -> HWLModel:

@@ -43,8 +43,8 @@ def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflu
     lco, sup = s.get("lco") or {}, s.get("suppression") or {}
     ours = {
         "nominal speed index V0": s.get("V0"),
-        "number of modes N": len(s.get("fit_error_percent", [])),
-        "(mu, na, nb, r, p, q)": tuple(s.get("orders", [])),
+        "number of modes N": s.get("ns", 0) // 2,
+        "(mu, na, nb, r, p, q)": tuple(s.get("orders") or []),
         "order of Σf nf": s.get("nf"),
         "order of Σs": s.get("ns"),
         "order of ΣAE": s.get("nae"),
@@ -67,7 +67,7 @@ def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflu
     rows = "\n".join(f"<tr><td>{html.escape(k)}</td><td>{_fmt(ours.get(k))}</td>"
                      f"<td>{_fmt(truth.get(k))}</td>"
                      f"<td>{html.escape(v)}</td></tr>" for k, v in PAPER_TABLE_I.items())
-    fit = ", ".join(f"{e:.3f}" for e in s.get("fit_error_percent", []))
+    fit = ", ".join(f"{e:.3f}" for e in s.get("fit_error_percent") or [])
     imgs = []
     for name, path in figures.items():
         data = base64.b64encode(Path(path).read_bytes()).decode("ascii")

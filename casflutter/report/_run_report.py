@@ -82,17 +82,28 @@ def write_figures(out: Path, result) -> dict:
         Figure name -> path.
     """
     out = Path(out)
-    model = result.identification.model
     files = {}
+    if result.identification is None:   # a GAF wing file: no records, ROM or ERA
+        if result.rfa_flutter is not None:
+            fl = result.rfa_flutter     # the structural branches, not the lag roots
+            modes = [b for b in fl.tracking.upper_branches() if fl.origin[b] >= 0]
+            fig = plot_vg_vf(fl, branches=modes, hz=False)
+            fig.axes[-1].set_xlabel("airspeed U [m/s]")
+            files["vg_vf_airspeed"] = _save(fig, out / "vg_vf_airspeed.png")
+        if result.flutter is not None:
+            files["vg_vf"] = _save(plot_vg_vf(result.flutter), out / "vg_vf.png")
+        return files
+    model = result.identification.model
     files["fig7_rom_fit"] = _save(plot_rom_fit(model, result.data), out / "fig7_rom_fit.png")
     real = result.realization
     files["hankel"] = _save(plot_hankel(real.hankel_singular_values, real.order),
                             out / "hankel_singular_values.png")
-    fp = flap_pulse_comparison(result.truth, model, result.system.structure,
-                               result.config.data.V0, dt=model.dt)
-    files["fig8_flap_pulses"] = _save(plot_flap_pulses(fp["timepts"], fp["truth_zm"],
-                                                       fp["rom_zm"], fp["v"]),
-                                      out / "fig8_flap_pulses.png")
+    if result.truth is not None:   # a wing file has no truth to compare with
+        fp = flap_pulse_comparison(result.truth, model, result.system.structure,
+                                   result.config.data.V0, dt=model.dt)
+        files["fig8_flap_pulses"] = _save(plot_flap_pulses(fp["timepts"], fp["truth_zm"],
+                                                           fp["rom_zm"], fp["v"]),
+                                          out / "fig8_flap_pulses.png")
     if result.lco is not None:
         files["fig9_lco"] = _save(plot_lco(result.lco.rom, truth=result.lco.truth),
                                   out / "fig9_lco.png")

@@ -132,6 +132,11 @@ class ModalStructure:
     speed_index : str
         The convention of the speed index ``V``.
 
+    Attributes
+    ----------
+    n_modes : int
+        Number of modes ``N`` (from ``omega``).
+
     Raises
     ------
     DimensionError

@@ -226,8 +226,9 @@ def _run_point(params: Mapping[str, Any], settings: Mapping[str, Any]):
     _, own, _ = _split(params, settings)
     out_dir = own.get("out_dir")
     write = out_dir is not None
+    # a point computed again (a resumed sweep whose store missed its line) replaces its folder
     return run(cfg, out_dir=Path(str(out_dir)) / _point_dir(params) if write else None,
-               quiet=bool(own.get("quiet", True)), write=write)
+               quiet=bool(own.get("quiet", True)), write=write, overwrite=True)
 
 
 def _rom_flutter_settings(settings: Mapping[str, Any]) -> dict:

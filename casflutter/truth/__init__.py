@@ -15,6 +15,8 @@ own linear state space in the speed index ``V`` gives the true flutter speed.
 - :class:`PitchPlungeSection` -- a dimensional pitch--plunge rig section read from a TOML
   file (``kind = "pitch_plunge"``; Wagner or quasi-steady aerodynamics, polynomial pitch
   spring, flap), e.g. the Texas A&M NATA section in ``problems/nata``.
+- :class:`WingProblem`, :class:`GAFProblem` -- a user's wing without a simulator, read from a
+  wing file: modal data with records (``kind = "wing"``) or with ``Q(ik)`` (``kind = "gaf"``).
 - :func:`load_problem` -- a problem by name or file, with parameter changes.
 - :func:`truth_records` -- chirp records of a truth (the paper's CFD runs, §IV.A).
 - :func:`truth_lco`, :func:`closed_loop_truth`, :func:`suppression_run`,
@@ -40,13 +42,14 @@ from ._registry import (PROBLEMS, file_problem_names, load_problem, load_problem
 from ._seed_wing import (SEED_FREQUENCIES_HZ, SEED_MODE_NAMES, SEED_SENSOR_ROWS, SEED_U_REF,
                          SeedWing, SeedWingParams)
 from ._typical_section import TypicalSection, TypicalSectionParams
+from ._wing_file import GAFProblem, WingProblem
 
 __all__ = [
     "AeroelasticTruth", "AeroMatrices", "SimulationResult",
     "TypicalSection", "TypicalSectionParams", "GolandWing", "GolandParams",
     "SeedWing", "SeedWingParams", "SEED_FREQUENCIES_HZ", "SEED_MODE_NAMES", "SEED_SENSOR_ROWS",
     "SEED_U_REF",
-    "PitchPlungeSection", "PitchPlungeParams", "FlapCoefficients",
+    "PitchPlungeSection", "PitchPlungeParams", "FlapCoefficients", "WingProblem", "GAFProblem",
     "PROBLEMS", "problem_names", "file_problem_names", "load_problem", "load_problem_file",
     "problem_definition", "problem_label", "parse_sets",
     "RecordSettings", "truth_records", "frozen_aero_truth",

@@ -147,6 +147,23 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     ------
     ConfigError
         An unknown ``sensor`` or a non-positive limit.
+
+    See Also
+    --------
+    suppression_run : the paper's gain ramp and release (Fig. 11) on the truth.
+
+    Examples
+    --------
+    >>> import control
+    >>> import numpy as np
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section")
+    >>> K = control.ss([], [], [], [[0.0, 0.0]])
+    >>> t = np.arange(0.0, 50.0, 0.1)
+    >>> sim = cf.closed_loop_truth(truth, K, 1.5, t, truth.displaced_state(1, 0.01),
+    ...                            lambda t: 1.0, sensor="displacement")
+    >>> sim.zm.shape
+    (500, 2)
     """
     if sensor not in ("acceleration", "displacement"):
         raise ConfigError(f"sensor={sensor!r}: use 'acceleration' or 'displacement'")
@@ -344,6 +361,22 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
     ------
     CasflutterError
         The closed-loop simulation blew up.
+
+    See Also
+    --------
+    closed_loop_truth : the closed-loop simulation it runs.
+    truth_lco : the established LCO it starts from.
+
+    Examples
+    --------
+    A controller ``K`` from :func:`synthesize` (through :meth:`AeroelasticLFT.physical_controller`)
+    on the seed wing, started from the truth's converged LCO at 1.05 times the flutter speed
+    (a run of a minute; :func:`run` does the same from a configuration):
+
+    >>> lco = cf.truth_lco(truth, 1.05 * Vf, 20.0, mode=1, deflection=0.01, dt=0.002)  # doctest: +SKIP
+    >>> sup = cf.suppression_run(truth, K, Vf, dt=0.002, mode=1, deflection=0.01,
+    ...                          x0=lco.final_state)                        # doctest: +SKIP
+    >>> sup.attenuation_percent, sup.lco_returns                           # doctest: +SKIP
     """
     sp = settings or SuppressionSettings()
     V = V_flutter * sp.speed_factor

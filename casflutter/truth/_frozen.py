@@ -36,6 +36,18 @@ def frozen_aero_truth(truth, V0: float):
     AeroelasticTruth
         Same class and parameters; ``aero_matrices(V)`` is ``aero_matrices(V0)`` with every
         force matrix times ``(V / V0)^2`` and the lag rates of ``V0``.
+
+    See Also
+    --------
+    find_flutter : the flutter speed of the truth and of its frozen copy.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section")
+    >>> frozen = cf.frozen_aero_truth(truth, 1.8)
+    >>> round(cf.find_flutter(truth, (0.5, 3.0)).Vf, 3), round(cf.find_flutter(frozen, (0.5, 3.0)).Vf, 3)
+    (2.17, 2.259)
     """
     base = type(truth)
     V0 = float(V0)

@@ -200,11 +200,33 @@ class GolandWing(AeroelasticTruth):
 
     # conventions --------------------------------------------------------------------
     def speed_index(self, U: float) -> float:
-        """Speed index ``V = U / (b omega_ref)`` for an airspeed ``U`` [m/s]."""
+        """Speed index ``V = U / (b omega_ref)`` for an airspeed ``U`` [m/s].
+
+        Parameters
+        ----------
+        U : float
+            Airspeed [m/s].
+
+        Returns
+        -------
+        float
+            Speed index.
+        """
         return float(U) / (self.params.b * self.params.omega_ref)
 
     def airspeed(self, V: float) -> float:
-        """Airspeed ``U = V b omega_ref`` [m/s] for a speed index ``V``."""
+        """Airspeed ``U = V b omega_ref`` [m/s] for a speed index ``V``.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        float
+            Airspeed [m/s].
+        """
         return float(V) * self.params.b * self.params.omega_ref
 
     @property
@@ -225,7 +247,19 @@ class GolandWing(AeroelasticTruth):
         return M / mL, K / mL
 
     def aero_matrices(self, V: float) -> AeroMatrices:
-        """Strip-theory Jones/Wagner operator at speed index ``V`` (module docstring)."""
+        """Strip-theory Jones/Wagner operator at speed index ``V`` (module docstring).
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        AeroMatrices
+            The state-space operator from modal motion to generalised forces (see
+            :meth:`AeroelasticTruth.aero_matrices`).
+        """
         p = self.params
         V = self._check_V(V)
         U = self.airspeed(V)

@@ -85,6 +85,18 @@ def truth_lco(truth, V: float, duration: float, mode: int, deflection: float, *,
     Returns
     -------
     TruthLco
+
+    See Also
+    --------
+    lco_branch : the whole LCO branch by continuation.
+    analyze_response : the classification of the response.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section", ["kappa2=3"])
+    >>> cf.truth_lco(truth, 2.4, 400.0, mode=1, deflection=0.05, dt=0.1).kind
+    'lco'
     """
     motion = {"acceleration": "uddot", "velocity": "udot", "displacement": "u"}
     if sensor not in motion:

@@ -81,8 +81,10 @@ class RecordSettings:
         if isinstance(d, bool) or not isinstance(d, int) or d < 0:
             raise ConfigError(f"coupling_delay = {d!r}: must be an integer >= 0")
         if d >= self.n_samples:
-            raise ConfigError(f"coupling_delay = {d} is not shorter than the record "
-                              f"({self.n_samples} samples)")
+            raise ConfigError(f"coupling_delay = {d}: must be an integer from 0 to "
+                              f"{self.n_samples - 1} samples (shorter than the record: "
+                              f"duration / dt = {self.n_samples} samples); it counts steps "
+                              "of dt, not seconds")
 
     @property
     def n_samples(self) -> int:
@@ -117,6 +119,19 @@ def truth_records(truth, settings: RecordSettings | None = None, **changes) -> I
     ------
     ConfigError
         An invalid setting (named), e.g. a band above the Nyquist frequency.
+
+    See Also
+    --------
+    identify : the HWL ROM from such records.
+    identify_common_denominator : the linear ROM from such records.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section")
+    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
+    >>> len(data.records), data.n_modes, data.has_v
+    (3, 2, True)
     """
     s = replace(settings or RecordSettings(), **changes) if changes else (
         settings or RecordSettings())

@@ -2,8 +2,10 @@
 
 A problem is named by one of :data:`PROBLEMS` (a built-in truth class with published
 defaults), by a TOML file describing a rig section (``kind = "pitch_plunge"``, see
-:mod:`._pitch_plunge`), or by the name of a folder of ``problems/`` whose ``problem.toml`` is
-such a file (e.g. ``nata``).
+:mod:`._pitch_plunge`) or a user's wing without a simulator (``kind = "wing"``: modal data and
+records; ``kind = "gaf"``: modal data and ``Q(ik)``; see :mod:`._wing_file`), or by the name
+of a folder of ``problems/`` whose ``problem.toml`` is such a file (e.g. ``nata``,
+``example_wing``, ``goland_gaf``).
 """
 
 from __future__ import annotations
@@ -19,8 +21,9 @@ from ._goland import GolandWing
 from ._pitch_plunge import PITCH_PLUNGE_KIND, PitchPlungeSection
 from ._seed_wing import SeedWing
 from ._typical_section import TypicalSection
+from ._wing_file import GAF_KIND, WING_KIND, GAFProblem, WingProblem
 
-__all__ = ["PROBLEMS", "FILE_KINDS", "problem_names", "file_problem_names", "load_problem",
+__all__ = ["PROBLEMS", "FILE_KINDS", "WING_KINDS", "problem_names", "file_problem_names", "load_problem",
            "load_problem_file", "problem_definition", "problem_label"]
 
 #: name -> truth class
@@ -31,7 +34,10 @@ PROBLEMS: dict[str, type[AeroelasticTruth]] = {
 }
 
 #: ``kind`` of a problem file -> truth class reading it
-FILE_KINDS: dict[str, type[AeroelasticTruth]] = {PITCH_PLUNGE_KIND: PitchPlungeSection}
+FILE_KINDS: dict[str, type] = {PITCH_PLUNGE_KIND: PitchPlungeSection}
+
+#: ``kind`` of a wing file (no truth simulator) -> the class reading it
+WING_KINDS: dict[str, type] = {WING_KIND: WingProblem, GAF_KIND: GAFProblem}
 
 
 def problem_names() -> list[str]:
@@ -41,6 +47,16 @@ def problem_names() -> list[str]:
     -------
     list of str
         The names :func:`load_problem` accepts besides a problem file's path.
+
+    See Also
+    --------
+    load_problem : a problem's truth, with parameter changes.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> sorted(cf.problem_names())
+    ['goland', 'seed_wing', 'typical_section']
     """
     return list(PROBLEMS)
 
@@ -56,7 +72,7 @@ def file_problem_names() -> list[str]:
         if path.parent.name in PROBLEMS:
             continue
         try:
-            if read_toml(path, "problem definition").get("kind") in FILE_KINDS:
+            if read_toml(path, "problem definition").get("kind") in (*FILE_KINDS, *WING_KINDS):
                 out.append(path.parent.name)
         except ConfigError:
             continue
@@ -90,8 +106,9 @@ def _cls(name: str) -> type[AeroelasticTruth]:
                           "problem TOML file (kind = \"pitch_plunge\")") from None
 
 
-def load_problem_file(path, sets=()) -> AeroelasticTruth:
-    """The truth described by a problem TOML file (``kind = "pitch_plunge"``).
+def load_problem_file(path, sets=()) -> AeroelasticTruth | WingProblem | GAFProblem:
+    """The truth described by a problem TOML file (``kind = "pitch_plunge"``), or the wing of a
+    wing file (``kind = "wing"`` or ``"gaf"``, no simulator).
 
     Parameters
     ----------
@@ -100,20 +117,29 @@ def load_problem_file(path, sets=()) -> AeroelasticTruth:
     sets : iterable of str
         ``"name=value"`` items applied to the file's values.
 
+    Returns
+    -------
+    AeroelasticTruth, WingProblem or GAFProblem
+
     Raises
     ------
     ConfigError
         Missing file, invalid TOML, unknown ``kind``, missing/unknown keys or non-physical
         values (the message names the key).
+    DataError
+        A wing file's record or ``Q(ik)`` file missing or unusable.
     """
     path = Path(path)
     data = read_toml(path, "problem file")
     kind = data.get("kind")
+    if kind in WING_KINDS:
+        return WING_KINDS[kind].from_mapping(data, sets=sets, path=path)
     if kind not in FILE_KINDS:
         raise ConfigError(f"problem file {path}: key 'kind' must be one of "
-                          f"{', '.join(map(repr, FILE_KINDS))}, got {kind!r}")
+                          f"{', '.join(map(repr, (*FILE_KINDS, *WING_KINDS)))}, got {kind!r}")
     default = path.parent.name if path.name == "problem.toml" else path.stem
-    name = dict(data.get("problem", {})).get("name", default)
+    problem = data.get("problem", {})
+    name = dict(problem if isinstance(problem, dict) else {}).get("name", default)
     return FILE_KINDS[kind].from_mapping(data, name=name, source=f"problem file {path}",
                                          sets=sets)
 
@@ -140,6 +166,18 @@ def load_problem(name: str, params: Mapping[str, Any] | Iterable[str] = ()) -> A
     ------
     ConfigError
         Unknown problem or parameter, or a non-physical value.
+
+    See Also
+    --------
+    problem_names : the built-in problems.
+    find_flutter : the flutter speed of the loaded truth.
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> truth = cf.load_problem("typical_section", ["mu=25"])
+    >>> truth.n_modes, truth.params.mu
+    (2, 25.0)
     """
     path = _file_of(name)
     if path is not None:

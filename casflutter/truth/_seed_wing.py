@@ -218,11 +218,33 @@ class SeedWing(AeroelasticTruth):
 
     # conventions --------------------------------------------------------------------
     def speed_index(self, U: float) -> float:
-        """Speed index ``V = U / U_ref`` for an airspeed ``U`` [m/s]."""
+        """Speed index ``V = U / U_ref`` for an airspeed ``U`` [m/s].
+
+        Parameters
+        ----------
+        U : float
+            Airspeed [m/s].
+
+        Returns
+        -------
+        float
+            Speed index.
+        """
         return float(U) / self.params.U_ref
 
     def airspeed(self, V: float) -> float:
-        """Airspeed ``U = V U_ref`` [m/s] for a speed index ``V``."""
+        """Airspeed ``U = V U_ref`` [m/s] for a speed index ``V``.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        float
+            Airspeed [m/s].
+        """
         return float(V) * self.params.U_ref
 
     @property
@@ -267,6 +289,17 @@ class SeedWing(AeroelasticTruth):
         """Linearised strip-theory Jones/Wagner operator at ``V`` (per unit modal mass).
 
         One downwash ``Q`` (and its two Jones lag states) per strip: ``ng = n_strips``.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        AeroMatrices
+            The state-space operator from modal motion to generalised forces (see
+            :meth:`AeroelasticTruth.aero_matrices`).
         """
         p = self.params
         V = self._check_V(V)
@@ -328,6 +361,16 @@ class SeedWing(AeroelasticTruth):
 
         Parameters
         ----------
+        timepts : ndarray, shape (K,)
+            Sample times.
+        u : ndarray, shape (K, N)
+            Modal displacements.
+        v : ndarray, shape (K,) or None
+            Flap angle [rad].
+        V : float
+            Speed index.
+        udot, uddot, vdot, vddot : ndarray, optional
+            Exact derivatives of the motion (default: finite differences).
         linear : bool
             Return the linearised forces instead (the operator of :meth:`aero_matrices`).
 
@@ -447,6 +490,18 @@ class SeedWing(AeroelasticTruth):
         outside (a controller and actuator), e.g. closed-loop suppression simulations.
 
         ``s = [u, u', z1, z2]`` is the full state of :meth:`simulate`.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+        linear : bool
+            The linearised forces instead.
+
+        Returns
+        -------
+        callable
+            ``f(s, v, vdot, vddot) -> (ds/dt, u'')``.
         """
         V = self._check_V(V)
         forces_at = self._forces(V, linear)

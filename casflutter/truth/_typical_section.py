@@ -111,11 +111,33 @@ class TypicalSection(AeroelasticTruth):
         return self.params.omega_theta ** 2 / (np.pi * self.params.mu)
 
     def airspeed_ratio(self, V: float) -> float:
-        """``U / (b omega_theta)`` is ``V`` itself for the typical section."""
+        """``U / (b omega_theta)`` is ``V`` itself for the typical section.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        float
+        """
         return float(V)
 
     def aero_matrices(self, V: float) -> AeroMatrices:
-        """Jones/Wagner aerodynamic operator at speed index ``V`` (module docstring)."""
+        """Jones/Wagner aerodynamic operator at speed index ``V`` (module docstring).
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        AeroMatrices
+            The state-space operator from modal motion to generalised forces (see
+            :meth:`AeroelasticTruth.aero_matrices`).
+        """
         p = self.params
         V = self._check_V(V)
         s = p.omega_theta

@@ -12,6 +12,14 @@ with ``nmeas = ny`` and ``ncon = nu``.
 Controller file: ``{"A", "B", "C", "D"}``; ``A``, ``B``, ``C`` may be omitted (or empty)
 for a static gain ``D``.  Matrices with a zero dimension are stored with their shape
 (``"shape_A"`` etc.) so that they round-trip.
+
+Both files may describe themselves (``casflutter run`` writes ``plant.json`` and
+``controller.json`` so): ``time_base`` ``{"domain": "continuous" | "discrete", "dt": ...,
+"time_unit": ...}``, ``inputs`` / ``outputs`` (signal names and units),
+``sign_convention``, the speeds in every unit and the verification the run found.  The
+loaders read ``time_base`` (a discrete-time system is loaded with its ``dt``, so that the
+continuous-time verification refuses it instead of misreading it) and ignore the other
+descriptive keys.
 """
 
 from __future__ import annotations
@@ -105,6 +113,26 @@ def _ss_dict(sys: control.StateSpace) -> dict:
     return out
 
 
+def _dt(d: dict, what: str):
+    """The sample time of a file's ``time_base`` (0: continuous time)."""
+    tb = d.get("time_base")
+    if tb is None:
+        return 0
+    if not isinstance(tb, dict) or tb.get("domain", "continuous") not in ("continuous",
+                                                                          "discrete"):
+        raise DataError(f"{what}: time_base = {tb!r:.80}; give {{\"domain\": \"continuous\"}} "
+                        "or {\"domain\": \"discrete\", \"dt\": SECONDS}")
+    if tb.get("domain", "continuous") == "continuous":
+        return 0
+    dt = tb.get("dt")
+    if dt is None:
+        return True            # discrete, sample time unspecified (python-control's rule)
+    if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not (math.isfinite(dt)
+                                                                          and dt > 0):
+        raise DataError(f"{what}: time_base.dt = {dt!r} must be a positive number (or null)")
+    return float(dt)
+
+
 def _ss_from(d: dict, what: str) -> control.StateSpace:
     if "D" not in d:
         raise DataError(f"{what}: key 'D' is missing (keys found: {sorted(d)})")
@@ -117,7 +145,7 @@ def _ss_from(d: dict, what: str) -> control.StateSpace:
     if A.shape != (n, n) or B.shape != (n, m) or C.shape != (p, n):
         raise DimensionError(f"{what}: inconsistent shapes A{A.shape}, B{B.shape}, "
                              f"C{C.shape}, D{D.shape}; need A (n,n), B (n,m), C (p,n), D (p,m)")
-    return control.ss(A, B, C, D)
+    return control.ss(A, B, C, D, _dt(d, what))
 
 
 def plant_to_json(P: SystemLike, nmeas: int, ncon: int, *, Vf: float | None = None,

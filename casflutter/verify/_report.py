@@ -79,7 +79,12 @@ class VerificationReport:
 
     def to_dict(self) -> dict:
         """JSON-serialisable summary; a non-finite number (the infinite γ of an unstable
-        loop, an unbounded interval end) becomes ``None`` (``null``: strict JSON)."""
+        loop, an unbounded interval end) becomes ``None`` (``null``: strict JSON).
+
+        Returns
+        -------
+        dict
+        """
         def num(x):
             if x is None:
                 return None
@@ -116,7 +121,17 @@ class VerificationReport:
         return out
 
     def format(self, max_poles: int = 8) -> str:
-        """A readable multi-line report."""
+        """A readable multi-line report.
+
+        Parameters
+        ----------
+        max_poles : int
+            Number of rightmost closed-loop poles listed.
+
+        Returns
+        -------
+        str
+        """
         def f(x):
             return f"{x:.6g}" if x is not None else "-"
 
@@ -221,6 +236,21 @@ def verify_controller(P: SystemLike, K: SystemLike, nmeas: int, ncon: int, *,
         Loop not well posed (``I - Dk D22`` singular).
     ConfigError
         ``Vf`` without ``n_delta`` (or the reverse), or a discrete-time system.
+
+    See Also
+    --------
+    speed_sweep : the closed-loop poles on a grid of speeds.
+    synthesize : the controller design it checks.
+
+    Examples
+    --------
+    >>> import control
+    >>> import casflutter as cf
+    >>> P = control.ss([[1.0]], [[1.0, 1.0]], [[1.0], [1.0]], [[0.0, 0.0], [0.0, 0.0]])
+    >>> K = control.ss([], [], [], [[-3.0]])
+    >>> rep = cf.verify_controller(P, K, nmeas=1, ncon=1)
+    >>> rep.stable, round(rep.hinf.gamma, 4)
+    (True, 0.5)
     """
     if delta_channel is not None:
         if n_delta is not None and n_delta != delta_channel:

@@ -63,6 +63,21 @@ def speed_sweep(P: SystemLike, K: SystemLike, nmeas: int, ncon: int, *, Vf: floa
     Returns
     -------
     SpeedSweep
+
+    See Also
+    --------
+    verify_controller : the exact stable interval this grid illustrates.
+
+    Examples
+    --------
+    >>> import control
+    >>> import casflutter as cf
+    >>> P = control.ss([[1.0]], [[1.0, 1.0]], [[1.0], [1.0]], [[0.0, 0.0], [0.0, 0.0]])
+    >>> import numpy as np
+    >>> K = control.ss([], [], [], [[-3.0]])
+    >>> sw = cf.speed_sweep(P, K, 1, 1, Vf=1.0, n_delta=1, V=np.linspace(0.5, 1.5, 5))
+    >>> np.round(sw.spectral_abscissa, 3)
+    array([-1.25 , -1.562, -2.   , -2.562, -3.25 ])
     """
     V = np.atleast_1d(np.asarray(V, dtype=float))
     if V.ndim != 1 or np.any(V < 0) or not np.all(np.isfinite(V)):

@@ -17,8 +17,10 @@ import os
 import matplotlib.pyplot as plt
 import numpy as np
 
+import casflutter as cf
 from casflutter.aeroelastic import RFASystem, find_flutter, pk_flutter
 from casflutter.data import GAFTable
+from casflutter.pipeline import config_path
 from casflutter.realize import fit_roger
 from casflutter.report import plot_vg_vf
 from casflutter.structure import ModalStructure
@@ -96,3 +98,23 @@ print(f"{'RFA -> ΣAE(U)':>22} {result.Vf:10.2f} {result.omega_f:16.2f}   "
 print(f"{'p–k on the same Q(ik)':>22} {pk.flutter_speed:10.2f} {pk.flutter_omega:16.2f}   "
       f"({pk.flutter_speed / ref['airspeed'] - 1:+.2%}, "
       f"{pk.flutter_omega / ref['frequency'] - 1:+.2%})")
+
+# %%
+# The same route from files, as an engineer with a NASTRAN SOL145 model would take it: the
+# wing file ``problems/goland_gaf/problem.toml`` (``kind = "gaf"``: the modal data, the tip
+# sensors, the speed scale and the RFA settings) names the table ``q_table.npz`` written once
+# by ``make_problem.py`` with the same exact-Theodorsen ``Q(ik)``.  The driver fits the RFA
+# the file asks for (six lag roots and no ``p``, ``p²`` terms, so that Σf frozen at the
+# flutter speed is exactly eq. 5 for the LFT), finds the flutter of ΣAE(U) and solves p–k
+# beside it: ``casflutter flutter problems/goland_gaf`` prints the same numbers, and
+# ``casflutter run problems/goland_gaf/run.toml`` continues with the LFT, the synthesis and
+# the verification.
+run_toml = config_path("goland_gaf", "run")
+from_file = cf.run(cf.load_config(run_toml, updates={"stages": []}), write=False, quiet=True)
+r = from_file.summary()["rfa"]
+print(f"wing file: {r['method']} RFA, {r['n_lags']} lag roots, poly_order {r['poly_order']}, "
+      f"fit error {r['fit_error']:.2e}")
+for label, b in (("RFA -> ΣAE(U)", r["flutter"]), ("p–k on the same Q(ik)", r["pk"])):
+    print(f"{label:>22} {b['airspeed_m_s']:10.2f} {b['omega_rad_s']:16.2f}   "
+          f"({b['airspeed_m_s'] / ref['airspeed'] - 1:+.2%}, "
+          f"{b['omega_rad_s'] / ref['frequency'] - 1:+.2%})")

@@ -64,9 +64,29 @@ def test_goland_speeds_in_metres_per_second(capsys):
                "--vrange", "50", "100", "--no-parametric", "--figure", "none", "--json"])
     assert rc == 0
     doc = json.loads(capsys.readouterr().out)
-    assert doc["units"] == {"V_flutter": "m/s", "V_divergence": "m/s", "omega_flutter": "rad/s"}
+    from casflutter.truth import load_problem
+
+    g = load_problem("goland", {"n_bending": 2, "n_torsion": 2})
+    u = doc["units"]
+    assert {k: u[k] for k in ("V_flutter", "V_divergence", "omega_flutter", "rom_V0",
+                              "V_range", "parametric_speeds")} == {
+        "V_flutter": "m/s", "V_divergence": "m/s", "omega_flutter": "rad/s", "rom_V0": "m/s",
+        "V_range": "m/s", "parametric_speeds": "m/s"}
+    assert u["speed_index"].startswith("V = U / (b omega_ref)")
     assert_allclose(doc["V_range"], [50.0, 100.0], rtol=1e-12)
     assert doc["truth"]["V_flutter"] is None  # Goland flutters at ~137 m/s
+    # no bare speed index beside the m/s: the explanation and the searches' messages (which
+    # speak in the speed index) say which unit each number is in
+    V0 = g.speed_index(doc["rom_V0"])
+    assert f"speed index V0 = {V0:g} (U0 = {doc['rom_V0']:.4g} m/s)" in doc["explanation"]
+    lo = g.speed_index(50.0)
+    assert doc["warnings"] and all(f"{lo:g}" in w and "is the speed index" in w
+                                   and "the speeds above are in m/s" in w
+                                   for w in doc["warnings"])
+    rc = main(["flutter", "goland", "--set", "n_bending=2", "--set", "n_torsion=2",
+               "--vrange", "50", "100", "--no-parametric", "--figure", "none"])
+    out = capsys.readouterr().out
+    assert rc == 0 and "V_flutter [m/s]" in out and f"ROM at V0={doc['rom_V0']:.4g} m/s" in out
 
 
 def test_unknown_set_lists_the_valid_names(capsys):

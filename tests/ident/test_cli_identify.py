@@ -10,6 +10,8 @@ import pytest
 import casflutter.ident as ident
 from casflutter.cli import main
 from casflutter.cli.commands.identify import _finite
+from casflutter.data import IOData
+from casflutter.errors import ConvergenceError
 from casflutter.ident import random_hwl_model, synthetic_data
 
 
@@ -67,6 +69,30 @@ def test_json_is_valid_and_out_written(npz, tmp_path, capsys):
     assert ident.HWLModel.load(out).orders.as_tuple() == (2, 1, 1, 1, 2, 2)
 
 
+def test_out_is_never_left_half_written(npz, tmp_path, capsys, monkeypatch):
+    """The model is written under a temporary name and renamed: a failure while writing
+    leaves the previous file as it was and no temporary file behind."""
+    out = tmp_path / "model.npz"
+    out.write_bytes(b"previous model")
+    real_save = ident.HWLModel.save
+
+    def fails_midway(self, fh):
+        fh.write(b"PK\x03\x04 half a zip")
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(ident.HWLModel, "save", fails_midway)
+    args = ["identify", str(npz), "--orders", "2,1,1,1,2,2", "--json", "--out", str(out)]
+    assert main(args) == 1
+    assert "No space left on device" in capsys.readouterr().err
+    assert out.read_bytes() == b"previous model" and sorted(tmp_path.iterdir()) == [out]
+    monkeypatch.setattr(ident.HWLModel, "save", real_save)
+    stem = tmp_path / "rom"                    # numpy's rule: savez adds .npz
+    assert main(["identify", str(npz), "--orders", "2,1,1,1,2,2", "--out", str(stem)]) == 0
+    assert f"model written to {stem}.npz" in capsys.readouterr().out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["model.npz", "rom.npz"]
+    assert ident.HWLModel.load(tmp_path / "rom.npz").orders.as_tuple() == (2, 1, 1, 1, 2, 2)
+
+
 def test_json_null_for_non_finite():
     assert _finite([1.0, math.nan, math.inf]) == [1.0, None, None]
     assert json.dumps({"x": _finite(np.float64("nan"))}, allow_nan=False) == '{"x": null}'
@@ -120,3 +146,33 @@ def test_max_time_exits_one_with_one_line(npz, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert any("warning" in e and "max_time" in e for e in err)
     assert err[-1].startswith("casflutter: identification stopped at --max-time")
+
+
+def test_nan_fit_is_a_failure(npz, capsys, monkeypatch):
+    """A fit that cannot be scored (a NaN error, e.g. orders 10,5,5,5,5,5) is never reported
+    as Solve_Succeeded with exit 0: identify raises, the CLI prints one line and exits 1."""
+    import casflutter.ident._identify as core
+
+    real_report = core.fit_report
+
+    def nan_report(model, data, mode="simulation", skip=None):
+        rep = real_report(model, data, mode, skip)
+        if mode != "simulation":
+            return rep
+        pct = np.array(rep.error_percent, dtype=float)
+        pct[-1] = math.nan
+        return type(rep)(rep.mode, pct, rep.nrmse, rep.rms_error, rep.skip)
+
+    monkeypatch.setattr(core, "fit_report", nan_report)
+    data = IOData.from_npz(npz)
+    with pytest.raises(ConvergenceError, match=r"not a finite number for output\(s\) y2") as exc:
+        ident.identify(data, (2, 1, 1, 1, 2, 2), criterion="simulation")
+    assert exc.value.result.success is False
+    assert exc.value.result.return_status == "Non_Finite_Fit"
+    assert main(["identify", str(npz), "--orders", "2,1,1,1,2,2", "--criterion",
+                 "simulation", "--json"]) == 1
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    errors = [ln for ln in captured.err.splitlines() if ln.startswith("casflutter: error")]
+    assert len(errors) == 1 and "not a finite number" in errors[0]
+    assert "Traceback" not in captured.err

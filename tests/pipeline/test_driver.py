@@ -24,7 +24,7 @@ from casflutter.verify import SpeedSweep, VerificationReport
 #: the keys of summary.json of ``casflutter run`` (the report, sweeps and scripts read them)
 SUMMARY_KEYS = {"problem", "V0", "n_sensors", "orders", "n_params", "fit_error_percent", "nf",
                 "ns", "nae", "flutter", "flutter_truth", "lco", "controller", "suppression",
-                "timings_s", "seed"}
+                "timings_s", "seed", "units", "flags", "casflutter_version", "threads"}
 
 #: the seed wing's study, cut to a few seconds per stage (a poor controller, a whole run)
 STUDY_SMALL = {"data.duration": 4.0, "flutter.n_grid": 61, "lco.duration": 1.0,
@@ -93,6 +93,15 @@ def test_the_flutter_check_is_a_configuration_of_the_same_driver(check):
     assert {"v0_history", "verification", "closed_loop"} <= set(s)
     assert s["verification"]["interval_ok"] == r.interval_ok
     json.dumps(s, allow_nan=False)
+    # the closed-loop stage has a flap actuator: the controller's poles are checked against
+    # its bandwidth and against the Nyquist frequency of the records
+    import numpy as np
+    fastest = np.max(np.abs(np.linalg.eigvals(np.asarray(r.controller.A))))
+    assert s["flags"] == {
+        "controller_faster_than_nyquist": bool(fastest > np.pi / r.data.dt),
+        "controller_faster_than_actuator": bool(fastest > r.config.closed_loop.actuator_omega)}
+    assert s["units"]["V"].startswith("speed index (V = U / (b omega_theta)")
+    assert s["units"]["airspeed_m_s"] is None and "airspeed_m_s" not in s["flutter"]
 
 
 @pytest.mark.parametrize("section, stage_class", [
@@ -104,8 +113,12 @@ def test_every_field_of_a_stages_settings_is_a_configuration_key(section, stage_
     keys = field_names(section)
     for f in fields(stage_class):
         assert f.name in keys
-    assert settings_as(section(), stage_class) == stage_class(
-        **({"coupling_delay": 1} if stage_class is RecordSettings else {}))
+    # the defaults the sections change: those of the seed wing's study (run.toml)
+    study = {RecordSettings: {"coupling_delay": 1},
+             IdentificationSettings: {"regularization": 1e-6},
+             SynthesisOptions: {"strictly_proper": True, "zero_start": False, "max_outer": 80,
+                                "max_stab_rounds": 300}}
+    assert settings_as(section(), stage_class) == stage_class(**study[stage_class])
 
 
 def test_a_configured_value_reaches_the_stage():
@@ -128,3 +141,67 @@ def test_the_rom_route_needs_no_controller():
     r = run(cfg, quiet=True, write=False)
     assert r.flutter.status == "no_crossing" and r.Vf is None and r.verification is None
     assert r.summary()["controller"] is None and "Vf error n/a" in r.explanation()
+
+
+# ---------------------------------------------------------------------- the output folder
+def _tree(folder):
+    return {p.relative_to(folder).as_posix(): p.read_bytes()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def test_the_output_folder_is_replaced_whole_or_not_at_all(study, tmp_path, monkeypatch):
+    import casflutter.pipeline._exports as exports
+    from casflutter._outputs import config_hash
+    from casflutter.errors import OutputError
+
+    target = tmp_path / "out"
+    files = exports.write_outputs(target, study)
+    first = _tree(target)
+    assert {"summary.json", "controller.json", "controller.mat", "plant.json", "config.json",
+            "manifest.json", "report.html", "rom.npz", "fig7_rom_fit.png"} <= set(first)
+    assert all(p.parent == target and p.is_file() for p in files.values())
+    m = json.loads(first["manifest.json"])
+    assert set(m["files"]) == set(first) - {"manifest.json"}
+    assert m["config_hash"] == config_hash(json.loads(first["config.json"]))
+    assert m["completed_stages"] == [k for k in study.timings if k != "total"]
+    assert m["seed"] == study.config.seed and m["started"] <= m["finished"]
+    # an existing non-empty folder is refused without overwrite
+    with pytest.raises(OutputError, match="not empty"):
+        exports.write_outputs(target, study)
+    assert _tree(target) == first
+
+    # a crash while the files are written leaves the previous run in place
+    def crash(*a, **k):
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(exports, "write_figures", crash)
+    with pytest.raises(RuntimeError, match="disk full"):
+        exports.write_outputs(target, study, overwrite=True)
+    assert _tree(target) == first and sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+    # overwrite: the new folder replaces the old one as a whole (no stale figure stays)
+    monkeypatch.setattr(exports, "write_figures", lambda out, result: {})
+    exports.write_outputs(target, study, overwrite=True)
+    new = _tree(target)
+    assert "fig7_rom_fit.png" not in new and new["config.json"] == first["config.json"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
+def test_plant_and_controller_files_reproduce_the_verification(study, tmp_path, capsys):
+    """``casflutter verify plant.json controller.json`` on a run's own exports gives the
+    run's verification: stability, H-inf norm to 1e-6 and the same speed intervals."""
+    import casflutter.pipeline._exports as exports
+    from casflutter.cli import main
+    from casflutter.verify import save_json
+
+    ver = study.verification
+    plant, ctrl = tmp_path / "plant.json", tmp_path / "controller.json"
+    save_json(exports.plant_document(study), plant)
+    save_json(exports.controller_document(study), ctrl)
+    assert main(["verify", str(plant), str(ctrl), "--json"]) == 0
+    got = json.loads(capsys.readouterr().out)
+    assert got["stable"] is ver.stable is True
+    assert got["Vf"] == study.Vf and got["n_delta"] == study.lft.n_delta
+    assert got["hinf"]["gamma"] == pytest.approx(ver.gamma, rel=1e-6)
+    assert got["hinf_delta"]["gamma"] == pytest.approx(ver.hinf_delta.gamma, rel=1e-6)
+    for key in ("small_gain_V", "small_gain_V_delta", "exact_V"):
+        assert got[key] == pytest.approx(list(getattr(ver, key)), rel=1e-6), key

@@ -111,3 +111,86 @@ def test_same_seed_same_numbers(reduced, tmp_path):
     for key in ("orders", "n_params", "fit_error_percent", "nf", "nae", "flutter",
                 "flutter_truth", "lco", "controller"):
         _assert_close(s[key], again[key], key)
+
+
+def test_exports_carry_names_units_speeds_and_reproduce_the_verification(reduced, capsys):
+    """controller.json/.mat and plant.json say what their signals are; ``casflutter verify
+    OUT/plant.json OUT/controller.json`` repeats the run's own verification."""
+    from scipy.io import loadmat
+
+    from casflutter.truth import load_problem
+
+    _, out, s = reduced
+    truth = load_problem("seed_wing")
+    c = json.loads((out / "controller.json").read_text())
+    assert c["time_base"] == {"domain": "continuous", "dt": None, "time_unit": "s",
+                              "frequency_unit": "rad/s"}
+    assert [i["name"] for i in c["inputs"]] == list(truth.modal_structure().sensor_names)
+    assert all(i["unit"].endswith("/s^2 (Hs rows of the problem's mode normalisation)")
+               for i in c["inputs"])                        # acceleration sensors
+    assert c["outputs"] == [{"name": "flap deflection command", "signal": "v", "unit": "rad"}]
+    assert c["sign_convention"].startswith("v = K zm")
+    Vf = s["flutter"]["V"]
+    # Vf and the certified intervals in speed index and in m/s (U = V U_ref, U_ref = 28.9)
+    assert c["design"]["Vf"]["speed_index"] == Vf
+    assert c["design"]["Vf"]["airspeed_m_s"] == pytest.approx(28.9 * Vf, rel=1e-12)
+    cert = c["certified"]
+    assert cert["exact_V"]["speed_index"] == s["controller"]["stable_V"]
+    assert cert["small_gain_V"]["speed_index"] == s["controller"]["small_gain_V"]
+    assert cert["exact_V"]["airspeed_m_s"] == pytest.approx(
+        [28.9 * v for v in s["controller"]["stable_V"]], rel=1e-12)
+    assert c["casflutter_version"] == s["casflutter_version"]
+    M = loadmat(out / "controller.mat")
+    assert M["Ts"].item() == 0.0 and str(M["time_unit"][0]) == "s"
+    assert [str(x[0]) for x in M["input_names"].ravel()] == [i["name"] for i in c["inputs"]]
+    np.testing.assert_allclose(M["exact_V"].ravel(), s["controller"]["stable_V"], rtol=1e-15)
+    np.testing.assert_allclose(M["Vf_airspeed_m_s"].item(), 28.9 * Vf, rtol=1e-12)
+
+    assert main(["verify", str(out / "plant.json"), str(out / "controller.json"),
+                 "--json"]) == 0
+    v = json.loads(capsys.readouterr().out)
+    ctl = s["controller"]
+    assert v["stable"] is ctl["stable"] is True and v["Vf"] == Vf
+    assert v["hinf"]["gamma"] == pytest.approx(ctl["gamma"], rel=1e-6)
+    assert v["small_gain_V"] == pytest.approx(ctl["small_gain_V"], rel=1e-6)
+    assert v["exact_V"] == pytest.approx(ctl["stable_V"], rel=1e-6)
+
+
+def test_summary_and_manifest_record_version_seed_threads_and_units(reduced):
+    import casflutter
+    from casflutter._outputs import config_hash
+
+    _, out, s = reduced
+    assert s["seed"] == 3 and s["casflutter_version"] == casflutter.__version__
+    assert set(s["threads"]) == {"env", "pools"} and s["threads"]["pools"]
+    # the CLI pins every BLAS pool to one thread (bit-identical numbers)
+    assert all(p["num_threads"] == 1 for p in s["threads"]["pools"])
+    assert s["units"]["V"].startswith("speed index (V = U / U_ref")
+    for key in ("flutter", "flutter_truth"):
+        assert s[key]["airspeed_m_s"] == pytest.approx(28.9 * s[key]["V"], rel=1e-12)
+    assert s["flags"]["controller_faster_than_nyquist"] is False
+    m = json.loads((out / "manifest.json").read_text())
+    assert m["complete"] is True and m["seed"] == 3
+    assert m["casflutter_version"] == casflutter.__version__
+    assert m["config_hash"] == config_hash(json.loads((out / "config.json").read_text()))
+    assert m["completed_stages"] == [k for k in s["timings_s"] if k != "total"]
+    assert set(m["files"]) == {p.name for p in out.iterdir()} - {"manifest.json"}
+    assert m["threads"] == s["threads"]
+
+
+def test_a_run_into_a_non_empty_folder_is_refused_before_any_work(reduced, monkeypatch,
+                                                                  capsys):
+    import casflutter.pipeline._run as driver
+
+    cfg_path, out, _ = reduced
+    before = {p.name: p.stat().st_mtime_ns for p in out.iterdir()}
+
+    def no_work(*a, **k):
+        raise AssertionError("the work started before the output folder was checked")
+
+    monkeypatch.setattr(driver, "truth_records", no_work)
+    assert main(["run", str(cfg_path), "--out", str(out), "--quiet"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("casflutter: error: output folder ") and "--overwrite" in err
+    assert "\n" not in err
+    assert {p.name: p.stat().st_mtime_ns for p in out.iterdir()} == before

@@ -25,12 +25,16 @@ duration = 4.0
 [rom]
 regularization = 1e-6
 [flutter]
+V_range = [0.05, 2.5]
 n_grid = 61
 [lco]
 duration = 1.0
+initial_deflection = 0.05
 [controller]
 order = {order}
 starts = 1
+zero_start = true
+strictly_proper = false
 max_outer = 1
 max_stab_rounds = 2
 stability_margin = 1e-4

@@ -5,6 +5,11 @@ paper's ROM route at one speed with the V² scaling, the truth with its aerodyna
 that speed, and the parametric ROM interpolated in V) beside the full-order truth, prints the
 flutter and divergence speeds in the problem's own units (or writes JSON to stdout) and,
 with ``--figure PATH``, saves the V–g / V–f figure.
+
+On a GAF wing file (``kind = "gaf"``: modal data and ``Q(ik)``, e.g. ``problems/goland_gaf``)
+the route is the rational-function approximation instead: the driver with no optional stage
+fits the RFA, finds the flutter of ΣAE(U) in m/s and rad/s and solves p–k on the same table;
+both are printed side by side with the published reference of the file, if any.
 """
 
 from __future__ import annotations
@@ -29,7 +34,9 @@ def register(subparsers) -> None:
                     "with a parametric ROM interpolated in V; compare with the truth.  Speeds "
                     "in the problem's unit (speed index for the typical section, m/s for the "
                     "Goland wing).")
-    p.add_argument("problem", help="problem name (see `casflutter problems`) or rig TOML file")
+    p.add_argument("problem", help="problem name (see `casflutter problems`), rig TOML file, "
+                                   "or GAF wing file (kind = \"gaf\", e.g. "
+                                   "problems/goland_gaf: RFA flutter in m/s with p-k)")
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="NAME=VALUE",
                    help="change a problem parameter (repeatable)")
     p.add_argument("--vrange", nargs=2, type=float, metavar=("LO", "HI"), default=None,
@@ -47,7 +54,8 @@ def register(subparsers) -> None:
 
 def _speed_conv(truth):
     """(V -> problem unit, problem unit -> V, unit name)."""
-    if hasattr(truth, "airspeed") and hasattr(truth, "speed_index"):
+    if callable(getattr(truth, "airspeed", None)) and callable(getattr(truth, "speed_index",
+                                                                      None)):
         return truth.airspeed, truth.speed_index, "m/s"
     return float, float, "speed index " + truth.modal_structure().speed_index
 
@@ -88,10 +96,14 @@ def summarize(result, problem: str) -> dict:
     if not rom_stable:
         warn.append("the single-speed ROM is unstable on its own (ΣAE unstable at V = 0): "
                     "its crossings are not flutter onsets")
+    # the searches' own messages speak in the speed index: say so when the output does not
+    note = "" if vunit.startswith("speed index") else (
+        f" (V in this message is the speed index {truth.modal_structure().speed_index}; the "
+        f"speeds above are in {vunit})")
     for key, r in (("truth", result.flutter_truth), ("rom", result.flutter),
                    ("parametric_rom", parametric)):
         if r is not None and r.Vf is None:
-            warn.append(f"{key}: {r.message}")
+            warn.append(f"{key}: {r.message}{note}")
 
     def err(x):
         return None if x is None else float(x)
@@ -102,7 +114,10 @@ def summarize(result, problem: str) -> dict:
         "rom": rom,
         "parametric_rom": _block(parametric, truth, to_unit, fscale),
         "frozen_aero_truth": _block(result.flutter_frozen, truth, to_unit, fscale),
-        "units": {"V_flutter": vunit, "V_divergence": vunit, "omega_flutter": funit},
+        "units": {"V_flutter": vunit, "V_divergence": vunit, "omega_flutter": funit,
+                  "rom_V0": vunit, "V_range": vunit, "parametric_speeds": vunit,
+                  "relative_errors": "fraction (0.01 = 1 %)", "timings": "s",
+                  "speed_index": truth.modal_structure().speed_index},
         "rom_V0": to_unit(result.config.data.V0),
         "V_range": [to_unit(v) for v in result.config.flutter.V_range],
         "parametric_speeds": (None if result.parametric is None
@@ -153,16 +168,114 @@ def _fmt(x, unit="") -> str:
     return f"{x:.6g}{unit}"
 
 
+def summarize_gaf(result, problem: str) -> dict:
+    """The JSON document of ``casflutter flutter`` on a GAF wing file: the RFA's flutter and
+    the p–k check in m/s and rad/s, and their errors against the file's reference."""
+    s = result.summary()["rfa"]
+    ref = result.problem.definition.get("reference", {}).get("flutter")
+    errors = None
+    if ref and "airspeed" in ref and "frequency" in ref:
+        errors = {key: None if s[key] is None else {
+            "airspeed": s[key]["airspeed_m_s"] / ref["airspeed"] - 1.0,
+            "omega": s[key]["omega_rad_s"] / ref["frequency"] - 1.0} for key in ("flutter", "pk")}
+    warn = []
+    if s["flutter"] is None:
+        warn.append(f"rfa: {result.rfa_flutter.message}")
+    if s["pk"] is None:
+        warn.append(f"p-k: {result.pk.message}")
+    return {"problem": problem, "route": "rfa", "rfa": {k: s[k] for k in (
+                "method", "n_lags", "poly_order", "lag_roots", "n_lag_states", "fit_error",
+                "max_element_error")},
+            "rfa_flutter": s["flutter"], "pk": s["pk"],
+            "reference": None if not ref else {"airspeed_m_s": ref.get("airspeed"),
+                                               "omega_rad_s": ref.get("frequency")},
+            "relative_errors": errors, "U_range": list(result.problem.U_range),
+            "units": {"airspeed": "m/s", "omega": "rad/s", "k": "omega b / U"},
+            "timings": {k: float(v) for k, v in result.timings.items()}, "warnings": warn}
+
+
+def _run_gaf(args, problem, label: str, fig_path) -> int:
+    """``casflutter flutter`` on a GAF wing file."""
+    from ...errors import ConfigError
+    from ...pipeline import RunConfig, run as run_config
+
+    for flag, given in (("--v0", args.v0 is not None), ("--vrange", args.vrange is not None)):
+        if given:
+            raise ConfigError(f"{flag} does not apply to the GAF wing file {problem.path}: it "
+                              "has no records, and its airspeed range is gaf.U_range [m/s]; "
+                              "edit the file")
+    cfg = RunConfig(stages=(), sensors=replace(RunConfig().sensors,
+                                               kind=problem.structure.sensor))
+    cfg = replace(cfg, problem=replace(cfg.problem, name=str(problem.path)))
+    result = run_config(cfg, quiet=True, write=False)
+    doc = summarize_gaf(result, label)
+    if fig_path is not None:
+        from ...report import plot_vg_vf
+
+        Path(fig_path).parent.mkdir(parents=True, exist_ok=True)
+        pk, fl = result.pk, result.rfa_flutter
+        low = [b for b in fl.tracking.upper_branches() if fl.origin[b] in pk.modes]
+        fig = plot_vg_vf(fl, branches=low, hz=False)
+        ag, af = fig.axes
+        ag.set_title(f"Uf = {fl.Vf:.2f} m/s, {fl.omega_f:.2f} rad/s")
+        for j in range(len(pk.modes)):
+            ag.plot(pk.U, pk.damping_ratio[:, j], "ko", ms=3, mfc="none",
+                    label="p–k" if j == 0 else None)
+            af.plot(pk.U, pk.omega[:, j], "ko", ms=3, mfc="none")
+        ag.legend(fontsize=7)
+        af.set_xlabel("airspeed U [m/s]")
+        fig.savefig(fig_path, dpi=110)
+        doc["figure"] = fig_path
+    else:
+        doc["figure"] = None
+    if args.json:
+        json.dump(doc, sys.stdout, indent=2)
+        sys.stdout.write("\n")
+        return 0
+    r = doc["rfa"]
+    print(f"{label}: flutter from Q(ik) ({r['method']} RFA, {r['n_lags']} lag roots, fit "
+          f"error {r['fit_error']:.2e}); airspeed [m/s], frequency [rad/s]")
+    print(f"  {'':22} {'U_flutter':>10} {'omega_flutter':>14} {'k':>8} {'error U':>9} "
+          f"{'error omega':>12}")
+    rows = [("RFA -> ΣAE(U)", doc["rfa_flutter"], "flutter"), ("p-k on Q(ik)", doc["pk"], "pk")]
+    if doc["reference"]:
+        rows.append(("published", {"airspeed_m_s": doc["reference"]["airspeed_m_s"],
+                                   "omega_rad_s": doc["reference"]["omega_rad_s"], "k": None},
+                     None))
+    for name, b, key in rows:
+        if b is None:
+            print(f"  {name:22} {'none in range':>10}")
+            continue
+        e = (doc["relative_errors"] or {}).get(key) if key else None
+        err = (f"{100 * e['airspeed']:+8.2f}% {100 * e['omega']:+11.2f}%" if e else "")
+        k = "" if b["k"] is None else f"{b['k']:.4f}"
+        print(f"  {name:22} {b['airspeed_m_s']:10.2f} {b['omega_rad_s']:14.2f} {k:>8} {err}")
+    for w in doc["warnings"]:
+        print(f"  warning: {w}")
+    if doc["figure"]:
+        print(f"  V-g/V-f figure: {doc['figure']}")
+    return 0
+
+
 def run(args) -> int:
     """Handler: run the route, print or write JSON, save the figure."""
     from ...pipeline import flutter_config, run as run_config
-    from ...truth import load_problem, parse_sets, problem_label
+    from ...errors import ConfigError
+    from ...truth import GAFProblem, WingProblem, load_problem, parse_sets, problem_label
 
     fig_path = None                  # figures only where asked, checked before the work
     if args.figure is not None and args.figure.lower() != "none":
         fig_path = str(check_figure_path(args.figure, what="--figure"))
     changes = parse_sets(args.sets)
     truth = load_problem(args.problem, changes)
+    label = problem_label(args.problem)
+    if isinstance(truth, GAFProblem):
+        return _run_gaf(args, truth, label, fig_path)
+    if isinstance(truth, WingProblem):
+        raise ConfigError(f"{args.problem} is a wing file with records (kind = \"wing\"): "
+                          "its flutter speed comes from `casflutter run` with a run "
+                          "configuration whose [problem] name is the file (e.g. "
+                          "problems/example_wing/run.toml, stages = [] for flutter only)")
     label = problem_label(args.problem)
     _, from_unit, vunit = _speed_conv(truth)
     updates = {"problem.set": changes}
@@ -188,16 +301,19 @@ def run(args) -> int:
         sys.stdout.write("\n")
         return 0
     u = doc["units"]
+    vu = "m/s" if u["V_flutter"] == "m/s" else "index"
     print(f"{label}: flutter speed ({u['V_flutter']}), frequency ({u['omega_flutter']})")
-    print(f"  {'':16} {'V_flutter':>14} {'omega_flutter':>14} {'mode':>12} {'V_divergence':>14}")
-    for key, label in (("truth", "truth"), ("rom", f"ROM at V0={doc['rom_V0']:.4g}"),
+    print(f"  {'':20} {f'V_flutter [{vu}]':>18} {'omega_flutter':>14} {'mode':>12} "
+          f"{f'V_divergence [{vu}]':>20}")
+    v0 = f"{doc['rom_V0']:.4g}" + (" m/s" if vu == "m/s" else "")
+    for key, label in (("truth", "truth"), ("rom", f"ROM at V0={v0}"),
                        ("frozen_aero_truth", "frozen-aero truth"),
                        ("parametric_rom", "parametric ROM")):
         b = doc[key]
         if b is None:
             continue
-        print(f"  {label:16} {_fmt(b['V_flutter']):>14} {_fmt(b['omega_flutter']):>14} "
-              f"{str(b['mode']):>12} {_fmt(b['V_divergence']):>14}")
+        print(f"  {label:20} {_fmt(b['V_flutter']):>18} {_fmt(b['omega_flutter']):>14} "
+              f"{str(b['mode']):>12} {_fmt(b['V_divergence']):>20}")
     print(f"  {doc['explanation']}")
     for w in doc["warnings"]:
         print(f"  warning: {w}")

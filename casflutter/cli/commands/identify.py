@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..._outputs import atomic_file
 from ...errors import ConfigError
 
 
@@ -123,8 +124,13 @@ def _main(args) -> int:
     for w in caught:   # one line each on stderr
         print(f"casflutter: warning: {w.message}", file=sys.stderr)
     real = realize(res.model, args.nf if args.nf else "auto")
-    if args.out:
-        res.model.save(args.out)
+    out_path = None
+    if args.out:   # written under a temporary name and renamed: never a half-written file
+        out_path = Path(args.out)
+        if not out_path.name.endswith(".npz"):   # numpy's own rule for savez
+            out_path = out_path.with_name(out_path.name + ".npz")
+        with atomic_file(out_path) as tmp, open(tmp, "wb") as fh:
+            res.model.save(fh)
     if args.json:
         out = {
             "orders": list(res.model.orders.as_tuple()), "n_params": res.n_params,
@@ -146,8 +152,8 @@ def _main(args) -> int:
         print(res.summary())
         print(f"linear part realised by ERA + Tustin: nf = {real.order} "
               f"(exact-order bound {real.exact_order_bound})")
-        if args.out:
-            print(f"model written to {args.out}")
+        if out_path is not None:
+            print(f"model written to {out_path}")
     if res.return_status in ("Maximum_WallTime_Exceeded",):
         print(f"casflutter: identification stopped at --max-time ({res.return_status}); the "
               "best iterate is reported", file=sys.stderr)
@@ -177,6 +183,7 @@ def register(subparsers) -> None:
     p.add_argument("--dt", type=float, help="sampling time [s]")
     p.add_argument("--fs", help=".mat variable holding the sampling frequency")
     p.add_argument("--nf", type=int, help="order of Σf (default: from the Hankel singular values)")
-    p.add_argument("--out", help="write the model (.npz)")
+    p.add_argument("--out", help="write the model (.npz; written under a temporary name "
+                                 "beside it and renamed when complete)")
     p.add_argument("--json", action="store_true", help="print JSON instead of the table")
     p.set_defaults(func=_main)

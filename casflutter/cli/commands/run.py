@@ -6,29 +6,66 @@ from __future__ import annotations
 import json
 
 
+def _speed(block) -> str:
+    """``V = 1.2 (speed index), U = 34.7 m/s, q = 737 Pa`` of a flutter block."""
+    if block is None or block.get("V") is None:
+        return "V = None"
+    text = f"V = {block['V']:.6g} (speed index)"
+    if block.get("airspeed_m_s") is not None:
+        text += f", U = {block['airspeed_m_s']:.6g} m/s"
+    if block.get("dynamic_pressure_Pa") is not None:
+        text += f", q = {block['dynamic_pressure_Pa']:.6g} Pa"
+    return text
+
+
 def _main(args) -> int:
     from ...pipeline import load_config, run
 
     cfg = load_config(args.config)   # validated before any work starts
-    res = run(cfg, out_dir=args.out, seed=args.seed, quiet=args.quiet)
+    # the output folder is checked (and refused when not empty without --overwrite) before
+    # any work, and written atomically at the end
+    res = run(cfg, out_dir=args.out, seed=args.seed, quiet=args.quiet,
+              overwrite=args.overwrite)
     s = res.summary()
     fl, ft = s["flutter"], s["flutter_truth"]
-    lines = [
-        f"problem {s['problem']}: orders {tuple(s['orders'])}, {s['n_params']} parameters, "
-        f"nf = {s['nf']}, ns = {s['ns']}, nae = {s['nae']}",
-        "ROM fit error per mode [%]: " + ", ".join(f"{e:.3f}" for e in s["fit_error_percent"]),
-        f"flutter (ROM):   V = {fl['V']}, {fl['freq_hz']} Hz, mode {fl['mode']}",
-        f"flutter (truth): V = {ft['V']}, {ft['freq_hz']} Hz, mode {ft['mode']}",
-    ]
+    if s["orders"] is not None:
+        lines = [
+            f"problem {s['problem']}: orders {tuple(s['orders'])}, {s['n_params']} parameters, "
+            f"nf = {s['nf']}, ns = {s['ns']}, nae = {s['nae']}",
+            "ROM fit error per mode [%]: " + ", ".join(f"{e:.3f}"
+                                                       for e in s["fit_error_percent"])]
+    else:                            # a GAF wing file: the RFA of Q(ik) in place of the ROM
+        r = s["rfa"]
+        lines = [f"problem {s['problem']}: {r['method']} RFA, {r['n_lags']} lag roots, fit "
+                 f"error {r['fit_error']:.3g}, ns = {s['ns']}, nae = {s['nae']}"]
+        for key, label in (("flutter", "RFA ΣAE(U)"), ("pk", "p-k")):
+            b = r[key]
+            if b is not None:
+                lines.append(f"flutter ({label}): U = {b['airspeed_m_s']:.6g} m/s, "
+                             f"{b['omega_rad_s']:.6g} rad/s, mode {b['mode']}")
+    lines.append(f"speeds: V is the {s['units']['V']}")
+    if fl is not None:
+        what = "ROM" if s["orders"] is not None else "ΣAE(V), Σf frozen at Uf"
+        lines.append(f"flutter ({what}):   {_speed(fl)}, {fl['freq_hz']} Hz, mode {fl['mode']}")
+    if ft is not None:
+        lines.append(f"flutter (truth): {_speed(ft)}, {ft['freq_hz']} Hz, mode {ft['mode']}")
     if s["lco"] is not None:
         lines.append(f"LCO: {s['lco']['freq_hz']} Hz ({s['lco']['kind']})")
     if s["controller"] is not None:
         c = s["controller"]
         lines.append(f"controller order {c['order']}: verified gamma = {c['gamma']}, small-gain "
-                     f"V in {c['small_gain_V']}, exact stable V in {c['stable_V']}")
+                     f"V in {c['small_gain_V']}, exact stable V in {c['stable_V']} (speed "
+                     "index)")
+        air = (c.get("certified") or {}).get("exact_V") or {}
+        if air.get("airspeed_m_s") is not None:
+            lines.append(f"  exact stable airspeed in {air['airspeed_m_s']} m/s")
+        for w in (c.get("poles") or {}).get("warnings", ()):
+            lines.append(f"  warning: {w}")
     if s["suppression"] is not None:
         lines.append(f"suppression: attenuation {s['suppression']['attenuation_percent']} %, LCO "
                      f"returns on release: {s['suppression']['lco_returns']}")
+    for stage, why in s.get("skipped", {}).items():
+        lines.append(f"skipped {stage}: {why}")
     if res.interval_ok is not None or res.closed_loop is not None:
         lines.append(f"checks passed: {res.success}")
     lines.append(f"total {s['timings_s']['total']:.1f} s; outputs in {res.out_dir}/")
@@ -43,7 +80,12 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("run", help="the paper's study end to end (default: seed wing)",
                               description=__doc__)
     p.add_argument("config", nargs="?", help="TOML configuration (default: the seed wing's)")
-    p.add_argument("--out", default="casflutter-run", help="output folder")
+    p.add_argument("--out", default="casflutter-run",
+                   help="output folder (written beside itself as OUT.incomplete-XXXXXX and "
+                        "moved into place at the end)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace an existing non-empty output folder (refused otherwise, "
+                        "before any work)")
     p.add_argument("--seed", type=int, help="overrides the configuration's seed")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument("--json", action="store_true", help="print summary.json")
