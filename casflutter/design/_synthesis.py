@@ -364,12 +364,16 @@ class _Phase:
             Hc = np.array([c.grad for c in con]).reshape(len(con), prob.n)
             cv = np.minimum(np.array([c.value for c in con]), 0.0)
             if H is None:
-                # curvature scale from the cuts active now (within 1 % of the top value): a
-                # far-away piece with a huge gradient (an ill-conditioned eigenvalue) would
-                # otherwise shrink every step to nothing
+                # stabilisation: curvature scale from the eigenvalue cuts active now (within
+                # 1 % of the top value) when some far-away ill-conditioned eigenvalue has a
+                # gradient 1e3 times larger, which would otherwise shrink every step to nothing
                 top = float(np.max(fv))
-                act = fv >= top - 0.01 * max(abs(f), abs(top), 1e-12)
-                gscale = float(np.max(np.linalg.norm(G[act], axis=1)))
+                act = fv >= top - 0.01 * max(abs(f), abs(top), 1e-12) \
+                    if self.kind == "stab" else np.ones(fv.size, bool)
+                gnorm = np.linalg.norm(G, axis=1)
+                gscale = float(np.max(gnorm))
+                if gscale > 1e3 * float(np.max(gnorm[act])):
+                    gscale = float(np.max(gnorm[act]))
                 H = max(1e-8, 0.1 * gscale / delta0) * np.eye(prob.n)
                 fresh = True
             step = self.qp.solve(H, fv, G, cv, Hc, delta * free)
