@@ -102,6 +102,10 @@ def _time_scale(parts: Sequence[Partition]) -> float:
     return float(np.sqrt(np.min(small) * big))
 
 
+_KAPPA_MAX = 1e8
+"""Eigenvalue condition number above which a Re λ cut is not extrapolated linearly."""
+
+
 @dataclass
 class Cut:
     """One smooth piece: value, gradient w.r.t. vec(Kbar) (column-major) and an identity
@@ -110,6 +114,15 @@ class Cut:
     value: float
     grad: np.ndarray
     key: tuple
+    linear: bool = True
+    """False for a nearly defective eigenvalue, whose gradient does not predict its motion
+    over a finite step: its reach within a trust region is taken as its value alone."""
+
+    def reach(self, delta: float) -> float:
+        """Largest value the linear model reaches within the box trust region ``delta``."""
+        if not self.linear:
+            return self.value
+        return self.value + delta * float(np.sum(np.abs(self.grad)))
 
 
 def _cluster_samples(r: int) -> list[np.ndarray]:
@@ -266,8 +279,13 @@ class Problem:
             b = P.C2 @ x
             g = (L.T @ np.real(np.outer(a, b)) @ R.T).ravel(order="F")
             val = float(w[i].real) + offset
-            if val + delta * np.sum(np.abs(g)) >= threshold:
-                out.append(Cut(val, g, tag + (complex(w[i]),)))
+            # condition number of the eigenvalue: beyond _KAPPA_MAX it sits in a (nearly)
+            # defective cluster, moves like a fractional power of the step and its first-order
+            # gradient (up to 1e60 on BDT2's Jordan blocks) would swamp the QP
+            kappa = np.linalg.norm(y) * np.linalg.norm(x) / abs(yx)
+            cut = Cut(val, g, tag + (complex(w[i]),), linear=bool(kappa <= _KAPPA_MAX))
+            if cut.reach(delta) >= threshold:
+                out.append(cut)
         return out
 
     def eig_cuts(self, K: np.ndarray, margin: float, threshold: float, delta: float,

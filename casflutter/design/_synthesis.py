@@ -304,9 +304,9 @@ class _Phase:
             allc += [Cut(c.value - self.opts.min_det * 1e-6, c.grad, c.key)
                      for c in prob.det_cuts(K)]
             top = max(allc, key=lambda c: c.value)
-            reach = top.value - delta * np.sum(np.abs(top.grad))
-            obj = [c for c in allc if c.value + delta * np.sum(np.abs(c.grad)) >= reach]
-            obj.sort(key=lambda c: -(c.value + delta * np.sum(np.abs(c.grad))))
+            reach = top.value - (delta * np.sum(np.abs(top.grad)) if top.linear else 0.0)
+            obj = [c for c in allc if c.reach(delta) >= reach]
+            obj.sort(key=lambda c: -c.reach(delta))
             return obj[:48], []
         gams, peaks = info
         obj: list[Cut] = []
@@ -317,8 +317,8 @@ class _Phase:
             memory[j] = _merge(ws, memory[j])
             obj += prob.sigma_cuts(K, j, memory[j], floor=self.opts.active_ratio * f)
         con = [c for c in prob.eig_cuts(K, 0.0, 0.0, delta, which="stab")]
-        con += [c for c in prob.det_cuts(K) if c.value + delta * np.sum(np.abs(c.grad)) >= 0]
-        con.sort(key=lambda c: -(c.value + delta * np.sum(np.abs(c.grad))))
+        con += [c for c in prob.det_cuts(K) if c.reach(delta) >= 0]
+        con.sort(key=lambda c: -c.reach(delta))
         return obj, con[:64]
 
     def done(self, f: float) -> bool:
@@ -364,7 +364,16 @@ class _Phase:
             Hc = np.array([c.grad for c in con]).reshape(len(con), prob.n)
             cv = np.minimum(np.array([c.value for c in con]), 0.0)
             if H is None:
-                gscale = float(np.max(np.linalg.norm(G, axis=1)))
+                # stabilisation: curvature scale from the eigenvalue cuts active now (within
+                # 1 % of the top value) when some far-away ill-conditioned eigenvalue has a
+                # gradient 1e3 times larger, which would otherwise shrink every step to nothing
+                top = float(np.max(fv))
+                act = fv >= top - 0.01 * max(abs(f), abs(top), 1e-12) \
+                    if self.kind == "stab" else np.ones(fv.size, bool)
+                gnorm = np.linalg.norm(G, axis=1)
+                gscale = float(np.max(gnorm))
+                if gscale > 1e3 * float(np.max(gnorm[act])):
+                    gscale = float(np.max(gnorm[act]))
                 H = max(1e-8, 0.1 * gscale / delta0) * np.eye(prob.n)
                 fresh = True
             step = self.qp.solve(H, fv, G, cv, Hc, delta * free)
