@@ -10,9 +10,11 @@ user path) is validated with :func:`numpydoc.validate.validate`.  The checks enf
 - on the user-path *functions* also ``PR01`` (every parameter documented), ``RT01`` (a
   Returns section), ``SA01`` (See Also: where to go next on the pipeline) and ``EX01`` (an
   Examples section), so a script writer finds every argument, result and a worked call;
-- on public methods ``PR01`` and ``RT01`` as well; the fields of the dataclasses are
-  documented in their Attributes/Parameters section or by an attribute docstring (numpydoc's
-  PR01 reads only the generated constructor, so that is checked here).
+- on public methods ``PR01`` and ``RT01`` as well (an override of a documented base-class
+  method documents what differs; its parameters and result are the base's);
+- the fields of the dataclasses are documented in their Attributes/Parameters section or by
+  an attribute docstring (numpydoc's PR01 reads only the generated constructor, so that is
+  checked here).
 
 The Examples of the user path run as doctests (:func:`test_examples_run`): each is a worked
 call on the typical section or a small plant, with its output checked.
@@ -60,7 +62,12 @@ def _user_path() -> dict[str, tuple[object, tuple[str, ...]]]:
                 if isinstance(value, (classmethod, staticmethod)):
                     value = value.__func__
                 if inspect.isfunction(value):
-                    out[f"{obj.__module__}.{obj.__qualname__}.{attr}"] = (value, METHODS)
+                    # an override of a documented base method documents what differs; its
+                    # parameters and result are the base method's
+                    overrides = any(attr in vars(b) and getattr(b, attr).__doc__
+                                    for b in obj.__mro__[1:])
+                    out[f"{obj.__module__}.{obj.__qualname__}.{attr}"] = (
+                        value, ALL_OBJECTS if overrides else METHODS)
     return out
 
 

@@ -151,7 +151,18 @@ class AeroelasticTruth(abc.ABC):
 
     @abc.abstractmethod
     def aero_matrices(self, V: float) -> AeroMatrices:
-        """The linear aerodynamic operator at speed index ``V`` (module docstring)."""
+        """The linear aerodynamic operator at speed index ``V`` (module docstring).
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        AeroMatrices
+            The state-space operator from modal motion (and flap) to generalised forces.
+        """
 
     @property
     @abc.abstractmethod
@@ -521,7 +532,20 @@ class AeroelasticTruth(abc.ABC):
     def flap_dynamics(self, V: float, linear: bool = False):
         """The truth as ``f(s, v, v', v'') -> (ds/dt, u'')`` for a flap driven from outside
         (a controller and actuator); ``s = [u, u', z1, z2]`` as in :meth:`simulate`, with the
-        same (optional) nonlinear structural stiffness unless ``linear``."""
+        same (optional) nonlinear structural stiffness unless ``linear``.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+        linear : bool
+            The linearised dynamics instead.
+
+        Returns
+        -------
+        callable
+            ``f(s, v, vdot, vddot) -> (ds/dt, u'')``.
+        """
         c = self._coupled(V)
         A, Bf, Minv, N = c["A"], c["Bflap"], c["Minv"], c["N"]
         Phi = self._Phi

@@ -248,17 +248,6 @@ class GolandWing(AeroelasticTruth):
 
     def aero_matrices(self, V: float) -> AeroMatrices:
         """Strip-theory Jones/Wagner operator at speed index ``V`` (module docstring).
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        AeroMatrices
-            The state-space operator from modal motion to generalised forces (see
-            :meth:`AeroelasticTruth.aero_matrices`).
         """
         p = self.params
         V = self._check_V(V)

@@ -289,17 +289,6 @@ class SeedWing(AeroelasticTruth):
         """Linearised strip-theory Jones/Wagner operator at ``V`` (per unit modal mass).
 
         One downwash ``Q`` (and its two Jones lag states) per strip: ``ng = n_strips``.
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        AeroMatrices
-            The state-space operator from modal motion to generalised forces (see
-            :meth:`AeroelasticTruth.aero_matrices`).
         """
         p = self.params
         V = self._check_V(V)
@@ -490,18 +479,6 @@ class SeedWing(AeroelasticTruth):
         outside (a controller and actuator), e.g. closed-loop suppression simulations.
 
         ``s = [u, u', z1, z2]`` is the full state of :meth:`simulate`.
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-        linear : bool
-            The linearised forces instead.
-
-        Returns
-        -------
-        callable
-            ``f(s, v, vdot, vddot) -> (ds/dt, u'')``.
         """
         V = self._check_V(V)
         forces_at = self._forces(V, linear)

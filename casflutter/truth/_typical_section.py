@@ -126,17 +126,6 @@ class TypicalSection(AeroelasticTruth):
 
     def aero_matrices(self, V: float) -> AeroMatrices:
         """Jones/Wagner aerodynamic operator at speed index ``V`` (module docstring).
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        AeroMatrices
-            The state-space operator from modal motion to generalised forces (see
-            :meth:`AeroelasticTruth.aero_matrices`).
         """
         p = self.params
         V = self._check_V(V)
