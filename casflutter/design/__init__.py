@@ -7,12 +7,12 @@ the benchmark plants; :func:`partition`, :class:`Partition`; :func:`hinf_norm` /
 :func:`exact_hinf_norm` (the synthesis' own Hamiltonian norm) and :func:`verify_closed_loop`.
 """
 
-from ._flutter import FlutterDesign, design_flutter_controller, loop_abscissa
+from ._flutter import FlutterDesign, design_flutter_controller, loop_abscissa, with_flap_rate
 from ._norm import hinf_norm
 from ._plant import Partition, exact_hinf_norm, load_compleib, partition
 from ._synthesis import (StartRecord, SynthesisOptions, SynthesisResult, synthesize,
                          verify_closed_loop)
 
 __all__ = ["synthesize", "SynthesisOptions", "SynthesisResult", "StartRecord",
-           "design_flutter_controller", "FlutterDesign", "loop_abscissa", "load_compleib",
-           "partition", "Partition", "exact_hinf_norm", "hinf_norm", "verify_closed_loop"]
+           "design_flutter_controller", "with_flap_rate", "FlutterDesign", "loop_abscissa",
+           "load_compleib", "partition", "Partition", "exact_hinf_norm", "hinf_norm", "verify_closed_loop"]

@@ -9,6 +9,11 @@ interval is made a design requirement:
 * constraints: the ROM loop ΣAE(V) (eq. 8-9) closed by ``K`` decays at a rate ``decay`` at
   ``n_speeds`` speeds spread over the interval, and the algebraic loop through the
   accelerometers' flap feed-through stays well posed (``1 − Dk D22(V) >= min_det``);
+* flap rate (optional): the H∞ plants gain an output ``z_r = w v̇`` (the flap rate through a
+  first-order filter of bandwidth ``a``, ``z_r = w a (v − x_r)``, ``ẋ_r = a (v − x_r)``),
+  so the controller does not ask for more flap rate than a servo has: without it the
+  paper's order-3 design holds the seed wing's established LCO only with a flap rate far
+  beyond a wind-tunnel servo's, and a rate-saturated servo lets the LCO through;
 * continuation in speed: starting from the paper's design at Vf, the upper end of the
   constrained interval is pushed a step ``ΔV`` beyond the edge where the current loop still
   decays (found by a dense eigenvalue scan), each design starting from the previous
@@ -33,7 +38,7 @@ from ..aeroelastic import AeroelasticLFT, AeroelasticSystem, build_lft
 from ..errors import ConfigError, SynthesisError
 from ._synthesis import SynthesisOptions, SynthesisResult, synthesize
 
-__all__ = ["FlutterDesign", "design_flutter_controller", "loop_abscissa"]
+__all__ = ["FlutterDesign", "design_flutter_controller", "loop_abscissa", "with_flap_rate"]
 
 log = logging.getLogger("casflutter.design")
 
@@ -90,6 +95,49 @@ def loop_abscissa(system: AeroelasticSystem, K: control.StateSpace, speeds) -> n
     return np.array(out)
 
 
+def with_flap_rate(P: control.StateSpace, nmeas: int, weight: float,
+                   bandwidth: float) -> control.StateSpace:
+    """``P`` with one more performance output, the weighted flap rate ``z_r = w v̇``.
+
+    The rate is taken through a first-order filter, ``ẋ_r = a (v − x_r)``,
+    ``z_r = w a (v − x_r)`` (``v̇`` below the bandwidth ``a``), inserted after the existing
+    performance outputs; the measurements stay the last ``nmeas`` outputs and the flap
+    ``v`` the last input, as :func:`synthesize` expects.
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        Partitioned plant (inputs ``[w, v]``, outputs ``[z, zm]``), e.g. the LFT's ``P``
+        (eq. 14).
+    nmeas : int
+        Number of measurements (the last outputs).
+    weight : float
+        ``w`` [1 / (rad per time unit)]: how much one unit of flap rate counts against the
+        plant's performance outputs (> 0).
+    bandwidth : float
+        ``a`` [rad per time unit] (> 0), e.g. the flap servo's bandwidth.
+
+    Returns
+    -------
+    control.StateSpace
+        One state and one output more than ``P``.
+    """
+    if not (weight > 0 and bandwidth > 0):
+        raise ConfigError(f"flap-rate weight {weight!r} and bandwidth {bandwidth!r} must be > 0")
+    A, B, C, D = (np.asarray(M, dtype=float) for M in (P.A, P.B, P.C, P.D))
+    n, m, nz = A.shape[0], B.shape[1], C.shape[0] - nmeas
+    ev = np.zeros((1, m))
+    ev[0, -1] = 1.0                                       # the flap command v
+    a, w = float(bandwidth), float(weight)
+    Aa = np.block([[A, np.zeros((n, 1))], [np.zeros((1, n)), np.full((1, 1), -a)]])
+    Ba = np.vstack([B, a * ev])
+    Ca = np.vstack([np.hstack([C[:nz], np.zeros((nz, 1))]),
+                    np.hstack([np.zeros((1, n)), np.full((1, 1), -w * a)]),
+                    np.hstack([C[nz:], np.zeros((nmeas, 1))])])
+    Da = np.vstack([D[:nz], w * a * ev, D[nz:]])
+    return control.ss(Aa, Ba, Ca, Da)
+
+
 def _speeds(lo: float, hi: float, n: int, Vf: float) -> np.ndarray:
     return np.unique(np.concatenate([np.linspace(lo, hi, n), [Vf]]))
 
@@ -97,8 +145,9 @@ def _speeds(lo: float, hi: float, n: int, Vf: float) -> np.ndarray:
 def design_flutter_controller(system: AeroelasticSystem, Vf: float, order: int = 3, *,
                               speeds: tuple = (1.0,), interval: tuple = (), n_speeds: int = 40, decay: float = 0.05,
                               steps: int = 4, starts: int = 3, seed: int = 0,
-                              options: SynthesisOptions | Mapping[str, Any] | None = None
-                              ) -> FlutterDesign:
+                              options: SynthesisOptions | Mapping[str, Any] | None = None,
+                              flap_rate_weight: float = 0.0,
+                              flap_rate_bandwidth: float = 251.3) -> FlutterDesign:
     """Fixed-order flutter suppression controller, robust at Vf and stable over an interval.
 
     Parameters
@@ -125,6 +174,12 @@ def design_flutter_controller(system: AeroelasticSystem, Vf: float, order: int =
         Random starts of the first design and their seed (same seed, same controller).
     options : SynthesisOptions or dict, optional
         Settings of :func:`synthesize` (``decay`` is set from the argument).
+    flap_rate_weight : float
+        ``w`` of :func:`with_flap_rate` on every H∞ plant (0: none, the paper's design).
+        γ of the result is then the norm of the weighted plant; the verification layer
+        measures the paper's γ on the LFT alone.
+    flap_rate_bandwidth : float
+        ``a`` of :func:`with_flap_rate` [rad per time unit].
 
     Returns
     -------
@@ -144,6 +199,11 @@ def design_flutter_controller(system: AeroelasticSystem, Vf: float, order: int =
     if not speeds or any(not f > 0 for f in speeds):
         raise ConfigError(f"speeds = {list(speeds)!r}: positive multiples of Vf")
     hinf = [build_lft(system, float(f) * Vf).P for f in speeds]
+    if flap_rate_weight < 0:
+        raise ConfigError(f"flap_rate_weight = {flap_rate_weight!r}: >= 0 (0: no penalty)")
+    if flap_rate_weight > 0:
+        hinf = [with_flap_rate(P, lft.nmeas, flap_rate_weight, flap_rate_bandwidth)
+                for P in hinf]
     if not interval:
         syn = synthesize(hinf, lft.nmeas, lft.ncon, order, starts=starts, seed=seed,
                          options=opts)

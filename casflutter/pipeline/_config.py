@@ -33,6 +33,7 @@ impossible values fail with a :class:`~casflutter.errors.ConfigError` naming the
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -249,10 +250,25 @@ class ControllerSettings(SynthesisOptions):
     """Outer iterations per start (:class:`casflutter.design.SynthesisOptions`)."""
     max_stab_rounds: int = 300
     """Stabilisation rounds per start (:class:`casflutter.design.SynthesisOptions`)."""
+    flap_rate_weight: float = 0.003
+    """Weight ``w`` of the flap rate in the H∞ plants (:func:`casflutter.design.with_flap_rate`,
+    per rad/s of flap rate); 0: the paper's design without it.  The seed wing's servo
+    saturates at 300°/s; without the weight its order-3 design needs far more to hold the
+    established LCO."""
+    flap_rate_bandwidth: float = 251.3
+    """Bandwidth of the flap-rate filter [rad per time unit] (the seed wing's 40 Hz servo)."""
 
     def __post_init__(self):
         super().__post_init__()
         _integer("order", self.order, 0)
+        for key in ("flap_rate_weight", "flap_rate_bandwidth"):
+            value = getattr(self, key)
+            if not (isinstance(value, (int, float)) and not isinstance(value, bool)
+                    and math.isfinite(value) and value >= 0):
+                raise ConfigError(f"controller.{key} = {value!r}: a finite number >= 0")
+        if self.flap_rate_weight > 0 and not self.flap_rate_bandwidth > 0:
+            raise ConfigError(f"controller.flap_rate_bandwidth = {self.flap_rate_bandwidth!r}: "
+                              "> 0 when flap_rate_weight > 0")
         _integer("starts", self.starts, 1)
         sp = finite_numbers("speeds", self.speeds, what="a non-empty list of positive "
                             "multiples of Vf, containing 1.0")
@@ -400,6 +416,9 @@ class SuppressionSection(SuppressionSettings):
     """Length of the gain ramp 0 -> 1."""
     hold: float = 6.0
     """Closed-loop time at full gain."""
+    release: float = 25.0
+    """Open-loop time after the release: long enough for the LCO to grow back from the tap
+    to half its amplitude (its growth rate at 1.05 Vf is slow)."""
     flap_limit: float | None = 0.2618
     """Flap position limit [rad] (15 deg); from Python ``None`` for no limit."""
     flap_rate_limit: float | None = 5.236

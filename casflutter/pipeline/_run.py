@@ -429,7 +429,8 @@ def _controller_stages(cfg: RunConfig, system, Vf: float, prog, out: dict) -> No
         design = design_flutter_controller(
             system, Vf, c.order, speeds=tuple(c.speeds), interval=tuple(c.interval),
             n_speeds=c.n_speeds, decay=c.interval_decay, steps=c.steps, starts=c.starts,
-            seed=cfg.seed, options=options)
+            seed=cfg.seed, options=options, flap_rate_weight=c.flap_rate_weight,
+            flap_rate_bandwidth=c.flap_rate_bandwidth)
         syn, K = design.synthesis, design.controller
     with prog.stage("verify"):
         ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
