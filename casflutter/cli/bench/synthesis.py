@@ -57,7 +57,9 @@ def _hinfsyn_gamma(P, nmeas: int, ncon: int, timeout: float) -> float | None:
     proc.start()
     proc.join(timeout)
     if proc.is_alive():
-        proc.terminate()
+        # SIGKILL: the child inherits the command's Python SIGTERM handler, which cannot run
+        # while slycot's Fortran holds the thread, so terminate() left join() waiting forever
+        proc.kill()
         proc.join()
         return None
     try:
