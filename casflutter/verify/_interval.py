@@ -226,7 +226,7 @@ def _pick_ends(kinds: dict[float, str], matrix, nominal: float, method: str,
                              ("lower", -1.0, cands[cands < 0][::-1])):
         end = (sign * math.inf, math.nan, "none")
         prev = 0.0
-        for i, t in enumerate(list(pool) + [None]):
+        for t in list(pool) + [None]:
             far = prev + sign * max(1.0, 2 * abs(prev)) if t is None else float(t)
             if not stable(0.5 * (prev + far)):
                 # the stability boundary lies in [prev, midpoint): at the candidate prev when
