@@ -209,7 +209,7 @@ def active_frequencies(A, B, C, D, gamma: float, omega_peak: float, *, ratio: fl
                        max_count: int = 8) -> list[tuple[float, float]]:
     """Local maxima of ``σ_max(T(jω))`` above ``ratio * gamma``: ``[(ω, σ), ...]`` by
     decreasing σ, the exact peak first; ``ω = inf`` stands for the feed-through ``σ_max(D)``
-    when it is above the level (the peak of a loop whose norm is its feed-through).
+    when the norm is the feed-through (otherwise that piece would have no cut at all).
 
     The bands where ``σ_max > ratio γ`` are delimited by the imaginary eigenvalues of the
     Hamiltonian at that level; one local maximum is located in each band.
@@ -218,15 +218,16 @@ def active_frequencies(A, B, C, D, gamma: float, omega_peak: float, *, ratio: fl
     n = A.shape[0]
     sD = float(np.linalg.norm(D, 2)) if D.size else 0.0
     level = ratio * gamma
-    # the feed-through is a local maximum (at ω = ∞) of the peak function once it is above the
-    # level: it is an active piece of the model (without it a peak at ω = ∞ has no cut at all)
     if np.isfinite(omega_peak):
         out.append((float(omega_peak), float(gamma)))
-    if sD >= level:
+    else:
+        # the norm is the feed-through: its piece (ω = ∞) is the active one, and the local
+        # maxima above the feed-through level are the others
         out.append((np.inf, sD))
-    # crossings only above the feed-through: the bands where σ_max exceeds both
-    level = max(level, sD * (1 + 1e-6))
-    if n == 0 or level >= gamma:
+        level = max(level, sD * (1 + 1e-6))
+        if n == 0 or level >= gamma:
+            return out
+    if n == 0 or level <= sD * (1 + 1e-9):
         return out
     w = level_crossings(A, B, C, D, level)
     if w.size == 0:
