@@ -19,7 +19,8 @@ singular problems the γ-iteration of SB10AD can take many seconds before it ref
 Everything is deterministic (no random choice); the SLICOT routines are SB10AD (central
 controller; bisection on γ, then the controller at ``gamma_factor`` times the γ found) and
 AB09AD/AB09MD/AB09ND (balanced truncation / singular perturbation, through
-:func:`control.balred`).
+:func:`control.balred`); the third reduction (slowest modes, the rest residualised) is
+numpy/scipy.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ import logging
 
 import control
 import numpy as np
+import scipy.linalg as sla
 
 from ._plant import Partition
 
@@ -105,15 +107,51 @@ def full_order_controller(P: Partition, gamma_factor: float = 1.1
     return control.ss(Ak, Bk, Ck, Dk), g_opt
 
 
+def slow_modal(K: control.StateSpace, order: int) -> control.StateSpace | None:
+    """Keep the ``order`` slowest modes of ``K`` and replace the others by their DC gain.
+
+    An ordered real Schur form puts the slow poles first; a Sylvester equation decouples the
+    two parts exactly, and the fast part is residualised (``D - C2 A22⁻¹ B2``).  The slow
+    dynamics of an H∞ controller are its (near-)integral action on weighted tracking errors,
+    which balanced truncation of the controller alone may discard.  ``None`` when the split
+    would cut a complex pair or the fast part is singular.
+    """
+    A, B, C, D = (np.asarray(M, float) for M in (K.A, K.B, K.C, K.D))
+    n = A.shape[0]
+    if not 0 < order < n:
+        return None
+    mags = np.sort(np.abs(np.linalg.eigvals(A)))
+    if mags[order] <= mags[order - 1] * (1 + 1e-9):
+        return None
+    thr = 0.5 * (mags[order - 1] + mags[order])
+    try:
+        T, Z, sdim = sla.schur(A, output="real", sort=lambda x, y: np.hypot(x, y) <= thr)
+        if sdim != order:
+            return None
+        A11, A12, A22 = T[:order, :order], T[:order, order:], T[order:, order:]
+        Bz, Cz = Z.T @ B, C @ Z
+        X = sla.solve_sylvester(A11, -A22, -A12)       # [I X; 0 I] block-diagonalises T
+        B1 = Bz[:order] - X @ Bz[order:]
+        C2 = Cz[:, order:] + Cz[:, :order] @ X
+        Dr = D - C2 @ np.linalg.solve(A22, Bz[order:])
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    return control.ss(A11, B1, Cz[:, :order], Dr)
+
+
 def reduced_controllers(K: control.StateSpace, order: int) -> list[control.StateSpace]:
-    """Reductions of ``K`` to at most ``order`` states: balanced truncation and balanced
-    singular perturbation (DC gain kept); ``[K]`` when it is already small enough.
+    """Reductions of ``K`` to at most ``order`` states: balanced truncation, balanced
+    singular perturbation (DC gain kept) and the slowest modes with the others residualised
+    (:func:`slow_modal`); ``[K]`` when it is already small enough.
 
     Reductions that fail (e.g. more unstable controller poles than ``order``) are left out.
     """
     if K.nstates <= order:
         return [K]
     out = []
+    Km = slow_modal(K, order)
+    if Km is not None:
+        out.append(Km)
     for method in ("truncate", "matchdc"):
         try:
             Kr = control.balred(K, order, method=method)

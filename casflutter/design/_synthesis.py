@@ -285,6 +285,28 @@ def _initial_gain(prob: Problem, kind: str, rng: np.random.Generator,
     return K
 
 
+def _shrunk(prob: Problem, K0: np.ndarray) -> np.ndarray | None:
+    """``K0`` with its couplings to the loop (``Dk, Bk, Ck``) halved until the worst
+    spectral abscissa is no larger than with those couplings at zero (at most 20 halvings,
+    keeping the loop well posed); ``None`` if that never happens."""
+    Z = K0.copy()
+    Z[:prob.nu, :] = 0.0
+    Z[:, :prob.ny] = 0.0
+    try:
+        a0 = max(float(np.max(prob.alphas(Z)[0])), 0.0)
+    except np.linalg.LinAlgError:
+        return None
+    K = K0.copy()
+    for _ in range(20):
+        K = Z + 0.5 * (K - Z)
+        try:
+            if prob.well_posed(K) and float(np.max(prob.alphas(K)[0])) <= a0:
+                return K
+        except np.linalg.LinAlgError:
+            return None
+    return None
+
+
 @dataclass
 class _Phase:
     """One phase of the bundle iteration (module docstring)."""
@@ -604,6 +626,21 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
         # the decay rates reached, or at least a stable, well-posed loop (the H∞ phase then
         # keeps it stable: every accepted step has a finite norm)
         ok = prob.feasible(K) and (phi <= 0.0 or (a_h < 0 and np.isfinite(phi)))
+        if not ok and kind == "random":
+            # a random gain that moved the loop far right of the zero controller's abscissa
+            # can leave the phase crawling at a (nearly) defective rightmost eigenvalue, where
+            # the linear cuts mispredict: retry once with the random part shrunk until the
+            # loop is no more unstable than with the zero controller (deterministic)
+            K1 = _shrunk(prob, K0)
+            if K1 is not None:
+                log.info("%s: stabilisation failed (abscissa %.4g rad/s); retried from the "
+                         "random gain shrunk towards zero", label, a_h)
+                r1b = stab.run(K1, label, opts.max_stab_rounds)
+                K, phi = r1b["K"], r1b["f"]
+                r1 = dict(r1b, iterations=r1["iterations"] + r1b["iterations"])
+                a_h = float(np.max(prob.alphas(K)[0])) * prob.w0
+                best_alpha = min(best_alpha, a_h)
+                ok = prob.feasible(K) and (phi <= 0.0 or (a_h < 0 and np.isfinite(phi)))
         log.info("%s: stabilisation %s after %d iterations (abscissa %.4g rad/s)", label,
                  "reached the decay rates" if ok else "failed", r1["iterations"], a_h)
         if ok:
