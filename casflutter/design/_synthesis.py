@@ -287,13 +287,14 @@ def _initial_gain(prob: Problem, kind: str, rng: np.random.Generator,
 
 def _shrunk(prob: Problem, K0: np.ndarray) -> np.ndarray | None:
     """``K0`` with its couplings to the loop (``Dk, Bk, Ck``) halved until the worst
-    spectral abscissa is no larger than with those couplings at zero (at most 20 halvings,
-    keeping the loop well posed); ``None`` if that never happens."""
+    spectral abscissa (scaled time, where the plants' time scale is 1) is at most
+    ``max(α0, 0) + 0.05``, ``α0`` the abscissa with those couplings at zero (at most 20
+    halvings, keeping the loop well posed); ``None`` if that never happens."""
     Z = K0.copy()
     Z[:prob.nu, :] = 0.0
     Z[:, :prob.ny] = 0.0
     try:
-        a0 = max(float(np.max(prob.alphas(Z)[0])), 0.0)
+        a0 = max(float(np.max(prob.alphas(Z)[0])), 0.0) + 0.05
     except np.linalg.LinAlgError:
         return None
     K = K0.copy()

@@ -82,18 +82,40 @@ def test_a_norm_at_the_feedthrough_has_an_active_piece_at_infinity():
 
 
 @pytest.mark.slow
-def test_he6_order6_improves_on_the_reduced_full_order_controller():
-    """HE6 order 6: the balanced singular-perturbation reduction of the full-order controller
-    is stable with its norm at the feed-through (ω = ∞); the synthesis, which starts from it,
-    must end at or below its verified γ and within 2 γ* (before, the loop stopped after one
-    iteration: no cut at ω = ∞)."""
+def test_he6_order6_reaches_the_hard_plant_target_from_the_full_order_start():
+    """HE6 (20 states; four near-integrating tracking weights, lightly damped rotor modes):
+    the default synthesis at order 6 (zero start plus the reduced full-order starts) ends
+    within 1.5 γ* of the LMI optimum (issue 10, item 4) and at or below every stable reduction
+    of the full-order controller (verified independently).  The order-6 reductions have
+    their norm at the feed-through (ω = ∞), which the local model must be able to cut."""
     P, nmeas, ncon, meta = load_compleib(LARGE / "HE6.json")
     K, _ = full_order_controller(partition(P, nmeas, ncon))
     g_red = min(_verified_gamma(P, Kr, nmeas, ncon) for Kr in reduced_controllers(K, 6))
     assert np.isfinite(g_red)
-    res = synthesize(P, nmeas, ncon, 6, starts=0, initial=reduced_controllers(K, 6)[1:],
-                     seed=0)
+    res = synthesize(P, nmeas, ncon, 6, starts=1, seed=0)
+    assert any(s.kind == "full-order-reduced" for s in res.starts)
     g = _verified_gamma(P, res.controller, nmeas, ncon)
     np.testing.assert_allclose(res.gamma, g, rtol=1e-6)
     assert g <= g_red * (1 + 1e-9)
-    assert g <= 2.0 * meta["gamma_full_order_lmi"]
+    assert g <= 1.5 * meta["gamma_full_order_lmi"]
+
+
+def test_failed_random_start_is_retried_from_a_shrunk_gain():
+    """HE4's third seeded start (seed 0) is a random gain that moves the loop's abscissa to
+    about +8 (scaled); the shrunk retry must be no more unstable than the zero coupling, and
+    the start then stabilises (the old behaviour: 'stabilisation failed', abscissa 12 rad/s)."""
+    from casflutter.design._problem import Problem
+    from casflutter.design._synthesis import _initial_gain, _shrunk
+    P, nmeas, ncon, _ = load_compleib(COMPLEIB / "HE4.json")
+    prob = Problem([partition(P, nmeas, ncon)], [], 0)
+    rng = np.random.default_rng(0)
+    _initial_gain(prob, "random", rng)              # start 1 (the zero start draws nothing)
+    K = _initial_gain(prob, "random", rng)          # start 2
+    a_rand = float(np.max(prob.alphas(K)[0]))
+    K1 = _shrunk(prob, K)
+    a_zero = max(float(np.max(prob.alphas(np.zeros_like(K))[0])), 0.0)
+    assert K1 is not None
+    assert float(np.max(prob.alphas(K1)[0])) <= a_zero + 0.05 < a_rand
+    res = synthesize(P, nmeas, ncon, 0, starts=3, seed=0,
+                     options=dict(max_outer=1, full_order_start=False))
+    assert all(s.stabilized and s.spectral_abscissa < 0 for s in res.starts)
