@@ -347,6 +347,9 @@ class _Phase:
             if gj < self.opts.active_ratio * f:
                 continue
             ws = prob.peaks(K, j, gj, wj, self.opts.active_ratio * f / gj)
+            if memory[j]:
+                # the feed-through piece (ω = ∞) enters only a model that has no other piece
+                ws = [w for w in ws if np.isfinite(w)]
             memory[j] = _merge(ws, memory[j])
             obj += prob.sigma_cuts(K, j, memory[j], floor=self.opts.active_ratio * f)
         con = [c for c in prob.eig_cuts(K, 0.0, 0.0, delta, which="stab")]
@@ -603,7 +606,9 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
     if opts.full_order_start and len(parts) == 1 and not sparts:
         full = full_order_controller(parts[0], opts.full_order_gamma_factor)
         if full is not None:
-            plan += [("full-order-reduced", Kr) for Kr in reduced_controllers(full[0], order)]
+            # (a static reduction that is zero would only repeat the zero start)
+            plan += [("full-order-reduced", Kr) for Kr in reduced_controllers(full[0], order)
+                     if Kr.nstates or np.any(np.asarray(Kr.D) != 0)]
     records, gains = [], []
     best_alpha = np.inf
     log.info("synthesis: order %d, %d H-inf plant(s) (%d states), %d stability plant(s), "
