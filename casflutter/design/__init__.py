@@ -4,10 +4,13 @@ Public names: :func:`synthesize` with :class:`SynthesisOptions`, :class:`Synthes
 :class:`StartRecord`; :func:`design_flutter_controller` with :class:`FlutterDesign` (the
 LFT at Vf plus stability of ΣAE(V) over an interval, eq. 8-16); :func:`load_compleib` for
 the benchmark plants; :func:`partition`, :class:`Partition`; :func:`hinf_norm` /
-:func:`exact_hinf_norm` (the synthesis' own Hamiltonian norm) and :func:`verify_closed_loop`.
+:func:`exact_hinf_norm` (the synthesis' own Hamiltonian norm) and :func:`verify_closed_loop`;
+:func:`stabilize_interval` with :func:`full_order_start` and :class:`IntervalReach` (how far
+one controller holds ΣAE(V) stable, by continuation in speed).
 """
 
 from ._flutter import FlutterDesign, design_flutter_controller, loop_abscissa, with_flap_rate
+from ._interval import IntervalReach, full_order_start, stabilize_interval
 from ._norm import hinf_norm
 from ._plant import Partition, exact_hinf_norm, load_compleib, partition
 from ._synthesis import (StartRecord, SynthesisOptions, SynthesisResult, synthesize,
@@ -15,4 +18,5 @@ from ._synthesis import (StartRecord, SynthesisOptions, SynthesisResult, synthes
 
 __all__ = ["synthesize", "SynthesisOptions", "SynthesisResult", "StartRecord",
            "design_flutter_controller", "with_flap_rate", "FlutterDesign", "loop_abscissa",
+           "stabilize_interval", "full_order_start", "IntervalReach",
            "load_compleib", "partition", "Partition", "exact_hinf_norm", "hinf_norm", "verify_closed_loop"]

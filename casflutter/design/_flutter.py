@@ -198,12 +198,19 @@ def design_flutter_controller(system: AeroelasticSystem, Vf: float, order: int =
     lft = build_lft(system, Vf)
     if not speeds or any(not f > 0 for f in speeds):
         raise ConfigError(f"speeds = {list(speeds)!r}: positive multiples of Vf")
-    hinf = [build_lft(system, float(f) * Vf).P for f in speeds]
     if flap_rate_weight < 0:
         raise ConfigError(f"flap_rate_weight = {flap_rate_weight!r}: >= 0 (0: no penalty)")
-    if flap_rate_weight > 0:
-        hinf = [with_flap_rate(P, lft.nmeas, flap_rate_weight, flap_rate_bandwidth)
-                for P in hinf]
+
+    def plant_at(V: float) -> control.StateSpace:
+        """The LFT at ``V`` in the form every plant of the design shares: the stability
+        plants carry the flap-rate output too (it adds one stable filter state), so that
+        all plants have the same ``w, z, u, y`` sizes."""
+        P = build_lft(system, V).P
+        if flap_rate_weight > 0:
+            P = with_flap_rate(P, lft.nmeas, flap_rate_weight, flap_rate_bandwidth)
+        return P
+
+    hinf = [plant_at(float(f) * Vf) for f in speeds]
     if not interval:
         syn = synthesize(hinf, lft.nmeas, lft.ncon, order, starts=starts, seed=seed,
                          options=opts)
@@ -235,7 +242,7 @@ def design_flutter_controller(system: AeroelasticSystem, Vf: float, order: int =
         rounds += 1
         top = min(hi, e + dV)
         speeds = _speeds(lo, top, n_speeds, Vf)
-        stab = [build_lft(system, float(V)).P for V in speeds]
+        stab = [plant_at(float(V)) for V in speeds]
         try:
             trial = synthesize(hinf, lft.nmeas, lft.ncon, order, starts=0, seed=seed,
                                initial=K, stability_plants=stab,
@@ -252,7 +259,7 @@ def design_flutter_controller(system: AeroelasticSystem, Vf: float, order: int =
     # the last interval reached, then the full H∞ budget on it
     syn, e = best
     speeds = _speeds(lo, e, n_speeds, Vf)
-    stab = [build_lft(system, float(V)).P for V in speeds]
+    stab = [plant_at(float(V)) for V in speeds]
     try:
         final = synthesize(hinf, lft.nmeas, lft.ncon, order, starts=0, seed=seed,
                            initial=syn.controller, stability_plants=stab, options=opts)

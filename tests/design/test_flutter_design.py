@@ -59,3 +59,21 @@ def test_interval_must_contain_vf():
     system, Vf = seed_wing_loop()
     with pytest.raises(ConfigError, match="interval"):
         design_flutter_controller(system, Vf, 1, interval=(1.5 * Vf, 2 * Vf))
+
+
+def test_interval_design_with_the_flap_rate_output():
+    """The default configuration's flap-rate weight with an interval: the stability plants
+    carry the flap-rate output too (before, every plant-size check refused the design)."""
+    system, Vf = seed_wing_loop()
+    lo, hi = 0.05, 1.45
+    res = design_flutter_controller(system, Vf, 2, interval=(lo, hi), n_speeds=10, steps=1,
+                                    starts=1, seed=0, flap_rate_weight=0.003,
+                                    flap_rate_bandwidth=251.3,
+                                    options=SynthesisOptions(max_outer=15, zero_start=False))
+    assert res.met and res.reached == (lo, hi)
+    lft = build_lft(system, Vf)
+    ver = verify_controller(lft.P, res.controller, lft.nmeas, lft.ncon, Vf=Vf,
+                            n_delta=lft.n_delta)
+    assert ver.stable and ver.exact_V[0] <= lo and ver.exact_V[1] >= hi
+    # γ of the design is the weighted plant's: at least the paper's γ on the LFT alone
+    assert res.gamma >= ver.gamma * (1 - 1e-9)

@@ -1,0 +1,203 @@
+"""``casflutter bench interval``: how far one controller holds the seed wing's ROM loop stable.
+
+The question of issue-size: can a single linear controller keep ΣAE(V) (eq. 8-9) stable over
+the paper's interval V ∈ (0.05, 2.4)?  Two continuations bracket the answer
+(:func:`casflutter.design.stabilize_interval`):
+
+* from the low end: the paper's design at Vf of each ``--orders`` (the run configuration's
+  controller settings), its upper end pushed towards the target;
+* from the high end (``--full-order``): an LQG controller of the loop's own order designed at
+  the target's upper end, its lower end pushed down.
+
+Every controller's exact stable interval is then certified by the independent verification
+layer (:func:`casflutter.verify.verify_controller`, guardian map on the LFT at Vf).  The JSON
+also lists, per accelerometer channel, the speeds at which a complex zero pair of
+``v → zm_j`` crosses into the right half-plane near the flutter frequency: the plant property
+the two continuations stall at.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import os
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import scipy.linalg
+
+__all__ = ["register", "load_rom_loop"]
+
+_log = logging.getLogger(__name__)
+_ROOT = Path(__file__).resolve().parents[3]
+DEFAULT_ROM = _ROOT / "problems" / "seed_wing" / "rom_loop_seed0.npz"
+
+
+def load_rom_loop(path: Path):
+    """ΣAE and Vf from an ``.npz`` with Σf (``Af, Bf, bf, Cf, Df, df``), the structure
+    (``omega, zeta, alpha, Hs, sensor``) and ``Vf``."""
+    from ...aeroelastic import AeroelasticSystem  # noqa: PLC0415
+    from ...errors import DataError  # noqa: PLC0415
+    from ...structure import ModalStructure  # noqa: PLC0415
+
+    keys = ("Af", "Bf", "bf", "Cf", "Df", "df", "omega", "zeta", "alpha", "Hs", "sensor", "Vf")
+    try:
+        d = np.load(path)
+    except (OSError, ValueError) as exc:
+        raise DataError(f"{path}: not a readable .npz ROM-loop file ({exc})") from None
+    missing = [k for k in keys if k not in d]
+    if missing:
+        raise DataError(f"{path}: missing {missing}; the file needs {list(keys)} "
+                        "(see problems/seed_wing/rom_loop_seed0.npz)")
+    s = ModalStructure(omega=d["omega"], zeta=d["zeta"], alpha=float(d["alpha"]), Hs=d["Hs"],
+                       sensor=str(d["sensor"]))
+    return (AeroelasticSystem(s, d["Af"], d["Bf"], d["bf"], d["Cf"], d["Df"], d["df"]),
+            float(d["Vf"]))
+
+
+def _rhp_zero_crossings(system, lo: float, hi: float, band: tuple[float, float],
+                        n: int = 236) -> list[dict[str, Any]]:
+    """Speeds where a complex zero pair of ``v → zm_j`` with frequency in ``band`` enters the
+    right half-plane, per sensor ``j`` (zeros: finite generalised eigenvalues of the
+    Rosenbrock pencil)."""
+    out: list[dict[str, Any]] = []
+    grid = np.linspace(lo, hi, n)
+    m = system.loop(lo).C2.shape[0]
+    for j in range(m):
+        prev = None
+        for V in grid:
+            lp = system.loop(float(V))
+            N = lp.A.shape[0]
+            M = np.block([[lp.A, lp.B2[:, None]], [lp.C2[j:j + 1], lp.D22[j:j + 1, None]]])
+            E = np.zeros_like(M)
+            E[:N, :N] = np.eye(N)
+            z = scipy.linalg.eigvals(M, E)
+            z = z[np.isfinite(z)]
+            inband = z[(z.imag > band[0]) & (z.imag < band[1]) & (z.real > 0)]
+            if prev is not None and inband.size > prev:
+                zz = inband[np.argmin(inband.real)]
+                out.append({"sensor": j, "V": float(V), "zero": [float(zz.real),
+                                                                 float(zz.imag)]})
+            prev = inband.size
+    return out
+
+
+def _verified(system, nominal: float, K) -> dict[str, Any]:
+    """The verification layer's exact stable interval of ΣAE(V) closed by ``K``, on the LFT
+    built at ``nominal`` (eq. 10-15 hold around any nominal speed, not only Vf)."""
+    from ...aeroelastic import build_lft  # noqa: PLC0415
+    from ...verify import verify_controller  # noqa: PLC0415
+
+    lft = build_lft(system, nominal)
+    ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=nominal, n_delta=lft.n_delta)
+    ex = ver.exact_V
+    return {"nominal": nominal, "stable_at_nominal": bool(ver.stable),
+            "gamma": float(ver.gamma) if np.isfinite(ver.gamma) else None,
+            "exact_interval": [float(ex[0]), float(ex[1])] if ex is not None else None}
+
+
+def _reach_record(kind: str, order: int, reach, verified: dict, wall: float) -> dict:
+    return {"start": kind, "order": order, "anchor": reach.anchor,
+            "reached": list(reach.reached), "met": reach.met,
+            "worst_abscissa": reach.worst_abscissa, **{f"verified_{k}": v
+                                                        for k, v in verified.items()},
+            "history": [list(h) for h in reach.history], "wall_time_s": wall}
+
+
+def _handler(args: argparse.Namespace) -> int:
+    from ...design import (SynthesisOptions, design_flutter_controller,  # noqa: PLC0415
+                           full_order_start, stabilize_interval)
+    from ...errors import CasflutterError  # noqa: PLC0415
+    from ...pipeline import load_config  # noqa: PLC0415
+    from ..._outputs import check_output_path  # noqa: PLC0415
+    from ..._settings import settings_as  # noqa: PLC0415
+
+    try:
+        lo, hi = (float(x) for x in str(args.interval).split(","))
+        orders = [int(o) for o in str(args.orders).split(",") if o.strip()]
+    except ValueError:
+        print("casflutter bench interval: --interval LO,HI and --orders K,K,... (numbers)",
+              file=sys.stderr)
+        return 2
+    if not 0 <= lo < hi or any(k < 1 for k in orders):
+        print("casflutter bench interval: need 0 <= LO < HI and orders >= 1", file=sys.stderr)
+        return 2
+    try:    # everything checked before any design work; nothing is written until a result
+        out = check_output_path(args.out, what="--out", suffixes=(".json",))
+        system, Vf = load_rom_loop(Path(args.rom))
+        cfg = load_config(args.config)
+    except (OSError, CasflutterError) as exc:
+        print(f"casflutter bench interval: {exc}", file=sys.stderr)
+        return 2
+    c = cfg.controller
+    options = replace(settings_as(c, SynthesisOptions), ipopt={**cfg.solver.ipopt, **c.ipopt})
+    doc: dict[str, Any] = {"rom": str(args.rom), "Vf": Vf, "target": [lo, hi], "runs": []}
+
+    def write():
+        reached_low = [r["reached"][1] for r in doc["runs"] if r["anchor"] == "low"]
+        reached_high = [r["reached"][0] for r in doc["runs"] if r["anchor"] == "high"]
+        doc["summary"] = {
+            "highest_upper_end_from_low": max(reached_low, default=None),
+            "lowest_lower_end_from_high": min(reached_high, default=None),
+            "met_by_any": any(r["met"] for r in doc["runs"]),
+            "machine": {"cpus": os.cpu_count(), "load_average": list(os.getloadavg())
+                        if hasattr(os, "getloadavg") else None}}
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = out.with_name(out.name + ".tmp")
+        tmp.write_text(json.dumps(doc, indent=1, default=float))
+        tmp.replace(out)
+
+    for order in orders:
+        t0 = time.perf_counter()
+        design = design_flutter_controller(
+            system, Vf, order, starts=c.starts, seed=args.seed, options=options,
+            flap_rate_weight=c.flap_rate_weight, flap_rate_bandwidth=c.flap_rate_bandwidth)
+        reach = stabilize_interval(system, design.controller, (lo, hi), anchor="low")
+        rec = _reach_record(f"paper design at Vf (seed {args.seed})", order, reach,
+                            _verified(system, Vf, reach.controller), time.perf_counter() - t0)
+        rec["verified_start"] = _verified(system, Vf, design.controller)   # γ at Vf
+        doc["runs"].append(rec)
+        print(f"order {order} from the low end: reached {reach.reached}, verified "
+              f"{rec['verified_exact_interval']}", file=sys.stderr, flush=True)
+        write()
+    if args.full_order:
+        t0 = time.perf_counter()
+        K0 = full_order_start(system, hi)
+        reach = stabilize_interval(system, K0, (lo, hi), anchor="high")
+        rec = _reach_record(f"LQG at V = {hi:g}", K0.nstates, reach,
+                            _verified(system, hi, reach.controller), time.perf_counter() - t0)
+        doc["runs"].append(rec)
+        print(f"full order {K0.nstates} from the high end: reached {reach.reached}, verified "
+              f"{rec['verified_exact_interval']}", file=sys.stderr, flush=True)
+        write()
+    doc["rhp_zero_crossings"] = _rhp_zero_crossings(system, lo, hi, tuple(args.zero_band))
+    write()
+    print(f"wrote {out}", file=sys.stderr)
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add ``bench interval`` to the ``casflutter bench`` sub-commands."""
+    p = subparsers.add_parser(
+        "interval", help="how far one controller holds the ROM loop stable; writes JSON",
+        description=__doc__.split("\n\n")[1])
+    p.add_argument("--rom", default=str(DEFAULT_ROM),
+                   help="ROM loop .npz (default: the seed wing's, seed 0)")
+    p.add_argument("--config", default=None,
+                   help="run configuration for the controller settings (default: the seed "
+                        "wing's run.toml)")
+    p.add_argument("--interval", default="0.05,2.4", help="target speed-index interval LO,HI")
+    p.add_argument("--orders", default="3", help="orders of the low-end continuations")
+    p.add_argument("--full-order", action=argparse.BooleanOptionalAction, default=True,
+                   help="also the full-order continuation from the high end")
+    p.add_argument("--zero-band", type=float, nargs=2, default=(20.0, 80.0),
+                   metavar=("W_LO", "W_HI"),
+                   help="frequency band [rad/s] of the zero crossings reported")
+    p.add_argument("--seed", type=int, default=0, help="seed of the paper design's starts")
+    p.add_argument("--out", required=True, help="output JSON file")
+    p.set_defaults(func=_handler)

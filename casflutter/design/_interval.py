@@ -1,0 +1,296 @@
+"""How far one fixed controller keeps ΣAE(V) stable: continuation of a speed interval (eq. 8-9).
+
+The paper's controller is designed at Vf and reported stable over a speed interval.  Whether a
+single linear controller can hold the whole interval is a simultaneous-stabilisation problem
+over the family ΣAE(V), for which no finite test exists; this module answers it
+constructively, the way HIFOO's stabilisation phase does for one plant:
+
+* the objective is the worst closed-loop spectral abscissa over ``n_speeds`` speeds of the
+  current interval, ``max_j α(A_cl(V_j))``, smoothed by a log-sum-exp of temperature ``τ``
+  (``τ → 0`` recovers the max) and minimised over ``(Ak, Bk, Ck)`` by BFGS with the exact
+  gradient ``∂λ/∂A_cl = u vᵀ / (uᵀ v)`` of the rightmost eigenvalue (left/right
+  eigenvectors ``u``, ``v``) through the closed-loop map of
+  :meth:`~casflutter.aeroelastic.AeroelasticSystem.closed_loop_state_matrix`;
+* continuation: starting where the given controller already decays, one end of the interval
+  is pushed a step towards the target; a step is kept when the loop decays at the rate
+  ``decay`` on a dense scan of the new interval, grows 1.5x after a success and halves after
+  a failure, until the target is met or the step falls below ``min_step``.
+
+Pushing from the low end with a low-order controller and from the high end with a full-order
+one brackets what the family allows: where the two continuations stall, no controller that
+either method could reach holds the loop.  The result states the interval reached; its exact
+interval is for the independent verification layer to certify.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import control
+import numpy as np
+import scipy.linalg
+from scipy.optimize import minimize
+
+from .._threads import single_threaded
+from ..aeroelastic import AeroelasticSystem
+from ..errors import ConfigError, DimensionError
+
+__all__ = ["IntervalReach", "full_order_start", "stabilize_interval"]
+
+log = logging.getLogger("casflutter.design")
+
+
+@dataclass(frozen=True)
+class IntervalReach:
+    """Outcome of :func:`stabilize_interval`.
+
+    Attributes
+    ----------
+    controller : control.StateSpace
+        ``K(s)`` on the physical sensors (``v = K zm``), of the order of the start.
+    reached : tuple of float
+        ``(lo, hi)``: the last interval on which the loop decays at the rate ``decay`` on the
+        dense scan.
+    target : tuple of float
+        The requested interval.
+    anchor : str
+        ``"low"`` (the upper end was pushed) or ``"high"`` (the lower end was pushed).
+    worst_abscissa : float
+        Largest closed-loop spectral abscissa (rad/s) on the dense scan of ``reached``.
+    history : tuple of tuple
+        ``(lo, hi, worst)`` of every interval tried, in order (``worst`` on its grid).
+    met : bool
+        True when ``reached`` is the target.
+    """
+
+    controller: control.StateSpace
+    reached: tuple
+    target: tuple
+    anchor: str
+    worst_abscissa: float
+    history: tuple
+    met: bool
+
+
+def _unpack(p: np.ndarray, n: int, m: int):
+    """``(Ak, Bk, Ck)`` of an order-``n`` controller on ``m`` sensors from its parameters."""
+    return (p[:n * n].reshape(n, n), p[n * n:n * n + n * m].reshape(n, m),
+            p[n * n + n * m:].reshape(1, n))
+
+
+class _LoopFamily:
+    """ΣAE(V_j) at a set of speeds and the closed loop's rightmost eigenvalue and its gradient
+    with respect to ``(Ak, Bk, Ck)`` (``Dk`` held fixed)."""
+
+    def __init__(self, system: AeroelasticSystem, speeds, order: int, Dk: np.ndarray):
+        self.order, self.Dk = order, Dk
+        self.loops = [system.loop(float(V)) for V in speeds]
+        m = self.loops[0].C2.shape[0]
+        self.m = m
+
+    def rightmost(self, p: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
+        Ak, Bk, Ck = _unpack(p, self.order, self.m)
+        values, grads = [], []
+        for lp in self.loops:
+            s = 1.0 - float((self.Dk @ lp.D22)[0])
+            B2 = lp.B2[:, None] / s
+            vx = (self.Dk @ lp.C2) / s
+            zx = lp.C2 + lp.D22[:, None] @ vx
+            D22 = lp.D22[:, None]
+            Acl = np.block([[lp.A + lp.B2[:, None] @ vx, B2 @ Ck],
+                            [Bk @ zx, Ak + Bk @ D22 @ Ck / s]])
+            lam, VL, VR = scipy.linalg.eig(Acl, left=True, right=True)
+            i = int(np.argmax(lam.real))
+            u, v = VL[:, i].conj(), VR[:, i]
+            G = np.real(np.outer(u, v) / (u @ v))            # ∂λ/∂A_cl, real part
+            nx = lp.A.shape[0]
+            Gxk, Gkx, Gkk = G[:nx, nx:], G[nx:, :nx], G[nx:, nx:]
+            dAk = Gkk
+            dBk = Gkx @ zx.T + Gkk @ (D22 @ Ck / s).T
+            dCk = B2.T @ Gxk + (Bk @ D22 / s).T @ Gkk
+            values.append(float(lam[i].real))
+            grads.append(np.concatenate([dAk.ravel(), dBk.ravel(), dCk.ravel()]))
+        return np.array(values), grads
+
+    def smoothed(self, p: np.ndarray, tau: float | None) -> tuple[float, np.ndarray]:
+        a, g = self.rightmost(p)
+        k = int(np.argmax(a))
+        if tau is None or not np.isfinite(a[k]):
+            return float(a[k]), g[k]
+        w = np.exp((a - a[k]) / tau)
+        total = float(np.sum(w))
+        return float(a[k] + tau * math.log(total)), sum((wi / total) * gi for wi, gi in zip(w, g))
+
+
+def _dense_worst(system: AeroelasticSystem, K: control.StateSpace, lo: float, hi: float,
+                 n: int) -> float:
+    worst = -np.inf
+    for V in np.linspace(lo, hi, n):
+        try:
+            A = system.closed_loop_state_matrix(float(V), K)
+        except DimensionError:                 # a singular algebraic loop
+            return np.inf
+        worst = max(worst, float(np.max(np.linalg.eigvals(A).real)))
+    return worst
+
+
+def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
+                       anchor: str = "low", decay: float = 0.05, n_speeds: int = 40,
+                       first_step: float = 0.05, min_step: float = 0.0025,
+                       max_iter: int = 300, max_rounds: int = 200) -> IntervalReach:
+    """Extend the speed interval over which one controller keeps ΣAE(V) decaying.
+
+    Parameters
+    ----------
+    system : AeroelasticSystem
+        Σf and Σs: ΣAE(V) of eq. 8-9 at any speed index.
+    controller : control.StateSpace
+        The start ``K(s)`` (``v = K zm``, as :meth:`AeroelasticSystem.closed_loop_state_matrix`);
+        its order is kept and its ``D`` is held fixed (0 for a strictly proper controller).
+        It must stabilise ΣAE at the anchor end of the interval.
+    interval : (lo, hi)
+        Target speed-index interval, ``0 <= lo < hi``.
+    anchor : {"low", "high"}
+        The end the continuation starts from; the other end is pushed towards the target.
+    decay : float
+        Decay rate (rad/s) required at every speed of the interval.
+    n_speeds : int
+        Speeds of the objective on each interval tried (the dense check uses 8x as many).
+    first_step, min_step : float
+        First and smallest continuation step in V.
+    max_iter : int
+        BFGS iterations per temperature of the smoothed maximum (0.3, 0.1, 0.03, exact).
+    max_rounds : int
+        Continuation steps at most.
+
+    Returns
+    -------
+    IntervalReach
+
+    Raises
+    ------
+    ConfigError
+        A bad interval, anchor or setting, or a start that does not decay at the anchor end.
+    DimensionError
+        A controller that does not map the sensors to the flap.
+
+    See Also
+    --------
+    design_flutter_controller : H∞ design at Vf with stability over an interval.
+    casflutter.verify.verify_controller : the independent exact stable interval.
+    """
+    lo, hi = (float(x) for x in interval)
+    if not (0 <= lo < hi and math.isfinite(hi)):
+        raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
+    if anchor not in ("low", "high"):
+        raise ConfigError(f"anchor = {anchor!r}: 'low' or 'high'")
+    if not (decay >= 0 and n_speeds >= 2 and 0 < min_step <= first_step and max_iter >= 1):
+        raise ConfigError(f"need decay >= 0, n_speeds >= 2, 0 < min_step <= first_step, "
+                          f"max_iter >= 1; got decay={decay!r}, n_speeds={n_speeds!r}, "
+                          f"min_step={min_step!r}, first_step={first_step!r}, "
+                          f"max_iter={max_iter!r}")
+    K = control.ss(controller)
+    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (K.A, K.B, K.C, K.D))
+    order = K.nstates
+    m = system.loop(lo).C2.shape[0]
+    if Dk.shape != (1, m) or order == 0:
+        raise DimensionError(f"need a dynamic controller with {m} inputs (the sensors) and 1 "
+                             f"output (the flap); got order {order}, D of shape {Dk.shape}")
+    dense = 8 * n_speeds
+    with single_threaded():
+        start = hi if anchor == "high" else lo
+        if not _dense_worst(system, K, start, start, 1) < 0:
+            raise ConfigError(f"the start controller does not stabilise ΣAE at the anchor "
+                              f"V = {start:.4g}; start from a controller designed there")
+        # where the start already decays, scanning away from the anchor
+        grid = np.linspace(lo, hi, dense)
+        if anchor == "high":
+            grid = grid[::-1]
+        edge = start
+        for V in grid:
+            if _dense_worst(system, K, V, V, 1) > -decay:
+                break
+            edge = float(V)
+        cur = (lo, edge) if anchor == "low" else (edge, hi)
+        p = np.concatenate([Ak.ravel(), Bk.ravel(), Ck.ravel()])
+        step, history = float(first_step), []
+        log.info("interval continuation (%s end, order %d): the start decays on [%.4g, %.4g]",
+                 anchor, order, *cur)
+        rounds = 0
+        while cur != (lo, hi) and step >= min_step and rounds < max_rounds:
+            rounds += 1
+            trial = ((cur[0], min(hi, cur[1] + step)) if anchor == "low"
+                     else (max(lo, cur[0] - step), cur[1]))
+            fam = _LoopFamily(system, np.linspace(*trial, n_speeds), order, Dk)
+            q = p
+            for tau in (0.3, 0.1, 0.03, None):
+                if fam.smoothed(q, None)[0] <= -2 * decay:
+                    break
+                res = minimize(fam.smoothed, q, args=(tau,), jac=True, method="BFGS",
+                               options={"maxiter": int(max_iter)})
+                if np.all(np.isfinite(res.x)) and \
+                        fam.smoothed(res.x, None)[0] < fam.smoothed(q, None)[0]:
+                    q = res.x
+            worst = fam.smoothed(q, None)[0]
+            history.append((trial[0], trial[1], worst))
+            ok = worst <= -decay
+            if ok:
+                Kq = control.ss(*_unpack(q, order, m), Dk)
+                ok = _dense_worst(system, Kq, *trial, dense) <= -decay
+            log.info("interval continuation: [%.4g, %.4g] worst abscissa %.4g -> %s", *trial,
+                     worst, "kept" if ok else f"step {step / 2:.3g}")
+            if ok:
+                p, cur, step = q, trial, 1.5 * step
+            else:
+                step *= 0.5
+        Kout = control.ss(*_unpack(p, order, m), Dk) if rounds else K
+        worst = _dense_worst(system, Kout, *cur, dense)
+    return IntervalReach(Kout, cur, (lo, hi), anchor, worst, tuple(history), cur == (lo, hi))
+
+
+def full_order_start(system: AeroelasticSystem, V: float, *, state_weight: float = 0.01,
+                     noise_ratio: float = 1.0) -> control.StateSpace:
+    """A full-order observer-based (LQG) controller of ΣAE at one speed, to start from.
+
+    ``v = −Kx x̂`` with the LQR gain of ``(A, B2)`` for ``Q = state_weight·I``, ``R = 1`` and
+    the Kalman observer ``x̂' = A x̂ + B2 v + L (zm − C2 x̂ − D22 v)`` for unit process noise
+    on every state and measurement noise ``noise_ratio·I``; as ``v = K zm`` (eq. 8-9) it is
+    strictly proper, of the loop's order.
+
+    Parameters
+    ----------
+    system : AeroelasticSystem
+        Σf and Σs.
+    V : float
+        Speed index of the design.
+    state_weight, noise_ratio : float
+        LQR state weight and Kalman measurement-to-process noise ratio (> 0).
+
+    Returns
+    -------
+    control.StateSpace
+        ``K(s)``, sensors to flap.
+
+    Raises
+    ------
+    ConfigError
+        A weight that is not > 0.
+
+    See Also
+    --------
+    stabilize_interval : continues the interval such a controller holds.
+    """
+    if not (state_weight > 0 and noise_ratio > 0):
+        raise ConfigError(f"state_weight = {state_weight!r} and noise_ratio = {noise_ratio!r}: "
+                          "both > 0")
+    lp = system.loop(float(V))
+    n, m = lp.A.shape[0], lp.C2.shape[0]
+    B2 = lp.B2[:, None]
+    Kx, _, _ = control.lqr(lp.A, B2, state_weight * np.eye(n), np.eye(1))
+    L, _, _ = control.lqe(lp.A, np.eye(n), lp.C2, np.eye(n), noise_ratio * np.eye(m))
+    Kx, L = np.asarray(Kx), np.asarray(L)
+    D22 = lp.D22[:, None]
+    return control.ss(lp.A - B2 @ Kx - L @ lp.C2 + L @ D22 @ Kx, L, -Kx, np.zeros((1, m)))
+

@@ -1,0 +1,70 @@
+"""How far one controller holds the seed wing's ROM loop stable (continuation in speed).
+
+Fixture: ``problems/seed_wing/rom_loop_seed0.npz`` (Σf and Σs of the default run, seed 0).
+Truth used: the independent verification layer's exact stable interval (guardian map on the
+LFT at Vf) and eigenvalues of the closed loop computed here.
+"""
+
+from __future__ import annotations
+
+import control
+import numpy as np
+import pytest
+
+from casflutter.aeroelastic import build_lft
+from casflutter.design import full_order_start, loop_abscissa, stabilize_interval
+from casflutter.errors import ConfigError
+from casflutter.verify import verify_controller
+
+from casflutter.cli.bench.interval import DEFAULT_ROM, load_rom_loop
+
+
+def seed_wing_loop():
+    return load_rom_loop(DEFAULT_ROM)
+
+
+def _exact(system, nominal, K):
+    """The verification layer's exact interval on the LFT built at ``nominal``."""
+    lft = build_lft(system, nominal)
+    return verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=nominal, n_delta=lft.n_delta)
+
+
+def test_continuation_extends_the_interval_and_the_verification_certifies_it():
+    system, _ = seed_wing_loop()
+    hi, lo = 2.4, 2.15
+    start = full_order_start(system, hi)
+    # the start does not hold (lo, hi): the loop is unstable at lo
+    assert loop_abscissa(system, start, [lo])[0] > 0
+    reach = stabilize_interval(system, start, (lo, hi), anchor="high", n_speeds=20)
+    assert reach.met and reach.reached == (lo, hi)
+    assert reach.controller.nstates == start.nstates
+    ver = _exact(system, hi, reach.controller)
+    assert ver.stable and ver.exact_V[0] <= lo and ver.exact_V[1] >= hi
+    # the continuation's own dense scan agrees with eigenvalues computed here
+    assert np.all(loop_abscissa(system, reach.controller, np.linspace(lo, hi, 60)) < 0)
+    assert reach.worst_abscissa < 0
+
+
+def test_full_order_start_stabilises_the_loop_at_its_speed():
+    system, _ = seed_wing_loop()
+    for V in (1.5, 2.4):
+        K = full_order_start(system, V)
+        assert K.nstates == system.n_states
+        A = system.closed_loop_state_matrix(V, K)
+        assert np.max(np.linalg.eigvals(A).real) < 0
+        # and the open loop there is unstable: the controller does the work
+        assert np.max(np.linalg.eigvals(system.state_matrix(V)).real) > 0
+
+
+def test_bad_requests_are_refused_before_any_work():
+    system, Vf = seed_wing_loop()
+    K = full_order_start(system, 2.4)
+    with pytest.raises(ConfigError, match="interval"):
+        stabilize_interval(system, K, (2.0, 1.0))
+    with pytest.raises(ConfigError, match="anchor"):
+        stabilize_interval(system, K, (0.05, 2.4), anchor="middle")
+    idle = control.ss([[-1.0]], [[0.0, 0.0]], [[0.0]], [[0.0, 0.0]])   # K = 0
+    with pytest.raises(ConfigError, match="does not stabilise"):
+        stabilize_interval(system, idle, (0.05, 2.4), anchor="high")   # open loop flutters
+    with pytest.raises(ConfigError, match="> 0"):
+        full_order_start(system, 2.4, state_weight=0.0)
