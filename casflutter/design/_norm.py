@@ -208,17 +208,25 @@ def _refine_peak(A, B, C, D, a: float, b: float, w0: float, xatol: float = 1e-6
 def active_frequencies(A, B, C, D, gamma: float, omega_peak: float, *, ratio: float = 0.6,
                        max_count: int = 8) -> list[tuple[float, float]]:
     """Local maxima of ``σ_max(T(jω))`` above ``ratio * gamma``: ``[(ω, σ), ...]`` by
-    decreasing σ, the exact peak first.
+    decreasing σ, the exact peak first; ``ω = inf`` stands for the feed-through ``σ_max(D)``
+    when the norm is the feed-through (otherwise that piece would have no cut at all).
 
     The bands where ``σ_max > ratio γ`` are delimited by the imaginary eigenvalues of the
     Hamiltonian at that level; one local maximum is located in each band.
     """
     out: list[tuple[float, float]] = []
-    if np.isfinite(omega_peak):
-        out.append((float(omega_peak), float(gamma)))
     n = A.shape[0]
     sD = float(np.linalg.norm(D, 2)) if D.size else 0.0
     level = ratio * gamma
+    if np.isfinite(omega_peak):
+        out.append((float(omega_peak), float(gamma)))
+    else:
+        # the norm is the feed-through: its piece (ω = ∞) is the active one, and the local
+        # maxima above the feed-through level are the others
+        out.append((np.inf, sD))
+        level = max(level, sD * (1 + 1e-6))
+        if n == 0 or level >= gamma:
+            return out
     if n == 0 or level <= sD * (1 + 1e-9):
         return out
     w = level_crossings(A, B, C, D, level)

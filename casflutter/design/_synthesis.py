@@ -41,6 +41,7 @@ import numpy as np
 
 from .._threads import single_threaded
 from ..errors import ConfigError, DimensionError, SynthesisError
+from ._fullorder import full_order_controller, reduced_controllers
 from ._plant import Partition, partition
 from ._problem import Cut, Problem, realize, verify_closed_loop
 from ._qp import CutQP
@@ -55,7 +56,7 @@ log = logging.getLogger("casflutter.design")
 class SynthesisOptions:
     """Settings of :func:`synthesize` (checked on construction)."""
 
-    max_outer: int = 300
+    max_outer: int = 600
     """Maximum number of H∞ iterations (QP steps, accepted or not) per start."""
     max_stab_rounds: int = 150
     """Maximum number of stabilisation iterations per start."""
@@ -99,6 +100,13 @@ class SynthesisOptions:
     H∞ iterations is stopped (deterministic: counted in iterations)."""
     abandon_ratio: float = 1.5
     """See ``abandon_after``."""
+    full_order_start: bool = True
+    """For a single H∞ plant without stability plants: also start from the full-order H∞
+    central controller reduced to the order (:mod:`._fullorder`; only regular problems,
+    ``D12`` full column rank and ``D21`` full row rank, and only with slycot installed)."""
+    full_order_gamma_factor: float = 1.1
+    """The full-order controller is the central one at this factor times the optimal
+    full-order level (``> 1``)."""
     ipopt: Mapping[str, Any] = field(default_factory=dict)
     """Extra flat Ipopt options of the QP subproblems."""
 
@@ -111,7 +119,8 @@ class SynthesisOptions:
                   "active_ratio": 0 < self.active_ratio < 1,
                   "abandon_after": self.abandon_after >= 1,
                   "stall_window": self.stall_window >= 2, "stall_tol": 0 <= self.stall_tol < 1, "abandon_ratio": self.abandon_ratio > 1,
-                  "time_limit": self.time_limit is None or self.time_limit > 0}
+                  "time_limit": self.time_limit is None or self.time_limit > 0,
+                  "full_order_gamma_factor": self.full_order_gamma_factor > 1}
         bad = [k for k, ok in checks.items() if not ok]
         if bad:
             raise ConfigError(f"invalid SynthesisOptions field(s) {bad}: need max_outer>=1, "
@@ -119,7 +128,7 @@ class SynthesisOptions:
                               "decay>=0, 0<min_det<1, trust_region>0, max_trust_region>="
                               "trust_region, 0<active_ratio<1, abandon_after>=1, abandon_ratio>1, "
                               "stall_window>=2, 0<=stall_tol<1, "
-                              "time_limit None or >0")
+                              "time_limit None or >0, full_order_gamma_factor>1")
 
 
 @dataclass(frozen=True)
@@ -132,8 +141,9 @@ class StartRecord:
         Index of the start.
     kind : str
         ``"given"`` (an initial controller passed in), ``"given-perturbed"`` (the same padded
-        to the order with small random couplings of the new states), ``"zero"`` or
-        ``"random"``.
+        to the order with small random couplings of the new states),
+        ``"full-order-reduced"`` (the full-order H∞ controller reduced to the order,
+        :mod:`._fullorder`), ``"zero"`` or ``"random"``.
     stabilized : bool
         Whether the stabilisation phase ended with a stable, well-posed loop (the decay
         rates met, or at least a negative spectral abscissa).
@@ -275,6 +285,29 @@ def _initial_gain(prob: Problem, kind: str, rng: np.random.Generator,
     return K
 
 
+def _shrunk(prob: Problem, K0: np.ndarray) -> np.ndarray | None:
+    """``K0`` with its couplings to the loop (``Dk, Bk, Ck``) halved until the worst
+    spectral abscissa (scaled time, where the plants' time scale is 1) is at most
+    ``max(α0, 0) + 0.05``, ``α0`` the abscissa with those couplings at zero (at most 20
+    halvings, keeping the loop well posed); ``None`` if that never happens."""
+    Z = K0.copy()
+    Z[:prob.nu, :] = 0.0
+    Z[:, :prob.ny] = 0.0
+    try:
+        a0 = max(float(np.max(prob.alphas(Z)[0])), 0.0) + 0.05
+    except np.linalg.LinAlgError:
+        return None
+    K = K0.copy()
+    for _ in range(20):
+        K = Z + 0.5 * (K - Z)
+        try:
+            if prob.well_posed(K) and float(np.max(prob.alphas(K)[0])) <= a0:
+                return K
+        except np.linalg.LinAlgError:
+            return None
+    return None
+
+
 @dataclass
 class _Phase:
     """One phase of the bundle iteration (module docstring)."""
@@ -314,6 +347,9 @@ class _Phase:
             if gj < self.opts.active_ratio * f:
                 continue
             ws = prob.peaks(K, j, gj, wj, self.opts.active_ratio * f / gj)
+            if memory[j]:
+                # the feed-through piece (ω = ∞) enters only a model that has no other piece
+                ws = [w for w in ws if np.isfinite(w)]
             memory[j] = _merge(ws, memory[j])
             obj += prob.sigma_cuts(K, j, memory[j], floor=self.opts.active_ratio * f)
         con = [c for c in prob.eig_cuts(K, 0.0, 0.0, delta, which="stab")]
@@ -560,10 +596,19 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
     plan = [("given", g) for g in given]
     # a lower-order start padded with decoupled states sits on a saddle (zero Bk, Ck for the
     # new states): also start from a slightly perturbed copy
-    plan += [("given-perturbed", g) for g in given if control.ss(g).nstates < order and starts]
+    plan += [("given-perturbed", g) for k, g in plan
+             if k == "given" and control.ss(g).nstates < order and starts]
     # with a given controller the zero start would only repeat it (decoupled states)
     plan += [("zero" if i == 0 and opts.zero_start and not given else "random", None)
              for i in range(starts)]
+    # last, so that they never make the abandon test stop one of the starts above early: the
+    # result is never worse than without them
+    if opts.full_order_start and len(parts) == 1 and not sparts:
+        full = full_order_controller(parts[0], opts.full_order_gamma_factor)
+        if full is not None:
+            # (a static reduction that is zero would only repeat the zero start)
+            plan += [("full-order-reduced", Kr) for Kr in reduced_controllers(full[0], order)
+                     if Kr.nstates or np.any(np.asarray(Kr.D) != 0)]
     records, gains = [], []
     best_alpha = np.inf
     log.info("synthesis: order %d, %d H-inf plant(s) (%d states), %d stability plant(s), "
@@ -574,7 +619,7 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
         statuses: list[str] = []
         label = f"start {s} ({kind})"
         m_start = margin
-        if kind.startswith("given"):
+        if kind.startswith("given") or kind == "full-order-reduced":
             # a stable given controller is kept as it is (its γ bounds this order's from above)
             a0 = float(np.max(prob.alphas(K0)[0]))
             if a0 < 0:
@@ -587,12 +632,30 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
         # the decay rates reached, or at least a stable, well-posed loop (the H∞ phase then
         # keeps it stable: every accepted step has a finite norm)
         ok = prob.feasible(K) and (phi <= 0.0 or (a_h < 0 and np.isfinite(phi)))
+        if not ok and kind == "random":
+            # a random gain that moved the loop far right of the zero controller's abscissa
+            # can leave the phase crawling at a (nearly) defective rightmost eigenvalue, where
+            # the linear cuts mispredict: retry once with the random part shrunk until the
+            # loop is no more unstable than with the zero controller (deterministic)
+            K1 = _shrunk(prob, K0)
+            if K1 is not None:
+                log.info("%s: stabilisation failed (abscissa %.4g rad/s); retried from the "
+                         "random gain shrunk towards zero", label, a_h)
+                r1b = stab.run(K1, label, opts.max_stab_rounds)
+                K, phi = r1b["K"], r1b["f"]
+                r1 = dict(r1b, iterations=r1["iterations"] + r1b["iterations"])
+                a_h = float(np.max(prob.alphas(K)[0])) * prob.w0
+                best_alpha = min(best_alpha, a_h)
+                ok = prob.feasible(K) and (phi <= 0.0 or (a_h < 0 and np.isfinite(phi)))
         log.info("%s: stabilisation %s after %d iterations (abscissa %.4g rad/s)", label,
                  "reached the decay rates" if ok else "failed", r1["iterations"], a_h)
         if ok:
             best_g = min((r.gamma for r in records if r.stabilized), default=np.inf)
             hinf = _Phase(prob, qp, opts, "hinf", m_start, deadline, statuses,
-                          abandon_above=opts.abandon_ratio * best_g)
+                          # the reduced full-order starts descend slowly at first from far
+                          # above (often unstable), but into a better basin: never abandoned
+                          abandon_above=np.inf if kind == "full-order-reduced"
+                          else opts.abandon_ratio * best_g)
             r2 = hinf.run(K, label, opts.max_outer)
             K, gam = r2["K"], r2["f"]
             hist, conv, outer, pred = tuple(r2["history"]), r2["converged"], r2["iterations"], \

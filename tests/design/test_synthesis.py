@@ -98,7 +98,9 @@ def test_zero_start_option_and_iteration_budget():
     # without a time limit the budget is counted in iterations: a tighter cap is visible
     # in the Ipopt statuses, and zero_start=False makes every start a seeded random one
     P, nmeas, ncon, _ = load_compleib(COMPLEIB / "AC4.json")
-    opts = SynthesisOptions(max_outer=3, max_iter=2, zero_start=False)
+    # (AC4 is a regular problem: without full_order_start it would also get the reduced
+    # full-order starts, tested in test_fullorder.py)
+    opts = SynthesisOptions(max_outer=3, max_iter=2, zero_start=False, full_order_start=False)
     r = synthesize(P, nmeas, ncon, 1, starts=2, seed=7, options=opts)
     assert [s.kind for s in r.starts] == ["random", "random"]
     assert all(s.outer_iterations <= 3 for s in r.starts)
@@ -107,7 +109,8 @@ def test_zero_start_option_and_iteration_budget():
     assert "Maximum_WallTime_Exceeded" not in statuses
     r0 = synthesize(P, nmeas, ncon, 1, starts=2, seed=7,
                     options=SynthesisOptions(max_outer=3, max_iter=2))
-    assert [s.kind for s in r0.starts] == ["zero", "random"]
+    assert [s.kind for s in r0.starts][:2] == ["zero", "random"]
+    assert all(s.kind == "full-order-reduced" for s in r0.starts[2:])
 
 
 # --------------------------------------------------------------------------- COMPleib
@@ -140,7 +143,12 @@ def test_ac4_unstable_plant_is_stabilised_and_gamma_is_the_exact_norm():
     assert np.max(control.poles(cl).real) < 0
     gamma_slicot = float(control.linfnorm(cl)[0])
     np.testing.assert_allclose(res.gamma, gamma_slicot, rtol=1e-6)
-    assert res.gamma >= meta["gamma_full_order_lmi"] * (1 - 1e-3)
+    # no controller beats the full-order optimum; AC4 is a regular problem, whose optimum the
+    # Riccati γ-iteration (SLICOT SB10AD, bisection to ~1e-8) gives more accurately than the
+    # LMI value of reference.json (0.55919, 0.3 % high: an order-1 design reaches 0.55733)
+    gamma_full = float(control.hinfsyn(P, nmeas, ncon)[2])
+    assert gamma_full <= meta["gamma_full_order_lmi"]
+    assert res.gamma >= gamma_full * (1 - 1e-6)
     g_check, _, alpha = verify_closed_loop(P, K, nmeas, ncon)
     np.testing.assert_allclose(g_check, res.gamma, rtol=1e-9)
     assert alpha < 0
