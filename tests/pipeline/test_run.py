@@ -195,3 +195,22 @@ def test_a_run_into_a_non_empty_folder_is_refused_before_any_work(reduced, monke
     assert err.startswith("casflutter: error: output folder ") and "--overwrite" in err
     assert "\n" not in err
     assert {p.name: p.stat().st_mtime_ns for p in out.iterdir()} == before
+
+
+@pytest.mark.parametrize("flag", ["-q", "--quiet"])
+def test_both_quiet_flags_silence_the_stage_progress(tmp_path, monkeypatch, flag):
+    """``-q`` (the global flag) also silences the driver's stage lines, not only logging."""
+    import casflutter.pipeline
+
+    seen = {}
+
+    class Stop(Exception):
+        pass
+
+    def fake_run(cfg, **kw):
+        seen.update(kw)
+        raise Stop
+
+    monkeypatch.setattr(casflutter.pipeline, "run", fake_run)
+    assert main(["run", "--out", str(tmp_path / "o"), flag]) != 0    # stopped in the driver
+    assert seen["quiet"] is True

@@ -28,7 +28,8 @@ def _main(args) -> int:
     # imported; the driver then refuses a non-empty folder without --overwrite, before any
     # work, and writes the outputs atomically at the end
     check_output_path(args.out, what="--out", kind="dir")
-    res = run(cfg, out_dir=args.out, seed=args.seed, quiet=args.quiet,
+    res = run(cfg, out_dir=args.out, seed=args.seed,
+              quiet=args.quiet or bool(getattr(args, "log_quiet", False)),
               overwrite=args.overwrite)
     s = res.summary()
     fl, ft = s["flutter"], s["flutter_truth"]
