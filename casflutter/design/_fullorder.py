@@ -152,7 +152,13 @@ def reduced_controllers(K: control.StateSpace, order: int) -> list[control.State
     Km = slow_modal(K, order)
     if Km is not None:
         out.append(Km)
+    unstable = int(np.sum(np.linalg.eigvals(np.asarray(K.A, float)).real >= 0))
     for method in ("truncate", "matchdc"):
+        if unstable > order:
+            # balred keeps the whole unstable part: the result would exceed the order
+            log.info("full-order start: no balanced reduction to order %d (%d unstable "
+                     "controller poles)", order, unstable)
+            break
         try:
             Kr = control.balred(K, order, method=method)
         except Exception as exc:  # noqa: BLE001 - SLICOT errors of several types
