@@ -322,6 +322,12 @@ def plain_json(x: Any):
     return x
 
 
+def print_json(doc: Any) -> None:
+    """Print ``doc`` on stdout as strict JSON (:func:`plain_json`: a non-finite number is
+    ``null``), the ``--json`` output of the commands."""
+    sys.stdout.write(json.dumps(plain_json(doc), indent=2, allow_nan=False) + "\n")
+
+
 def utc_now() -> str:
     """The current time, UTC, ISO 8601 to the second (``2026-01-31T12:00:00Z``)."""
     return datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")

@@ -14,13 +14,11 @@ both are printed side by side with the published reference of the file, if any.
 
 from __future__ import annotations
 
-import json
 import math
-import sys
 from dataclasses import replace
 from pathlib import Path
 
-from ..._outputs import check_figure_path
+from ..._outputs import check_figure_path, print_json
 
 __all__ = ["register", "run", "summarize"]
 
@@ -229,8 +227,7 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
     else:
         doc["figure"] = None
     if args.json:
-        json.dump(doc, sys.stdout, indent=2)
-        sys.stdout.write("\n")
+        print_json(doc)
         return 0
     r = doc["rfa"]
     print(f"{label}: flutter from Q(ik) ({r['method']} RFA, {r['n_lags']} lag roots, fit "
@@ -297,8 +294,7 @@ def run(args) -> int:
     else:
         doc["figure"] = None
     if args.json:
-        json.dump(doc, sys.stdout, indent=2)
-        sys.stdout.write("\n")
+        print_json(doc)
         return 0
     u = doc["units"]
     vu = "m/s" if u["V_flutter"] == "m/s" else "index"

@@ -10,8 +10,7 @@ sections, the speed index for the typical section).  No figure is written unless
 
 from __future__ import annotations
 
-import json
-import sys
+from ..._outputs import print_json
 
 __all__ = ["register", "run"]
 
@@ -94,8 +93,7 @@ def run(args) -> int:
         plt.close(fig)
     doc["figure"] = fig_path
     if args.json:
-        json.dump(doc, sys.stdout, indent=2)
-        sys.stdout.write("\n")
+        print_json(doc)
         return 0 if branch.completed else 3
     h = doc["hopf"]
     print(f"{label}: {doc['kind']} {'Neimark-Sacker' if branch.hopf.discrete else 'Hopf'} point "
