@@ -2,7 +2,8 @@
 
 - :class:`AeroelasticSystem` / :func:`aeroelastic_loop` — ΣAE(V) (eq. 8-9) from Σf (eq. 5)
   and the modal structure Σs (:class:`casflutter.structure.ModalStructure`, eq. 6-7);
-  :class:`ParametricSystem` — the same with Σf interpolated in V.
+  :class:`ParametricSystem` — the same with Σf interpolated in V; :class:`TruthLoop` — the
+  truth's own linearisation as the same loop (flap behind a servo), what the ROM stands in for.
 - :func:`track_eigenvalues`, :func:`find_flutter` — branch tracking by eigenvector
   continuity, V–g / V–f data, flutter (Hopf) and divergence speeds.
 - :func:`simulate_loop` — the nonlinear discrete ROM in feedback with Σs (paper Fig. 9).
@@ -19,6 +20,7 @@ from ._pk import PKResult, pk_flutter
 from ._rfa_system import RFASystem
 from ._simulate import LoopSimulation, simulate_loop
 from ._tracking import EigenTracking, eig_sorted_by_reference, track_eigenvalues
+from ._truth_loop import TruthLoop
 
 __all__ = [
     "AeroelasticSystem", "AeroelasticLoop", "ParametricSystem", "aeroelastic_loop",
@@ -26,5 +28,5 @@ __all__ = [
     "EigenTracking", "track_eigenvalues", "eig_sorted_by_reference",
     "Crossing", "FlutterResult", "find_flutter", "origin_modes",
     "AeroelasticLFT", "build_lft", "RFASystem", "PKResult", "pk_flutter",
-    "LoopSimulation", "simulate_loop",
+    "LoopSimulation", "simulate_loop", "TruthLoop",
 ]

@@ -125,6 +125,46 @@ class AeroelasticLoop:
                           inputs=[f"w[{i}]" for i in range(self.n_modes)] + ["v"],
                           outputs=outs, name="Sigma_AE")
 
+    def closed_loop_state_matrix(self, controller) -> np.ndarray:
+        """State matrix of this loop closed with ``v = K zm`` (positive feedback, paper Fig. 3).
+
+        An algebraic loop through ``D22 Dk`` (accelerometers with a direct flap feed-through)
+        is solved exactly.
+
+        Parameters
+        ----------
+        controller : control.StateSpace
+            Continuous K with ``n_sensors`` inputs and one output.
+
+        Returns
+        -------
+        ndarray
+            The state matrix of ``(x, x_K)``.
+
+        Raises
+        ------
+        DimensionError
+            K does not map the sensors to the flap, or ``1 − Dk D22 = 0``.
+        """
+        Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in
+                          (controller.A, controller.B, controller.C, controller.D))
+        m = self.C2.shape[0]
+        if Dk.shape != (1, m):
+            raise DimensionError(
+                f"the controller has {Dk.shape[1]} inputs and {Dk.shape[0]} outputs; it needs "
+                f"{m} inputs (the sensors zm) and 1 output (the flap v)")
+        nk = Ak.shape[0] if Ak.size else 0
+        if nk == 0:
+            Ak, Bk, Ck = np.zeros((0, 0)), np.zeros((0, m)), np.zeros((1, 0))
+        s = 1.0 - float((Dk @ self.D22)[0])
+        if abs(s) < 1e-12:
+            raise DimensionError("the loop v = K zm is algebraically singular (1 - Dk D22 = 0)")
+        # v = (Ck xk + Dk C2 x) / s
+        vx, vk = (Dk @ self.C2) / s, Ck / s
+        B2 = self.B2[:, None]
+        zx, zk = self.C2 + self.D22[:, None] @ vx, self.D22[:, None] @ vk
+        return np.block([[self.A + B2 @ vx, B2 @ vk], [Bk @ zx, Ak + Bk @ zk]])
+
     def poles(self) -> np.ndarray:
         """Eigenvalues of Â(V).
 
@@ -252,9 +292,6 @@ class AeroelasticSystem:
     def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
         """State matrix of ΣAE(V) closed with ``v = K zm`` (positive feedback, paper Fig. 3).
 
-        An algebraic loop through ``D22 Dk`` (accelerometers with a direct flap feed-through)
-        is solved exactly.
-
         Parameters
         ----------
         V : float
@@ -265,27 +302,9 @@ class AeroelasticSystem:
         Returns
         -------
         ndarray
-            The state matrix of ``(x, x_K)``.
+            The state matrix of ``(x, x_K)``; see :meth:`AeroelasticLoop.closed_loop_state_matrix`.
         """
-        lp = self.loop(V)
-        Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in
-                          (controller.A, controller.B, controller.C, controller.D))
-        m = lp.C2.shape[0]
-        if Dk.shape != (1, m):
-            raise DimensionError(
-                f"the controller has {Dk.shape[1]} inputs and {Dk.shape[0]} outputs; it needs "
-                f"{m} inputs (the sensors zm) and 1 output (the flap v)")
-        nk = Ak.shape[0] if Ak.size else 0
-        if nk == 0:
-            Ak, Bk, Ck = np.zeros((0, 0)), np.zeros((0, m)), np.zeros((1, 0))
-        s = 1.0 - float((Dk @ lp.D22)[0])
-        if abs(s) < 1e-12:
-            raise DimensionError("the loop v = K zm is algebraically singular (1 - Dk D22 = 0)")
-        # v = (Ck xk + Dk C2 x) / s
-        vx, vk = (Dk @ lp.C2) / s, Ck / s
-        B2 = lp.B2[:, None]
-        zx, zk = lp.C2 + lp.D22[:, None] @ vx, lp.D22[:, None] @ vk
-        return np.block([[lp.A + B2 @ vx, B2 @ vk], [Bk @ zx, Ak + Bk @ zk]])
+        return self.loop(V).closed_loop_state_matrix(controller)
 
     def loop(self, V: float) -> AeroelasticLoop:
         """ΣAE at speed index V (eq. 8-9), with flap input v and disturbance w.

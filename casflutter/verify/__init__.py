@@ -2,7 +2,8 @@
 
 Closed-loop poles, the exact H∞ norm with its peak frequency (SLICOT ``AB13DD`` via
 slycot, or a numpy/scipy Hamiltonian implementation), the small-gain speed interval
-and the exact speed interval of closed-loop stability (bialternate-sum guardian map).
+and the exact speed interval of closed-loop stability (bialternate-sum guardian map), on the
+paper's LFT or on any loop polynomial in the speed index (a truth's own linearisation).
 Uses python-control, slycot, numpy and scipy only; shares no code with
 :mod:`casflutter.design`, whose results it re-checks.
 """
@@ -10,7 +11,8 @@ Uses python-control, slycot, numpy and scipy only; shares no code with
 from ._common import IllPosedError, NotHurwitzError
 from ._hinf import HinfNorm, hinf_norm, sigma_max, slycot_available
 from ._interval import (StabilityInterval, bialternate_sum, feedback_stability_interval,
-                        small_gain_interval, speed_interval, stability_interval)
+                        polynomial_stability_interval, small_gain_interval,
+                        speed_family_interval, speed_interval, stability_interval)
 from ._io import (PlantData, controller_from_json, controller_to_json, load_controller,
                   load_plant, plant_from_json, plant_to_json, save_json)
 from ._lft import lft_closed_loop, partition_plant
@@ -22,7 +24,7 @@ __all__ = [
     "HinfNorm", "hinf_norm", "sigma_max", "slycot_available",
     "StabilityInterval", "bialternate_sum", "feedback_stability_interval",
     "small_gain_interval", "speed_interval",
-    "stability_interval",
+    "stability_interval", "polynomial_stability_interval", "speed_family_interval",
     "PlantData", "controller_from_json", "controller_to_json", "load_controller", "load_plant",
     "plant_from_json", "plant_to_json", "save_json",
     "lft_closed_loop", "partition_plant",

@@ -18,13 +18,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import control
 import numpy as np
 
 from ..errors import ConfigError, DimensionError
 from ._common import NotHurwitzError, is_hurwitz, spectral_abscissa
 
 __all__ = ["small_gain_interval", "StabilityInterval", "stability_interval",
-           "feedback_stability_interval", "bialternate_sum", "speed_interval"]
+           "feedback_stability_interval", "polynomial_stability_interval",
+           "speed_family_interval", "bialternate_sum", "speed_interval"]
 
 
 def small_gain_interval(gamma: float, Vf: float) -> tuple[float, float]:
@@ -127,14 +129,22 @@ class StabilityInterval:
         return self.upper - self.lower
 
 
-def _pencil_roots(M0: np.ndarray, M1: np.ndarray, imag_tol: float) -> np.ndarray:
-    """Real finite δ with ``det(M0 + δ M1) = 0``, ``M0`` nonsingular.
+def _pencil_roots(M0: np.ndarray, *Ms: np.ndarray, imag_tol: float) -> np.ndarray:
+    """Real finite δ with ``det(M0 + δ M1 + … + δ^d Md) = 0``, ``M0`` nonsingular.
 
-    Uses ``μ = eig(-M0⁻¹ M1)``, ``δ = 1/μ`` (infinite roots map to μ = 0).
+    ``μ = 1/δ`` are the eigenvalues of the block companion matrix of the reversed
+    polynomial, first block row ``-M0⁻¹ [M1 … Md]`` (for ``d = 1`` simply
+    ``eig(-M0⁻¹ M1)``); infinite roots map to μ = 0.
     """
-    if M0.shape[0] == 0:
+    n = M0.shape[0]
+    if n == 0:
         return np.zeros(0)
-    mu = np.linalg.eigvals(-np.linalg.solve(M0, M1))
+    top = -np.linalg.solve(M0, np.hstack(Ms))
+    d = len(Ms)
+    companion = np.zeros((d * n, d * n))
+    companion[:n] = top
+    companion[n:, :-n] = np.eye((d - 1) * n)
+    mu = np.linalg.eigvals(companion)
     scale = max(1.0, float(np.max(np.abs(mu)))) if mu.size else 1.0
     mu = mu[np.abs(mu) > 1e-13 * scale]
     real = np.abs(mu.imag) <= imag_tol * np.abs(mu)
@@ -183,8 +193,8 @@ def stability_interval(A0: np.ndarray, A1: np.ndarray, *, nominal: float = 0.0,
             f"{alpha:.6g} >= 0): there is no stability interval around it; pick a "
             "stabilising controller / a nominal value where the loop is stable")
     # δ measured from the nominal value: A(nominal + t) = An + t A1.
-    t_cplx = _pencil_roots(bialternate_sum(An), bialternate_sum(A1), imag_tol)
-    t_real = _pencil_roots(An, A1, imag_tol)
+    t_cplx = _pencil_roots(bialternate_sum(An), bialternate_sum(A1), imag_tol=imag_tol)
+    t_real = _pencil_roots(An, A1, imag_tol=imag_tol)
     kinds = {float(t): "complex pair" for t in t_cplx}
     kinds.update({float(t): "real through 0" for t in t_real})
 
@@ -192,6 +202,129 @@ def stability_interval(A0: np.ndarray, A1: np.ndarray, *, nominal: float = 0.0,
         return An + t * A1
 
     return _pick_ends(kinds, matrix, nominal, "bialternate", check_tol)
+
+
+def polynomial_stability_interval(coefficients, *, nominal: float = 0.0,
+                                  imag_tol: float = 1e-6, check_tol: float = 1e-6
+                                  ) -> StabilityInterval:
+    """Exact maximal open interval of δ containing ``nominal`` with ``Σ_k δ^k A_k`` Hurwitz.
+
+    The guardian maps of :func:`stability_interval` for a matrix polynomial: a complex pair
+    crosses where ``det(2A(δ) ⊙ I) = 0`` and a real eigenvalue where ``det A(δ) = 0``; the
+    bialternate sum is linear in ``A``, so both are polynomial eigenvalue problems in δ,
+    solved exactly through their block companion linearisation.  A loop whose state matrix
+    is quadratic in the speed index (a truth's strip theory: lags ∝ V, circulatory forces
+    ∝ V²) is certified this way in V itself.
+
+    Parameters
+    ----------
+    coefficients : sequence of (n, n) array_like
+        ``A_0, A_1, …, A_d`` (``d >= 1``).
+    nominal : float
+        A value with ``A(nominal)`` Hurwitz.
+    imag_tol, check_tol : float
+        As in :func:`stability_interval`.
+
+    Returns
+    -------
+    StabilityInterval
+        ``method = "bialternate-polynomial"``.
+
+    Raises
+    ------
+    DimensionError
+        Fewer than two coefficients, or not all square of one size.
+    NotHurwitzError
+        If ``A(nominal)`` is not Hurwitz.
+    """
+    Ak = [np.atleast_2d(np.asarray(M, dtype=float)) for M in coefficients]
+    if len(Ak) < 2 or Ak[0].ndim != 2 or Ak[0].shape[0] != Ak[0].shape[1] or \
+            any(M.shape != Ak[0].shape for M in Ak):
+        raise DimensionError(f"need at least two square coefficient matrices of one size; got "
+                             f"shapes {[M.shape for M in Ak]}")
+    d = len(Ak) - 1
+    # re-expand about the nominal value: A(nominal + t) = Σ_j t^j Â_j,
+    # Â_j = Σ_{k>=j} C(k, j) nominal^(k-j) A_k
+    shifted = [sum(math.comb(k, j) * nominal ** (k - j) * Ak[k] for k in range(j, d + 1))
+               for j in range(d + 1)]
+    stable, alpha = is_hurwitz(shifted[0])
+    if not stable:
+        raise NotHurwitzError(
+            f"A(nominal) (nominal={nominal}) is not Hurwitz (spectral abscissa {alpha:.6g} "
+            ">= 0): there is no stability interval around it; pick a stabilising controller "
+            "/ a nominal value where the loop is stable")
+    t_cplx = _pencil_roots(*[bialternate_sum(M) for M in shifted], imag_tol=imag_tol)
+    t_real = _pencil_roots(*shifted, imag_tol=imag_tol)
+    kinds = {float(t): "complex pair" for t in t_cplx}
+    kinds.update({float(t): "real through 0" for t in t_real})
+
+    def matrix(t: float) -> np.ndarray:
+        return sum(t ** j * M for j, M in enumerate(shifted))
+
+    return _pick_ends(kinds, matrix, nominal, "bialternate-polynomial", check_tol)
+
+
+def speed_family_interval(plant_at, controller, nominal: float, *, degree: int = 2,
+                          fit_tol: float = 1e-9, imag_tol: float = 1e-6,
+                          check_tol: float = 1e-6) -> StabilityInterval:
+    """Exact stable speed interval of a plant family closed by one controller, ``v = K zm``.
+
+    For a loop that is not given as the paper's LFT (eq. 14-15), e.g. a truth's own
+    linearisation: the closed loop is formed here with python-control (positive feedback,
+    paper Fig. 3), its state matrix sampled at ``degree + 3`` speeds around ``nominal``,
+    fitted exactly by a polynomial of ``degree`` in V (checked at the two spare speeds),
+    and the interval taken by :func:`polynomial_stability_interval`.
+
+    Parameters
+    ----------
+    plant_at : callable
+        ``V -> control.StateSpace`` from the flap command to the sensors (one input), with
+        the same states at every speed.
+    controller : control.StateSpace
+        ``K(s)``, sensors to flap.
+    nominal : float
+        Speed index (> 0) at which the closed loop is stable.
+    degree : int
+        Degree in V of the closed-loop state matrix (2 for strip theory).
+    fit_tol : float
+        Largest relative misfit at the spare speeds for the loop to count as a polynomial.
+    imag_tol, check_tol : float
+        As in :func:`stability_interval`.
+
+    Returns
+    -------
+    StabilityInterval
+        In V; ``method = "bialternate-polynomial"``.
+
+    Raises
+    ------
+    ConfigError
+        ``nominal`` not > 0, ``degree`` < 1, or a closed loop that is not a polynomial of
+        that degree in V (the misfit is named).
+    NotHurwitzError
+        The loop is not stable at ``nominal``.
+    """
+    if not (nominal > 0 and math.isfinite(nominal)) or int(degree) < 1:
+        raise ConfigError(f"need nominal > 0 and degree >= 1; got nominal={nominal!r}, "
+                          f"degree={degree!r}")
+    d = int(degree)
+    speeds = nominal * (1.0 + 0.5 * (np.arange(d + 3) - (d + 2) / 2) / (d + 2))
+    K = control.ss(controller)
+    mats = [np.asarray(control.feedback(plant_at(float(V)), K, sign=1).A, dtype=float)
+            for V in speeds]
+    n = mats[0].shape[0]
+    vander = np.vander(speeds[:d + 1], d + 1, increasing=True)
+    stack = np.stack([M.ravel() for M in mats[:d + 1]])
+    coef = np.linalg.solve(vander, stack)
+    for V, M in zip(speeds[d + 1:], mats[d + 1:]):
+        fit = sum(V ** j * coef[j] for j in range(d + 1)).reshape(n, n)
+        misfit = np.linalg.norm(fit - M) / max(np.linalg.norm(M), 1e-300)
+        if misfit > fit_tol:
+            raise ConfigError(f"the closed loop is not a polynomial of degree {d} in V "
+                              f"(relative misfit {misfit:.3g} at V = {V:.4g}); "
+                              "pass the right degree")
+    return polynomial_stability_interval([c.reshape(n, n) for c in coef], nominal=nominal,
+                                         imag_tol=imag_tol, check_tol=check_tol)
 
 
 def _pick_ends(kinds: dict[float, str], matrix, nominal: float, method: str,
@@ -327,10 +460,10 @@ def feedback_stability_interval(A: np.ndarray, B: np.ndarray, C: np.ndarray,
         N0[:N2, N2 + col] = S[p_idx, q_idx]
         N0[N2:, N2 + col] = Y.ravel()
         N1[N2:, N2 + col] = (D @ Y).ravel()
-    t_cplx = _pencil_roots(N0, N1, imag_tol)
+    t_cplx = _pencil_roots(N0, N1, imag_tol=imag_tol)
     R0 = np.block([[A, -B], [np.zeros((k, n)), np.eye(k)]])
     R1 = np.block([[np.zeros((n, n)), np.zeros((n, k))], [-C, D]])
-    t_real = _pencil_roots(R0, R1, imag_tol)
+    t_real = _pencil_roots(R0, R1, imag_tol=imag_tol)
     lam = np.linalg.eigvals(D) if k else np.zeros(0)
     lam = lam[(np.abs(lam.imag) <= imag_tol * np.abs(lam)) & (np.abs(lam) > 0)]
     t_ill = -1.0 / lam.real

@@ -39,3 +39,12 @@ def test_a_rom_file_without_the_loop_is_named(tmp_path, capsys):
 def test_an_output_that_is_not_json_is_refused(tmp_path, capsys):
     assert main(["bench", "interval", "--out", str(tmp_path / "b.txt")]) == 2
     assert "--out" in capsys.readouterr().err
+
+
+def test_truth_model_refuses_a_bad_servo_before_any_work(tmp_path, capsys):
+    t0 = time.perf_counter()
+    assert main(["bench", "interval", "--model", "truth", "--servo", "0", "--out",
+                 str(tmp_path / "b.json")]) == 2
+    assert time.perf_counter() - t0 < 10
+    assert "servo_omega" in capsys.readouterr().err
+    assert not (tmp_path / "b.json").exists()

@@ -68,3 +68,27 @@ def test_bad_requests_are_refused_before_any_work():
         stabilize_interval(system, idle, (0.05, 2.4), anchor="high")   # open loop flutters
     with pytest.raises(ConfigError, match="> 0"):
         full_order_start(system, 2.4, state_weight=0.0)
+
+
+@pytest.mark.slow
+def test_continuation_on_the_truth_loop_is_certified_on_the_truth():
+    """The same continuation on the seed wing's own linearisation (flap behind the 40 Hz
+    servo): the interval it claims is inside the verification layer's exact interval on the
+    truth (polynomial guardian map, python-control closing the loop)."""
+    from casflutter.aeroelastic import TruthLoop
+    from casflutter.truth import SeedWing
+    from casflutter.verify import speed_family_interval
+
+    fam = TruthLoop(SeedWing(), 251.3)
+    hi, lo = 2.4, 1.8
+    start = full_order_start(fam, hi)
+    assert loop_abscissa(fam, start, [lo])[0] > 0
+    reach = stabilize_interval(fam, start, (lo, hi), anchor="high", n_speeds=20)
+    assert reach.met
+
+    def plant(V):
+        lp = fam.loop(V)
+        return control.ss(lp.A, lp.B2[:, None], lp.C2, lp.D22[:, None])
+
+    cert = speed_family_interval(plant, reach.controller, 0.5 * (lo + hi))
+    assert cert.lower <= lo and cert.upper >= hi

@@ -152,3 +152,123 @@ def test_exact_interval_of_the_goland_rfa_loop_matches_a_dense_sweep():
         assert inside < 0 < outside, (end, a)
     # the interval is wide: about (0.89, 1.37) Vf, not a point
     assert hi - lo > 0.4 * p.Vf
+
+
+# ---- matrix polynomials in δ and plant families in V ---------------------------------
+
+def _quadratic_family(seed=3):
+    """A(δ) with a complex pair of real part (δ - 0.5)² - 1 (crossing at δ = -0.5 and 1.5),
+    a real eigenvalue δ - 1.2 (through 0 at 1.2) and a fixed stable block, in a random basis:
+    the exact interval around 0 is (-0.5, 1.2)."""
+    rng = np.random.default_rng(seed)
+    T = rng.standard_normal((5, 5)) + 5 * np.eye(5)
+    Ti = np.linalg.inv(T)
+
+    def blocks(c0, c1, c2):
+        M = np.zeros((5, 5))
+        M[0, 0] = M[1, 1] = c0
+        M[2, 2] = c1
+        return M
+
+    # real part (δ-0.5)²-1 = δ² - δ - 0.75; real eigenvalue δ - 1.2
+    A0 = blocks(-0.75, -1.2, 0)
+    A0[0, 1], A0[1, 0] = 3.0, -3.0
+    A0[3:, 3:] = [[-2.0, 1.0], [0.0, -4.0]]
+    A1 = blocks(-1.0, 1.0, 0)
+    A2 = blocks(1.0, 0.0, 0)
+    return [T @ M @ Ti for M in (A0, A1, A2)]
+
+
+def test_polynomial_interval_known_quadratic():
+    from casflutter.verify import polynomial_stability_interval
+    r = polynomial_stability_interval(_quadratic_family(), nominal=0.0)
+    assert r.method == "bialternate-polynomial"
+    assert r.lower == pytest.approx(-0.5, abs=1e-8)
+    assert r.upper == pytest.approx(1.2, abs=1e-8)
+    assert r.crossing_lower == "complex pair" and r.crossing_upper == "real through 0"
+    # the same family seen from another nominal value inside the interval
+    r2 = polynomial_stability_interval(_quadratic_family(), nominal=0.9)
+    assert (r2.lower, r2.upper) == pytest.approx((-0.5, 1.2), abs=1e-8)
+
+
+def test_polynomial_interval_degree_one_is_the_affine_interval():
+    from casflutter.verify import polynomial_stability_interval
+    rng = np.random.default_rng(11)
+    A0 = rng.standard_normal((6, 6)) - 4 * np.eye(6)
+    A1 = rng.standard_normal((6, 6))
+    a = stability_interval(A0, A1)
+    p = polynomial_stability_interval([A0, A1])
+    assert (p.lower, p.upper) == pytest.approx((a.lower, a.upper), rel=1e-9)
+
+
+def test_polynomial_interval_refuses_bad_input():
+    from casflutter.verify import polynomial_stability_interval
+    with pytest.raises(DimensionError):
+        polynomial_stability_interval([np.eye(2)])
+    with pytest.raises(DimensionError):
+        polynomial_stability_interval([-np.eye(2), np.eye(3)])
+    with pytest.raises(NotHurwitzError):
+        polynomial_stability_interval([np.eye(2), np.eye(2)], nominal=0.0)
+
+
+def _scan_interval(fam, K, nominal, lo, hi, n=4001):
+    """Independent reference: dense eigenvalue scan of python-control's closed loop, then
+    bisection of the two sign changes next to ``nominal``."""
+    import control
+
+    def ab(V):
+        return np.max(control.feedback(fam(V), K, sign=1).poles().real)
+
+    grid = np.linspace(lo, hi, n)
+    vals = np.array([ab(V) for V in grid])
+    i0 = int(np.argmin(np.abs(grid - nominal)))
+    assert vals[i0] < 0
+    ends = []
+    for step in (1, -1):
+        i = i0
+        while 0 <= i + step < n and vals[i + step] < 0:
+            i += step
+        if not 0 <= i + step < n:
+            ends.append(None)
+            continue
+        a, b = grid[i], grid[i + step]
+        for _ in range(60):
+            m = 0.5 * (a + b)
+            a, b = (m, b) if ab(m) < 0 else (a, m)
+        ends.append(0.5 * (a + b))
+    return ends[1], ends[0]
+
+
+def test_speed_family_interval_on_a_truth_matches_a_dense_scan():
+    """The typical section's own linearisation (lags ∝ V, forces ∝ V²) closed by a small
+    controller: the certified interval against a dense scan with bisection."""
+    import control
+    from casflutter.aeroelastic import TruthLoop
+    from casflutter.truth import TypicalSection
+    from casflutter.verify import speed_family_interval
+    fam = TruthLoop(TypicalSection(), 5.0)
+
+    def plant(V):
+        lp = fam.loop(V)
+        return control.ss(lp.A, lp.B2[:, None], lp.C2, lp.D22[:, None])
+
+    K = control.ss([[-1.0]], [[0.3, -0.5]], [[0.4]], [[0.0, 0.0]])
+    r = speed_family_interval(plant, K, 1.0)
+    lo, hi = _scan_interval(plant, K, 1.0, 0.02, 4.0)
+    assert r.lower == pytest.approx(lo, abs=1e-6) if lo is not None else r.lower < 0.02
+    assert r.upper == pytest.approx(hi, abs=1e-6)
+
+
+def test_speed_family_interval_refuses_a_loop_that_is_not_polynomial():
+    import control
+    from casflutter.errors import ConfigError
+    from casflutter.verify import speed_family_interval
+
+    def plant(V):
+        return control.ss([[-1.0 + np.sqrt(V) * 0.1]], [[1.0]], [[1.0], [0.5]], [[0.0], [0.0]])
+
+    K = control.ss([[-2.0]], [[0.1, 0.1]], [[0.1]], [[0.0, 0.0]])
+    with pytest.raises(ConfigError, match="not a polynomial"):
+        speed_family_interval(plant, K, 1.0)
+    with pytest.raises(ConfigError, match="nominal"):
+        speed_family_interval(plant, K, 0.0)

@@ -10,7 +10,13 @@ the paper's interval V ∈ (0.05, 2.4)?  Two continuations bracket the answer
   the target's upper end, its lower end pushed down.
 
 Every controller's exact stable interval is then certified by the independent verification
-layer (:func:`casflutter.verify.verify_controller`, guardian map on the LFT at Vf).  The JSON
+layer (:func:`casflutter.verify.verify_controller`, guardian map on the LFT at Vf).
+
+With ``--model truth`` the same question is asked of the wing itself: the truth's own
+full-order linearisation with the flap behind a servo (:class:`casflutter.aeroelastic.TruthLoop`),
+continued from the high end by a full-order LQG start and from the low end by ``--orders``
+controllers (balanced truncations of the high-end result), each certified on the truth by
+:func:`casflutter.verify.speed_family_interval` (guardian map of the loop, quadratic in V).  The JSON
 also lists, per accelerometer channel, the speeds at which a complex zero pair of
 ``v → zm_j`` crosses into the right half-plane near the flutter frequency: the plant property
 the two continuations stall at.
@@ -101,6 +107,60 @@ def _verified(system, nominal: float, K) -> dict[str, Any]:
             "exact_interval": [float(ex[0]), float(ex[1])] if ex is not None else None}
 
 
+def _verified_family(family, nominal: float, K) -> dict[str, Any]:
+    """The verification layer's exact stable interval of a loop family that is polynomial in
+    V (a truth's linearisation), python-control closing the loop."""
+    import control  # noqa: PLC0415
+
+    from ...verify import speed_family_interval  # noqa: PLC0415
+
+    def plant(V):
+        lp = family.loop(V)
+        return control.ss(lp.A, lp.B2[:, None], lp.C2, lp.D22[:, None])
+
+    r = speed_family_interval(plant, K, nominal)
+    return {"nominal": nominal, "stable_at_nominal": True, "gamma": None,
+            "exact_interval": [float(r.lower), float(r.upper)]}
+
+
+def _truth_runs(family, lo: float, hi: float, orders, doc, write) -> None:
+    """Full order from the high end, then ``orders`` from the low end, on the truth loop."""
+    import control  # noqa: PLC0415
+
+    from ...design import full_order_start, stabilize_interval  # noqa: PLC0415
+    from ...errors import ConfigError  # noqa: PLC0415
+
+    servo = family.servo_omega
+    t0 = time.perf_counter()
+    K0 = full_order_start(family, hi)
+    high = stabilize_interval(family, K0, (lo, hi), anchor="high")
+    mid = 0.5 * sum(high.reached)
+    rec = _reach_record(f"LQG at V = {hi:g} (truth, servo {servo:g} rad/s)", K0.nstates,
+                        high, _verified_family(family, mid, high.controller),
+                        time.perf_counter() - t0)
+    doc["runs"].append(rec)
+    print(f"truth, full order {K0.nstates} from the high end: reached {high.reached}, "
+          f"verified {rec['verified_exact_interval']}", file=sys.stderr, flush=True)
+    write()
+    for order in orders:
+        t0 = time.perf_counter()
+        Kr = control.balred(high.controller, order, method="truncate")
+        Kr = control.ss(Kr.A, Kr.B, Kr.C, np.zeros_like(np.asarray(Kr.D)))
+        try:
+            reach = stabilize_interval(family, Kr, (lo, hi), anchor="low")
+        except ConfigError as exc:     # the truncation does not hold the low end
+            _log.warning("truth, order %d: %s", order, exc)
+            continue
+        rec = _reach_record("balanced truncation of the full-order truth controller", order,
+                            reach, _verified_family(family, 0.5 * sum(reach.reached),
+                                                    reach.controller),
+                            time.perf_counter() - t0)
+        doc["runs"].append(rec)
+        print(f"truth, order {order} from the low end: reached {reach.reached}, verified "
+              f"{rec['verified_exact_interval']}", file=sys.stderr, flush=True)
+        write()
+
+
 def _reach_record(kind: str, order: int, reach, verified: dict, wall: float) -> dict:
     return {"start": kind, "order": order, "anchor": reach.anchor,
             "reached": list(reach.reached), "met": reach.met,
@@ -112,8 +172,10 @@ def _reach_record(kind: str, order: int, reach, verified: dict, wall: float) -> 
 def _handler(args: argparse.Namespace) -> int:
     from ...design import (SynthesisOptions, design_flutter_controller,  # noqa: PLC0415
                            full_order_start, stabilize_interval)
-    from ...errors import CasflutterError  # noqa: PLC0415
+    from ...aeroelastic import TruthLoop  # noqa: PLC0415
+    from ...errors import CasflutterError, ConfigError  # noqa: PLC0415
     from ...pipeline import load_config  # noqa: PLC0415
+    from ...truth import AeroelasticTruth  # noqa: PLC0415
     from ..._outputs import check_output_path  # noqa: PLC0415
     from ..._settings import settings_as  # noqa: PLC0415
 
@@ -129,14 +191,26 @@ def _handler(args: argparse.Namespace) -> int:
         return 2
     try:    # everything checked before any design work; nothing is written until a result
         out = check_output_path(args.out, what="--out", suffixes=(".json",))
-        system, Vf = load_rom_loop(Path(args.rom))
         cfg = load_config(args.config)
+        if args.model == "truth":
+            truth = cfg.problem.load()
+            if not isinstance(truth, AeroelasticTruth):
+                raise ConfigError(f"--model truth: problem {cfg.problem.name!r} has no "
+                                  "simulator to linearise; use a problem with a truth")
+            family = TruthLoop(truth, float(cfg.controller.flap_rate_bandwidth
+                                            if args.servo is None else args.servo))
+        else:
+            system, Vf = load_rom_loop(Path(args.rom))
     except (OSError, CasflutterError) as exc:
         print(f"casflutter bench interval: {exc}", file=sys.stderr)
         return 2
     c = cfg.controller
     options = replace(settings_as(c, SynthesisOptions), ipopt={**cfg.solver.ipopt, **c.ipopt})
-    doc: dict[str, Any] = {"rom": str(args.rom), "Vf": Vf, "target": [lo, hi], "runs": []}
+    doc: dict[str, Any] = ({"model": "rom", "rom": str(args.rom), "Vf": Vf}
+                           if args.model == "rom" else
+                           {"model": "truth", "problem": cfg.problem.name,
+                            "servo_omega": family.servo_omega, "servo_zeta": family.servo_zeta})
+    doc.update({"target": [lo, hi], "runs": []})
 
     def write():
         reached_low = [r["reached"][1] for r in doc["runs"] if r["anchor"] == "low"]
@@ -145,6 +219,10 @@ def _handler(args: argparse.Namespace) -> int:
             "highest_upper_end_from_low": max(reached_low, default=None),
             "lowest_lower_end_from_high": min(reached_high, default=None),
             "met_by_any": any(r["met"] for r in doc["runs"]),
+            "target_certified_by_any": any(
+                r["verified_exact_interval"] is not None
+                and r["verified_exact_interval"][0] <= lo
+                and r["verified_exact_interval"][1] >= hi for r in doc["runs"]),
             "machine": {"cpus": os.cpu_count(), "load_average": list(os.getloadavg())
                         if hasattr(os, "getloadavg") else None}}
         out.parent.mkdir(parents=True, exist_ok=True)
@@ -152,6 +230,12 @@ def _handler(args: argparse.Namespace) -> int:
         tmp.write_text(json.dumps(doc, indent=1, default=float))
         tmp.replace(out)
 
+    if args.model == "truth":
+        _truth_runs(family, lo, hi, orders, doc, write)
+        doc["rhp_zero_crossings"] = _rhp_zero_crossings(family, lo, hi, tuple(args.zero_band))
+        write()
+        print(f"wrote {out}", file=sys.stderr)
+        return 0
     for order in orders:
         t0 = time.perf_counter()
         design = design_flutter_controller(
@@ -184,8 +268,15 @@ def _handler(args: argparse.Namespace) -> int:
 def register(subparsers) -> None:
     """Add ``bench interval`` to the ``casflutter bench`` sub-commands."""
     p = subparsers.add_parser(
-        "interval", help="how far one controller holds the ROM loop stable; writes JSON",
+        "interval", help="how far one controller holds the ROM loop (or the truth) stable; "
+                         "writes JSON",
         description=__doc__.split("\n\n")[1])
+    p.add_argument("--model", choices=("rom", "truth"), default="rom",
+                   help="the ROM loop (default) or the truth's own linearisation with the "
+                        "flap behind a servo")
+    p.add_argument("--servo", type=float, default=None,
+                   help="--model truth: servo natural frequency [rad/s] (default: the run "
+                        "configuration's controller.flap_rate_bandwidth)")
     p.add_argument("--rom", default=str(DEFAULT_ROM),
                    help="ROM loop .npz (default: the seed wing's, seed 0)")
     p.add_argument("--config", default=None,

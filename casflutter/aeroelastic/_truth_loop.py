@@ -1,0 +1,132 @@
+"""ΣAE(V) of a truth simulator's own linearisation: the loop the ROM stands in for.
+
+The paper designs and analyses on the ROM loop ΣAE(V) (eq. 8-9).  What a controller can do
+on the ROM is a property of the ROM; whether the *wing* allows the same is asked of the
+truth's full-order linearisation (:meth:`casflutter.truth.AeroelasticTruth.statespace`:
+structure, unsteady-lag states and the flap) with the flap behind a second-order servo, so
+that the controller commands the servo as it would on the wind-tunnel model.  The result is
+an :class:`~casflutter.aeroelastic.AeroelasticLoop` at every speed, with the same sensors
+(the problem's rows, read as the truth's sensor kind) and the same modal disturbance
+inputs, so everything that takes the ROM loop (:func:`casflutter.design.stabilize_interval`,
+:func:`casflutter.design.full_order_start`, closed-loop pole maps) takes this one.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ConfigError
+from ..truth import AeroelasticTruth
+from ._loop import AeroelasticLoop
+
+__all__ = ["TruthLoop"]
+
+
+@dataclass(frozen=True)
+class TruthLoop:
+    """The truth's linear aeroelastic loop at any speed index, flap behind a servo.
+
+    Attributes
+    ----------
+    truth : casflutter.truth.AeroelasticTruth
+        The simulator whose linearisation is used.
+    servo_omega : float
+        Servo natural frequency [rad per time unit of the truth] (> 0).
+    servo_zeta : float
+        Servo damping ratio (>= 0).
+
+    Raises
+    ------
+    ConfigError
+        A truth that is not an :class:`~casflutter.truth.AeroelasticTruth`, or a servo
+        frequency or damping out of range.
+
+    Notes
+    -----
+    States ``[u, u', lags, v, v']`` (the truth's order plus two); the input ``v`` of the
+    returned loops is the servo command, and ``zm`` are the problem's sensors: ``Hs u``,
+    ``Hs u'`` or ``Hs u''`` (the acceleration with its exact feed-through from the command
+    and the disturbances) as the truth's sensor kind says.
+    """
+
+    truth: AeroelasticTruth
+    servo_omega: float
+    servo_zeta: float = 0.7
+
+    def __post_init__(self):
+        if not isinstance(self.truth, AeroelasticTruth):
+            raise ConfigError(f"truth must be a casflutter.truth.AeroelasticTruth, got "
+                              f"{type(self.truth).__name__}")
+        if not (math.isfinite(self.servo_omega) and self.servo_omega > 0
+                and math.isfinite(self.servo_zeta) and self.servo_zeta >= 0):
+            raise ConfigError(f"servo_omega = {self.servo_omega!r} must be > 0 and "
+                              f"servo_zeta = {self.servo_zeta!r} >= 0")
+
+    @property
+    def n_modes(self) -> int:
+        """N."""
+        return self.truth.n_modes
+
+    def loop(self, V: float) -> AeroelasticLoop:
+        """The linear loop at speed index V.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        AeroelasticLoop
+            ``n_f`` counts every state beyond the structure's ``2N`` (lags and servo).
+        """
+        P = self.truth.statespace(float(V), actuator_omega=self.servo_omega,
+                                  actuator_zeta=self.servo_zeta)
+        A, B = np.asarray(P.A, float), np.asarray(P.B, float)
+        N = self.n_modes
+        s = self.truth.modal_structure()
+        nx = A.shape[0]
+        if s.sensor == "state":
+            C2, D2 = np.hstack([s.Hs, np.zeros((s.n_sensors, nx - 2 * N))]), np.zeros_like(B)
+        else:
+            rows = {"displacement": (np.eye(nx)[:N], np.zeros((N, B.shape[1]))),
+                    "velocity": (np.eye(nx)[N:2 * N], np.zeros((N, B.shape[1]))),
+                    "acceleration": (A[N:2 * N], B[N:2 * N])}[s.sensor]
+            C2, D2 = s.Hs @ rows[0], s.Hs @ rows[1]
+        Cu = np.eye(nx)[:N]
+        return AeroelasticLoop(float(V), A, B[:, 1:], B[:, 0].copy(), C2, D2[:, 1:],
+                               D2[:, 0].copy(), Cu, N, nx - 2 * N)
+
+    def state_matrix(self, V: float) -> np.ndarray:
+        """The open-loop state matrix at speed index V (flap servo at rest).
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        ndarray
+        """
+        return self.loop(V).A
+
+    def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
+        """State matrix at V closed with ``v = K zm`` (positive feedback, paper Fig. 3).
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+        controller : control.StateSpace
+            Continuous K with ``n_sensors`` inputs and one output (the servo command).
+
+        Returns
+        -------
+        ndarray
+            The state matrix of ``(x, x_K)``.
+        """
+        return self.loop(V).closed_loop_state_matrix(controller)
