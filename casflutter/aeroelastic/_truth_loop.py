@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ConfigError
+from ..structure import ModalStructure
 from ..truth import AeroelasticTruth
 from ._loop import AeroelasticLoop
 
@@ -37,12 +38,15 @@ class TruthLoop:
         Servo natural frequency [rad per time unit of the truth] (> 0).
     servo_zeta : float
         Servo damping ratio (>= 0).
+    sensors : ModalStructure, optional
+        Whose sensor rows and kind to read (e.g. a run's own, with its ``[sensors]``
+        changes); default the truth's :meth:`~casflutter.truth.AeroelasticTruth.modal_structure`.
 
     Raises
     ------
     ConfigError
-        A truth that is not an :class:`~casflutter.truth.AeroelasticTruth`, or a servo
-        frequency or damping out of range.
+        A truth that is not an :class:`~casflutter.truth.AeroelasticTruth`, a servo
+        frequency or damping out of range, or sensors on another number of modes.
 
     Notes
     -----
@@ -55,6 +59,7 @@ class TruthLoop:
     truth: AeroelasticTruth
     servo_omega: float
     servo_zeta: float = 0.7
+    sensors: ModalStructure | None = None
 
     def __post_init__(self):
         if not isinstance(self.truth, AeroelasticTruth):
@@ -64,6 +69,10 @@ class TruthLoop:
                 and math.isfinite(self.servo_zeta) and self.servo_zeta >= 0):
             raise ConfigError(f"servo_omega = {self.servo_omega!r} must be > 0 and "
                               f"servo_zeta = {self.servo_zeta!r} >= 0")
+        if self.sensors is not None and (not isinstance(self.sensors, ModalStructure) or
+                                         self.sensors.n_modes != self.truth.n_modes):
+            raise ConfigError(f"sensors must be a ModalStructure on the truth's "
+                              f"{self.truth.n_modes} modes")
 
     @property
     def n_modes(self) -> int:
@@ -87,7 +96,7 @@ class TruthLoop:
                                   actuator_zeta=self.servo_zeta)
         A, B = np.asarray(P.A, float), np.asarray(P.B, float)
         N = self.n_modes
-        s = self.truth.modal_structure()
+        s = self.sensors if self.sensors is not None else self.truth.modal_structure()
         nx = A.shape[0]
         if s.sensor == "state":
             C2, D2 = np.hstack([s.Hs, np.zeros((s.n_sensors, nx - 2 * N))]), np.zeros_like(B)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
@@ -18,7 +19,7 @@ from ..ident import CommonDenominatorResult, FitReport, IdentificationResult
 from ..lco import LCOBranch
 from ..realize import ParametricROM, RationalApproximation, Realization
 from ..truth import AeroelasticTruth, SuppressionResult, TruthLco, TruthLoopSweep
-from ..verify import SpeedSweep, VerificationReport
+from ..verify import SpeedSweep, StabilityInterval, VerificationReport
 from ._config import RunConfig
 from ._exports import label_summary
 from ._units import speed_scale, speed_values
@@ -213,6 +214,11 @@ class RunResult:
         γ and the speed intervals (eq. 10-16).
     rom_sweep : SpeedSweep or None
         Dense eigenvalue sweep of the ROM loop (``verify.sweep``).
+    truth_interval : StabilityInterval or None
+        Exact stable speed interval of the truth's own linearisation closed by the
+        controller, the flap behind a servo of ``controller.flap_rate_bandwidth``
+        (:class:`casflutter.aeroelastic.TruthLoop`), grown from ``data.V0``; ``None``
+        without a truth, or when the controller does not hold the truth at V0.
     closed_loop : ClosedLoopChecks or None
         Stage ``closed_loop``.
     suppression : SuppressionResult or None
@@ -259,6 +265,7 @@ class RunResult:
     controller: control.StateSpace | None = None
     verification: VerificationReport | None = None
     rom_sweep: SpeedSweep | None = None
+    truth_interval: StabilityInterval | None = None
     closed_loop: ClosedLoopChecks | None = None
     suppression: SuppressionResult | None = None
     timings: Mapping[str, float] = field(default_factory=dict)
@@ -486,6 +493,13 @@ class RunResult:
         if self.verification is None:
             return None
         ver = self.verification
+        ti = self.truth_interval
         return {"order": self.synthesis.order, "gamma": ver.gamma,
                 "small_gain_V": _pair(ver.small_gain_V), "stable_V": _pair(ver.exact_V),
-                "stable": bool(ver.stable)}
+                "stable": bool(ver.stable),
+                # V >= 0; an upper end without a crossing is written as null
+                "truth_stable_V": None if ti is None else [
+                    max(0.0, float(ti.lower)),
+                    float(ti.upper) if math.isfinite(ti.upper) else None],
+                "truth_servo_omega": (self.config.controller.flap_rate_bandwidth
+                                      if self.truth is not None else None)}

@@ -60,7 +60,7 @@ from .._linalg import spectral_abscissa
 from .._outputs import provenance, utc_now
 from .._settings import settings_as
 from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, RFASystem,
-                           build_lft, pk_flutter,
+                           TruthLoop, build_lft, pk_flutter,
                            find_flutter, simulate_loop)
 from ..data import envelope_growth_rate
 from ..design import SynthesisOptions, design_flutter_controller
@@ -73,7 +73,8 @@ from ..realize import ParametricROM, RFASettings, fit_rfa, realize, speed_nodes
 from ..truth import (AeroelasticTruth, GAFProblem, RecordSettings, WingProblem,
                      closed_loop_truth, frozen_aero_truth, suppression_run,
                      truth_lco, truth_loop_matrix, truth_loop_sweep, truth_records)
-from ..verify import speed_sweep, verify_controller
+from ..verify import (NotHurwitzError, StabilityInterval, speed_family_interval, speed_sweep,
+                      verify_controller)
 from ._config import RunConfig, load_config
 from ._exports import check_output_folder, log_flags, write_outputs
 from ._result import (ClosedLoopChecks, LcoResult, ParametricResult, RunResult,
@@ -388,7 +389,7 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
         with prog.stage("lco"):
             out["lco"] = _lco(cfg, truth, model, structure, flutter, flutter_truth, prog)
     if "controller" in cfg.stages:
-        _controller_stages(cfg, system, Vf, prog, out)
+        _controller_stages(cfg, system, Vf, prog, out, truth=truth, structure=structure)
     if "closed_loop" in cfg.stages and "closed_loop" not in skipped:
         with prog.stage("closed_loop"):
             out["closed_loop"] = _closed_loop(cfg, truth, model, system, out["lft"],
@@ -416,8 +417,10 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
     return _finish(out, prog, target, write, overwrite, info)
 
 
-def _controller_stages(cfg: RunConfig, system, Vf: float, prog, out: dict) -> None:
-    """The LFT at Vf (eq. 10-15), the fixed-order synthesis (§III.C) and the verification."""
+def _controller_stages(cfg: RunConfig, system, Vf: float, prog, out: dict, truth=None,
+                       structure=None) -> None:
+    """The LFT at Vf (eq. 10-15), the fixed-order synthesis (§III.C) and the verification,
+    on the ROM loop and, with a truth, on the truth's own linearisation."""
     with prog.stage("lft"):
         lft = build_lft(system, Vf)
     with prog.stage("controller"):
@@ -439,7 +442,28 @@ def _controller_stages(cfg: RunConfig, system, Vf: float, prog, out: dict) -> No
             out["rom_sweep"] = speed_sweep(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf,
                                            n_delta=lft.n_delta,
                                            V=np.linspace(lo * Vf, hi * Vf, cfg.verify.n_sweep))
+        if truth is not None:
+            out["truth_interval"] = _truth_interval(truth, structure, K, cfg, prog)
     out.update(lft=lft, synthesis=syn, controller=K, verification=ver)
+
+
+def _truth_interval(truth, structure, K, cfg: RunConfig, prog) -> StabilityInterval | None:
+    """The exact stable speed interval of the truth's own linearisation closed by ``K``, the
+    flap behind a servo of ``controller.flap_rate_bandwidth``, grown from ``data.V0``: the
+    interval on the wing the ROM stands in for.  ``None`` when K does not hold the truth
+    at V0."""
+    family = TruthLoop(truth, cfg.controller.flap_rate_bandwidth, sensors=structure)
+
+    def plant(V):
+        lp = family.loop(V)
+        return control.ss(lp.A, lp.B2[:, None], lp.C2, lp.D22[:, None])
+
+    try:
+        return speed_family_interval(plant, K, cfg.data.V0)
+    except NotHurwitzError:
+        prog.note(f"the controller does not stabilise the truth's linear loop at "
+                  f"V0 = {cfg.data.V0:.4g}")
+        return None
 
 
 def _finish(out: dict, prog, target: Path | None, write: bool, overwrite: bool,

@@ -78,6 +78,7 @@ def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflu
     ft = s.get("flutter_truth") or {}
     truth = {   # the truth simulator's own values, where it has one
         "flutter speed index Vf": ft.get("V"),
+        "stable speed range (controller)": ctrl.get("truth_stable_V"),
         "flutter mode": ft.get("mode"),
         "LCO fundamental frequency [Hz]": (lco.get("truth_freq_hz")
                                            if lco.get("truth_kind") == "lco" else None),
@@ -116,7 +117,9 @@ figcaption{{font-size:90%;color:#555}}</style></head><body>
 {rows}</table>
 <p>ROM fit error per mode [%]: {fit}. Truth flutter: V = {_fmt(ft.get('V'))},
 {_fmt(ft.get('freq_hz'))} Hz. Controller: verified γ = {_fmt(ctrl.get('gamma'))},
-small-gain interval of V {_fmt(ctrl.get('small_gain_V'))}, exact stable interval {_fmt(ctrl.get('stable_V'))}.</p>
+small-gain interval of V {_fmt(ctrl.get('small_gain_V'))}, exact stable interval {_fmt(ctrl.get('stable_V'))}
+on the ROM loop and {_fmt(ctrl.get('truth_stable_V'))} on the truth's own linearisation (flap
+behind a servo of {_fmt(ctrl.get('truth_servo_omega'))} rad/s).</p>
 {lco_text}
 <h2>Figures</h2>
 {''.join(imgs)}

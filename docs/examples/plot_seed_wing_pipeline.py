@@ -51,7 +51,10 @@ print(f"truth LCO at V = {s['lco']['truth_V']:.3f}: {s['lco']['truth_kind']}, "
 c = s["controller"]
 print(f"controller order {c['order']}: gamma = {c['gamma']:.4g}, small-gain V interval "
       f"({c['small_gain_V'][0]:.3f}, {c['small_gain_V'][1]:.3f}), exact stable V interval "
-      f"({c['stable_V'][0]:.3f}, {c['stable_V'][1]:.3f})")
+      f"({c['stable_V'][0]:.3f}, {c['stable_V'][1]:.3f}) on the ROM loop")
+if c["truth_stable_V"] is not None:   # the same controller on the wing the ROM stands in for
+    print(f"  on the truth's own linearisation (servo {c['truth_servo_omega']} rad/s): exact "
+          f"stable V interval {c['truth_stable_V']}")
 print(f"suppression of the truth's LCO at V = {s['suppression']['V']:.3f}: "
       f"{s['suppression']['attenuation_percent']:.1f} % attenuation")
 print("timings [s]:", {k: round(v, 2) for k, v in s["timings_s"].items()})

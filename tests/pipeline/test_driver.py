@@ -6,6 +6,7 @@ import json
 from dataclasses import fields
 
 import control
+import numpy as np
 import pytest
 
 from casflutter._settings import field_names, settings_as
@@ -221,3 +222,27 @@ def test_plant_and_controller_files_reproduce_the_verification(study, tmp_path, 
     assert got["hinf_delta"]["gamma"] == pytest.approx(ver.hinf_delta.gamma, rel=1e-6)
     for key in ("small_gain_V", "small_gain_V_delta", "exact_V"):
         assert got[key] == pytest.approx(list(getattr(ver, key)), rel=1e-6), key
+
+
+def test_the_controller_is_certified_on_the_truth_as_well(study):
+    """The run's controller on the truth's own linearisation (flap behind the servo of
+    controller.flap_rate_bandwidth): the certified interval against eigenvalues computed here
+    from the truth's state space, its accelerometer rows and python-control's feedback."""
+    r = study
+    ti = r.truth_interval
+    assert ti is not None and ti.lower < r.config.data.V0 < ti.upper
+    servo = r.config.controller.flap_rate_bandwidth
+    N = r.truth.n_modes
+    Hs = r.system.structure.Hs
+
+    def worst(V):
+        P = r.truth.statespace(V, actuator_omega=servo)
+        A, B = np.asarray(P.A), np.asarray(P.B)[:, :1]
+        G = control.ss(A, B, Hs @ A[N:2 * N], Hs @ B[N:2 * N])     # zm = Hs ü
+        return float(np.max(control.feedback(G, r.controller, sign=1).poles().real))
+
+    assert worst(0.5 * (max(ti.lower, 0.05) + ti.upper)) < 0
+    assert worst(0.999 * ti.upper) < 0 < worst(1.01 * ti.upper)
+    s = r.summary()["controller"]
+    assert s["truth_stable_V"] == [max(0.0, ti.lower), ti.upper]
+    assert s["truth_servo_omega"] == servo

@@ -61,6 +61,9 @@ def _main(args) -> int:
         lines.append(f"controller order {c['order']}: verified gamma = {c['gamma']}, small-gain "
                      f"V in {c['small_gain_V']}, exact stable V in {c['stable_V']} (speed "
                      "index)")
+        if c.get("truth_servo_omega") is not None:
+            lines.append(f"  on the truth's own linearisation (servo {c['truth_servo_omega']} "
+                         f"rad/s): exact stable V in {c['truth_stable_V']}")
         air = (c.get("certified") or {}).get("exact_V") or {}
         if air.get("airspeed_m_s") is not None:
             lines.append(f"  exact stable airspeed in {air['airspeed_m_s']} m/s")
