@@ -125,6 +125,16 @@ class AeroelasticLoop:
                           inputs=[f"w[{i}]" for i in range(self.n_modes)] + ["v"],
                           outputs=outs, name="Sigma_AE")
 
+    def flap_to_sensors(self) -> control.StateSpace:
+        """The loop from the flap ``v`` to the sensors ``zm`` alone (the plant a controller
+        ``v = K zm`` closes).
+
+        Returns
+        -------
+        control.StateSpace
+        """
+        return control.ss(self.A, self.B2[:, None], self.C2, self.D22[:, None])
+
     def closed_loop_state_matrix(self, controller) -> np.ndarray:
         """State matrix of this loop closed with ``v = K zm`` (positive feedback, paper Fig. 3).
 

@@ -453,13 +453,9 @@ def _truth_interval(truth, structure, K, cfg: RunConfig, prog) -> StabilityInter
     interval on the wing the ROM stands in for.  ``None`` when K does not hold the truth
     at V0."""
     family = TruthLoop(truth, cfg.controller.flap_rate_bandwidth, sensors=structure)
-
-    def plant(V):
-        lp = family.loop(V)
-        return control.ss(lp.A, lp.B2[:, None], lp.C2, lp.D22[:, None])
-
     try:
-        return speed_family_interval(plant, K, cfg.data.V0)
+        return speed_family_interval(lambda V: family.loop(V).flap_to_sensors(), K,
+                                     cfg.data.V0)
     except NotHurwitzError:
         prog.note(f"the controller does not stabilise the truth's linear loop at "
                   f"V0 = {cfg.data.V0:.4g}")

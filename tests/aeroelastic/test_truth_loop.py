@@ -85,3 +85,11 @@ def test_bad_servo_is_refused(wing, kw, msg):
 def test_not_a_truth_is_refused():
     with pytest.raises(ConfigError, match="AeroelasticTruth"):
         TruthLoop(object(), 100.0)
+
+
+def test_flap_to_sensors_is_the_flap_column_of_the_loop(wing):
+    lp = TruthLoop(wing, SERVO).loop(1.7)
+    full = lp.statespace()          # inputs [w_1..w_N, v]
+    G = lp.flap_to_sensors()
+    for w in (5.0, 60.0):
+        assert_allclose(G(1j * w)[:, 0], full(1j * w)[:, -1], rtol=1e-10)

@@ -27,8 +27,7 @@ def witness():
     fam = TruthLoop(SeedWing(), SERVO)
 
     def plant(V):
-        lp = fam.loop(V)
-        return control.ss(lp.A, lp.B2[:, None], lp.C2, lp.D22[:, None])
+        return fam.loop(V).flap_to_sensors()
 
     K = load_controller(problems_dir() / "seed_wing" / "truth_interval_controller.json")
     return plant, K

@@ -249,8 +249,7 @@ def test_speed_family_interval_on_a_truth_matches_a_dense_scan():
     fam = TruthLoop(TypicalSection(), 5.0)
 
     def plant(V):
-        lp = fam.loop(V)
-        return control.ss(lp.A, lp.B2[:, None], lp.C2, lp.D22[:, None])
+        return fam.loop(V).flap_to_sensors()
 
     K = control.ss([[-1.0]], [[0.3, -0.5]], [[0.4]], [[0.0, 0.0]])
     r = speed_family_interval(plant, K, 1.0)

@@ -110,15 +110,9 @@ def _verified(system, nominal: float, K) -> dict[str, Any]:
 def _verified_family(family, nominal: float, K) -> dict[str, Any]:
     """The verification layer's exact stable interval of a loop family that is polynomial in
     V (a truth's linearisation), python-control closing the loop."""
-    import control  # noqa: PLC0415
-
     from ...verify import speed_family_interval  # noqa: PLC0415
 
-    def plant(V):
-        lp = family.loop(V)
-        return control.ss(lp.A, lp.B2[:, None], lp.C2, lp.D22[:, None])
-
-    r = speed_family_interval(plant, K, nominal)
+    r = speed_family_interval(lambda V: family.loop(V).flap_to_sensors(), K, nominal)
     return {"nominal": nominal, "stable_at_nominal": True, "gamma": None,
             "exact_interval": [float(r.lower), float(r.upper)]}
 
