@@ -497,9 +497,8 @@ class RunResult:
         return {"order": self.synthesis.order, "gamma": ver.gamma,
                 "small_gain_V": _pair(ver.small_gain_V), "stable_V": _pair(ver.exact_V),
                 "stable": bool(ver.stable),
-                # V >= 0; an upper end without a crossing is written as null
+                # an upper end without a crossing is written as null
                 "truth_stable_V": None if ti is None else [
-                    max(0.0, float(ti.lower)),
-                    float(ti.upper) if math.isfinite(ti.upper) else None],
+                    float(ti.lower), float(ti.upper) if math.isfinite(ti.upper) else None],
                 "truth_servo_omega": (self.config.controller.flap_rate_bandwidth
                                       if self.truth is not None else None)}

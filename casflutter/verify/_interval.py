@@ -16,7 +16,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import control
 import numpy as np
@@ -294,7 +294,8 @@ def speed_family_interval(plant_at, controller, nominal: float, *, degree: int =
     Returns
     -------
     StabilityInterval
-        In V; ``method = "bialternate-polynomial"``.
+        In V (lower end at least 0: a stable loop down to V = 0 has ``lower = 0``);
+        ``method = "bialternate-polynomial"``.
 
     Raises
     ------
@@ -323,8 +324,13 @@ def speed_family_interval(plant_at, controller, nominal: float, *, degree: int =
             raise ConfigError(f"the closed loop is not a polynomial of degree {d} in V "
                               f"(relative misfit {misfit:.3g} at V = {V:.4g}); "
                               "pass the right degree")
-    return polynomial_stability_interval([c.reshape(n, n) for c in coef], nominal=nominal,
-                                         imag_tol=imag_tol, check_tol=check_tol)
+    r = polynomial_stability_interval([c.reshape(n, n) for c in coef], nominal=nominal,
+                                      imag_tol=imag_tol, check_tol=check_tol)
+    # speeds are >= 0; an end within the location tolerance of V = 0 (where lag states
+    # scaled by V give eigenvalues through 0) is V = 0
+    if r.lower <= check_tol * nominal:
+        r = replace(r, lower=0.0)
+    return r
 
 
 def _pick_ends(kinds: dict[float, str], matrix, nominal: float, method: str,

@@ -36,7 +36,9 @@ def witness():
 def test_the_verification_layer_certifies_the_paper_interval_on_the_truth(witness):
     plant, K = witness
     cert = speed_family_interval(plant, K, 1.2)
-    assert cert.lower <= 0.05 and cert.upper >= 2.4
+    assert cert.upper >= 2.4
+    # stable down to V = 0, where the lag states (∝ V) put eigenvalues at 0
+    assert cert.lower == 0.0
 
 
 def test_a_dense_scan_agrees(witness):

@@ -117,25 +117,38 @@ def _verified_family(family, nominal: float, K) -> dict[str, Any]:
             "exact_interval": [float(r.lower), float(r.upper)]}
 
 
+def _add_run(doc, write, label: str, kind: str, order: int, reach, verified: dict,
+             t0: float, **extra) -> None:
+    """Record one continuation (with its certified interval), report it and rewrite the JSON."""
+    rec = _reach_record(kind, order, reach, verified, time.perf_counter() - t0)
+    rec.update(extra)
+    doc["runs"].append(rec)
+    print(f"{label}: reached {reach.reached}, verified {rec['verified_exact_interval']}",
+          file=sys.stderr, flush=True)
+    write()
+
+
+def _from_high_end(family, lo: float, hi: float):
+    """An LQG controller of the loop's own order at ``hi``, its lower end pushed to ``lo``."""
+    from ...design import full_order_start, stabilize_interval  # noqa: PLC0415
+
+    K0 = full_order_start(family, hi)
+    return stabilize_interval(family, K0, (lo, hi), anchor="high")
+
+
 def _truth_runs(family, lo: float, hi: float, orders, doc, write) -> None:
     """Full order from the high end, then ``orders`` from the low end, on the truth loop."""
     import control  # noqa: PLC0415
 
-    from ...design import full_order_start, stabilize_interval  # noqa: PLC0415
+    from ...design import stabilize_interval  # noqa: PLC0415
     from ...errors import ConfigError  # noqa: PLC0415
 
-    servo = family.servo_omega
     t0 = time.perf_counter()
-    K0 = full_order_start(family, hi)
-    high = stabilize_interval(family, K0, (lo, hi), anchor="high")
-    mid = 0.5 * sum(high.reached)
-    rec = _reach_record(f"LQG at V = {hi:g} (truth, servo {servo:g} rad/s)", K0.nstates,
-                        high, _verified_family(family, mid, high.controller),
-                        time.perf_counter() - t0)
-    doc["runs"].append(rec)
-    print(f"truth, full order {K0.nstates} from the high end: reached {high.reached}, "
-          f"verified {rec['verified_exact_interval']}", file=sys.stderr, flush=True)
-    write()
+    high = _from_high_end(family, lo, hi)
+    n = high.controller.nstates
+    _add_run(doc, write, f"truth, full order {n} from the high end",
+             f"LQG at V = {hi:g} (truth, servo {family.servo_omega:g} rad/s)", n, high,
+             _verified_family(family, 0.5 * sum(high.reached), high.controller), t0)
     for order in orders:
         t0 = time.perf_counter()
         Kr = control.balred(high.controller, order, method="truncate")
@@ -145,14 +158,9 @@ def _truth_runs(family, lo: float, hi: float, orders, doc, write) -> None:
         except ConfigError as exc:     # the truncation does not hold the low end
             _log.warning("truth, order %d: %s", order, exc)
             continue
-        rec = _reach_record("balanced truncation of the full-order truth controller", order,
-                            reach, _verified_family(family, 0.5 * sum(reach.reached),
-                                                    reach.controller),
-                            time.perf_counter() - t0)
-        doc["runs"].append(rec)
-        print(f"truth, order {order} from the low end: reached {reach.reached}, verified "
-              f"{rec['verified_exact_interval']}", file=sys.stderr, flush=True)
-        write()
+        _add_run(doc, write, f"truth, order {order} from the low end",
+                 "balanced truncation of the full-order truth controller", order, reach,
+                 _verified_family(family, 0.5 * sum(reach.reached), reach.controller), t0)
 
 
 def _reach_record(kind: str, order: int, reach, verified: dict, wall: float) -> dict:
@@ -165,7 +173,7 @@ def _reach_record(kind: str, order: int, reach, verified: dict, wall: float) -> 
 
 def _handler(args: argparse.Namespace) -> int:
     from ...design import (SynthesisOptions, design_flutter_controller,  # noqa: PLC0415
-                           full_order_start, stabilize_interval)
+                           stabilize_interval)
     from ...aeroelastic import TruthLoop  # noqa: PLC0415
     from ...errors import CasflutterError, ConfigError  # noqa: PLC0415
     from ...pipeline import load_config  # noqa: PLC0415
@@ -236,23 +244,16 @@ def _handler(args: argparse.Namespace) -> int:
             system, Vf, order, starts=c.starts, seed=args.seed, options=options,
             flap_rate_weight=c.flap_rate_weight, flap_rate_bandwidth=c.flap_rate_bandwidth)
         reach = stabilize_interval(system, design.controller, (lo, hi), anchor="low")
-        rec = _reach_record(f"paper design at Vf (seed {args.seed})", order, reach,
-                            _verified(system, Vf, reach.controller), time.perf_counter() - t0)
-        rec["verified_start"] = _verified(system, Vf, design.controller)   # γ at Vf
-        doc["runs"].append(rec)
-        print(f"order {order} from the low end: reached {reach.reached}, verified "
-              f"{rec['verified_exact_interval']}", file=sys.stderr, flush=True)
-        write()
+        _add_run(doc, write, f"order {order} from the low end",
+                 f"paper design at Vf (seed {args.seed})", order, reach,
+                 _verified(system, Vf, reach.controller), t0,
+                 verified_start=_verified(system, Vf, design.controller))   # γ at Vf
     if args.full_order:
         t0 = time.perf_counter()
-        K0 = full_order_start(system, hi)
-        reach = stabilize_interval(system, K0, (lo, hi), anchor="high")
-        rec = _reach_record(f"LQG at V = {hi:g}", K0.nstates, reach,
-                            _verified(system, hi, reach.controller), time.perf_counter() - t0)
-        doc["runs"].append(rec)
-        print(f"full order {K0.nstates} from the high end: reached {reach.reached}, verified "
-              f"{rec['verified_exact_interval']}", file=sys.stderr, flush=True)
-        write()
+        reach = _from_high_end(system, lo, hi)
+        n = reach.controller.nstates
+        _add_run(doc, write, f"full order {n} from the high end", f"LQG at V = {hi:g}", n,
+                 reach, _verified(system, hi, reach.controller), t0)
     doc["rhp_zero_crossings"] = _rhp_zero_crossings(system, lo, hi, tuple(args.zero_band))
     write()
     print(f"wrote {out}", file=sys.stderr)
