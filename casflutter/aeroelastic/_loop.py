@@ -25,7 +25,7 @@ import control
 import numpy as np
 
 from .._linalg import spectral_abscissa
-from ..errors import DimensionError
+from ..errors import ConfigError, DimensionError
 from ..structure import ModalStructure
 
 __all__ = ["AeroelasticSystem", "AeroelasticLoop", "ParametricSystem", "aeroelastic_loop",
@@ -174,6 +174,47 @@ class AeroelasticLoop:
         B2 = self.B2[:, None]
         zx, zk = self.C2 + self.D22[:, None] @ vx, self.D22[:, None] @ vk
         return np.block([[self.A + B2 @ vx, B2 @ vk], [Bk @ zx, Ak + Bk @ zk]])
+
+    def with_servo(self, omega: float, zeta: float = 0.7) -> "AeroelasticLoop":
+        """This loop with the flap behind a second-order servo, ``v̈ = ω² (c − v) − 2ζω v̇``.
+
+        The controller then commands ``c`` as it would on a wind-tunnel model (the truth's
+        :class:`~casflutter.aeroelastic.TruthLoop` puts its flap behind the same servo), and the
+        flap position ``v`` becomes a state: the sensors' flap feed-through ``D22`` moves into
+        ``C2``, so the returned loop is strictly proper in ``c``.
+
+        Parameters
+        ----------
+        omega : float
+            Servo natural frequency [rad per time unit] (> 0).
+        zeta : float
+            Servo damping ratio (>= 0).
+
+        Returns
+        -------
+        AeroelasticLoop
+            States ``(x, v, v̇)``; ``n_f`` counts the two servo states.
+
+        Raises
+        ------
+        ConfigError
+            A frequency or damping out of range.
+        """
+        if not (np.isfinite(omega) and omega > 0 and np.isfinite(zeta) and zeta >= 0):
+            raise ConfigError(f"servo omega = {omega!r} must be > 0 and zeta = {zeta!r} >= 0")
+        n, m = self.A.shape[0], self.C2.shape[0]
+        w2 = float(omega) ** 2
+        A = np.zeros((n + 2, n + 2))
+        A[:n, :n], A[:n, n] = self.A, self.B2
+        A[n, n + 1] = 1.0
+        A[n + 1, n], A[n + 1, n + 1] = -w2, -2.0 * float(zeta) * float(omega)
+        B2 = np.zeros(n + 2)
+        B2[n + 1] = w2
+        C2 = np.hstack([self.C2, self.D22[:, None], np.zeros((m, 1))])
+        return AeroelasticLoop(self.V, A, np.vstack([self.B1, np.zeros((2, self.B1.shape[1]))]),
+                               B2, C2, self.D21, np.zeros(m),
+                               np.hstack([self.Cu, np.zeros((self.n_modes, 2))]),
+                               self.n_modes, self.n_f + 2)
 
     def poles(self) -> np.ndarray:
         """Eigenvalues of Â(V).
@@ -402,6 +443,37 @@ class ParametricSystem:
         """
         return AeroelasticSystem.from_parts(self.rom.sigma_f(V), self.structure,
                                             warn_unstable=False)
+
+    def loop(self, V: float) -> AeroelasticLoop:
+        """ΣAE at speed index V (eq. 8-9) with Σf interpolated at the same V.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        AeroelasticLoop
+        """
+        return AeroelasticSystem(self.structure, *self.rom.sigma_f_matrices(V)).loop(V)
+
+    def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
+        """State matrix of :meth:`loop` closed with ``v = K zm`` (positive feedback).
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+        controller : control.StateSpace
+            Continuous K with ``n_sensors`` inputs and one output.
+
+        Returns
+        -------
+        ndarray
+            The state matrix of ``(x, x_K)``.
+        """
+        return self.loop(V).closed_loop_state_matrix(controller)
 
     def state_matrix(self, V: float) -> np.ndarray:
         """Â(V) of eq. 8a with Σf interpolated at the same V.
