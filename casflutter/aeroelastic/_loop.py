@@ -18,6 +18,8 @@ for accelerometers the zm rows carry the aerodynamic and disturbance feed-throug
 
 from __future__ import annotations
 
+import math
+import numbers
 import warnings
 from dataclasses import dataclass
 
@@ -239,6 +241,20 @@ class AeroelasticSystem:
         Σs.
     Af, Bf, bf, Cf, Df, df : ndarray
         The blocks of Σf (eq. 5).
+    convective_V0 : float, optional
+        The speed index at which Σf was identified, to scale its time with the speed:
+        ``Σf(s; V) = Σf(s V0 / V)``, i.e. ``Af, Bf, bf`` times ``V / V0`` in eq. 8.  The
+        aerodynamics of a wing in incompressible flow depend on the reduced frequency
+        ``ω b / U``, so their lags speed up with V; eq. 8 as the paper writes it (``None``,
+        the default) scales only the forces by ``V²`` and keeps the lags of ``V0``.  With the
+        scaling, ΣAE(V) is a quadratic polynomial in V (the lags ∝ V, the forces ∝ V²);
+        the paper's LFT in ``V²`` (eq. 14) no longer describes it.
+
+    Notes
+    -----
+    With ``convective_V0`` set, eq. 8a reads
+    ``Â(V) = [[As + V² Bs Df Cs, V² Bs Cf], [(V/V0) Bf Cs, (V/V0) Af]]`` and
+    ``B̂2(V) = [V² Bs df; (V/V0) bf]``.
     """
 
     structure: ModalStructure
@@ -248,10 +264,32 @@ class AeroelasticSystem:
     Cf: np.ndarray
     Df: np.ndarray
     df: np.ndarray
+    convective_V0: float | None = None
+
+    def __post_init__(self):
+        V0 = self.convective_V0
+        if V0 is not None and not (isinstance(V0, numbers.Real) and not isinstance(V0, bool)
+                                   and math.isfinite(V0) and V0 > 0):
+            raise ConfigError(f"convective_V0 = {V0!r}: the identification speed index of Σf "
+                              "(> 0), or None for eq. 8 without time scaling")
+
+    def lag_scale(self, V: float) -> float:
+        """The factor on ``Af, Bf, bf`` at speed index V: ``V / convective_V0``, or 1.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        float
+        """
+        return 1.0 if self.convective_V0 is None else float(V) / float(self.convective_V0)
 
     @classmethod
-    def from_parts(cls, sigma_f, structure: ModalStructure, *, warn_unstable: bool = True
-                   ) -> "AeroelasticSystem":
+    def from_parts(cls, sigma_f, structure: ModalStructure, *, warn_unstable: bool = True,
+                   convective_V0: float | None = None) -> "AeroelasticSystem":
         """Build from Σf (continuous ``control.StateSpace``) and Σs.
 
         Parameters
@@ -262,6 +300,9 @@ class AeroelasticSystem:
             Σs (a truth's :meth:`modal_structure` goes in as it is).
         warn_unstable : bool
             Warn when Σf is unstable on its own.
+        convective_V0 : float, optional
+            Scale Σf's time with the speed from this identification speed index (class
+            attribute ``convective_V0``).
 
         Returns
         -------
@@ -282,7 +323,7 @@ class AeroelasticSystem:
             raise DimensionError(f"structure must be a casflutter.structure.ModalStructure "
                                  f"(Σs), got {type(structure).__name__}")
         parts = split_sigma_f(sigma_f, structure.n_modes)
-        sys = cls(structure, *parts)
+        sys = cls(structure, *parts, convective_V0=convective_V0)
         if warn_unstable and not sys.rom_stable:
             warnings.warn(
                 f"Σf is unstable on its own (spectral abscissa {sys.rom_spectral_abscissa:.3g} > 0), "
@@ -334,10 +375,10 @@ class AeroelasticSystem:
         ndarray, shape (2N + nf, 2N + nf)
         """
         s = self.structure
-        V2 = float(V) ** 2
+        V2, r = float(V) ** 2, self.lag_scale(V)
         As, Bs, Cs = s.As, s.Bs, s.Cs
         top = np.hstack([As + V2 * Bs @ self.Df @ Cs, V2 * Bs @ self.Cf])
-        bot = np.hstack([self.Bf @ Cs, self.Af])
+        bot = np.hstack([r * self.Bf @ Cs, r * self.Af])
         return np.vstack([top, bot])
 
     def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
@@ -375,7 +416,7 @@ class AeroelasticSystem:
         Bs, Cs = s.Bs, s.Cs
         A = self.state_matrix(V)
         B1 = np.vstack([Bs, np.zeros((nf, s.n_modes))])
-        B2 = np.concatenate([V2 * Bs @ self.df, self.bf])
+        B2 = np.concatenate([V2 * Bs @ self.df, self.lag_scale(V) * self.bf])
         Hx, Hf = s.sensor_matrices()
         C2 = np.hstack([Hx + V2 * Hf @ self.Df @ Cs, V2 * Hf @ self.Cf])
         D21 = Hf.copy()
