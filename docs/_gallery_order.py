@@ -10,6 +10,7 @@ ORDER = (
     "plot_lco_branches.py",
     "plot_compleib_synthesis.py",
     "plot_seed_wing_pipeline.py",
+    "plot_seed_wing_control_models.py",
     "plot_wing_file.py",
     "plot_sweep.py",
     "plot_sensitivity.py",

@@ -179,6 +179,13 @@ def build_lft(system: AeroelasticSystem, Vf: float) -> AeroelasticLFT:
     """
     if Vf is None or not np.isfinite(Vf):
         raise ConfigError(f"Vf must be a finite speed index, got {Vf!r} (no flutter found?)")
+    if getattr(system, "convective_V0", None) is not None:
+        raise ConfigError(
+            "the LFT of eq. 14 takes V only through V² (Σf frozen at its identification "
+            "speed); this system scales Σf's time with V (convective_V0 = "
+            f"{system.convective_V0!r}), so eq. 14 does not describe it: build the LFT on "
+            "the system without convective_V0, or certify a controller with "
+            "casflutter.verify.speed_family_interval (exact for a loop polynomial in V)")
     s = system.structure
     N, nf = s.n_modes, system.n_f
     Vf2 = float(Vf) ** 2

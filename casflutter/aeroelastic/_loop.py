@@ -18,6 +18,8 @@ for accelerometers the zm rows carry the aerodynamic and disturbance feed-throug
 
 from __future__ import annotations
 
+import math
+import numbers
 import warnings
 from dataclasses import dataclass
 
@@ -25,7 +27,7 @@ import control
 import numpy as np
 
 from .._linalg import spectral_abscissa
-from ..errors import DimensionError
+from ..errors import ConfigError, DimensionError
 from ..structure import ModalStructure
 
 __all__ = ["AeroelasticSystem", "AeroelasticLoop", "ParametricSystem", "aeroelastic_loop",
@@ -175,6 +177,47 @@ class AeroelasticLoop:
         zx, zk = self.C2 + self.D22[:, None] @ vx, self.D22[:, None] @ vk
         return np.block([[self.A + B2 @ vx, B2 @ vk], [Bk @ zx, Ak + Bk @ zk]])
 
+    def with_servo(self, omega: float, zeta: float = 0.7) -> "AeroelasticLoop":
+        """This loop with the flap behind a second-order servo, ``v̈ = ω² (c − v) − 2ζω v̇``.
+
+        The controller then commands ``c`` as it would on a wind-tunnel model (the truth's
+        :class:`~casflutter.aeroelastic.TruthLoop` puts its flap behind the same servo), and the
+        flap position ``v`` becomes a state: the sensors' flap feed-through ``D22`` moves into
+        ``C2``, so the returned loop is strictly proper in ``c``.
+
+        Parameters
+        ----------
+        omega : float
+            Servo natural frequency [rad per time unit] (> 0).
+        zeta : float
+            Servo damping ratio (>= 0).
+
+        Returns
+        -------
+        AeroelasticLoop
+            States ``(x, v, v̇)``; ``n_f`` counts the two servo states.
+
+        Raises
+        ------
+        ConfigError
+            A frequency or damping out of range.
+        """
+        if not (np.isfinite(omega) and omega > 0 and np.isfinite(zeta) and zeta >= 0):
+            raise ConfigError(f"servo omega = {omega!r} must be > 0 and zeta = {zeta!r} >= 0")
+        n, m = self.A.shape[0], self.C2.shape[0]
+        w2 = float(omega) ** 2
+        A = np.zeros((n + 2, n + 2))
+        A[:n, :n], A[:n, n] = self.A, self.B2
+        A[n, n + 1] = 1.0
+        A[n + 1, n], A[n + 1, n + 1] = -w2, -2.0 * float(zeta) * float(omega)
+        B2 = np.zeros(n + 2)
+        B2[n + 1] = w2
+        C2 = np.hstack([self.C2, self.D22[:, None], np.zeros((m, 1))])
+        return AeroelasticLoop(self.V, A, np.vstack([self.B1, np.zeros((2, self.B1.shape[1]))]),
+                               B2, C2, self.D21, np.zeros(m),
+                               np.hstack([self.Cu, np.zeros((self.n_modes, 2))]),
+                               self.n_modes, self.n_f + 2)
+
     def poles(self) -> np.ndarray:
         """Eigenvalues of Â(V).
 
@@ -198,6 +241,20 @@ class AeroelasticSystem:
         Σs.
     Af, Bf, bf, Cf, Df, df : ndarray
         The blocks of Σf (eq. 5).
+    convective_V0 : float, optional
+        The speed index at which Σf was identified, to scale its time with the speed:
+        ``Σf(s; V) = Σf(s V0 / V)``, i.e. ``Af, Bf, bf`` times ``V / V0`` in eq. 8.  The
+        aerodynamics of a wing in incompressible flow depend on the reduced frequency
+        ``ω b / U``, so their lags speed up with V; eq. 8 as the paper writes it (``None``,
+        the default) scales only the forces by ``V²`` and keeps the lags of ``V0``.  With the
+        scaling, ΣAE(V) is a quadratic polynomial in V (the lags ∝ V, the forces ∝ V²);
+        the paper's LFT in ``V²`` (eq. 14) no longer describes it.
+
+    Notes
+    -----
+    With ``convective_V0`` set, eq. 8a reads
+    ``Â(V) = [[As + V² Bs Df Cs, V² Bs Cf], [(V/V0) Bf Cs, (V/V0) Af]]`` and
+    ``B̂2(V) = [V² Bs df; (V/V0) bf]``.
     """
 
     structure: ModalStructure
@@ -207,10 +264,32 @@ class AeroelasticSystem:
     Cf: np.ndarray
     Df: np.ndarray
     df: np.ndarray
+    convective_V0: float | None = None
+
+    def __post_init__(self):
+        V0 = self.convective_V0
+        if V0 is not None and not (isinstance(V0, numbers.Real) and not isinstance(V0, bool)
+                                   and math.isfinite(V0) and V0 > 0):
+            raise ConfigError(f"convective_V0 = {V0!r}: the identification speed index of Σf "
+                              "(> 0), or None for eq. 8 without time scaling")
+
+    def lag_scale(self, V: float) -> float:
+        """The factor on ``Af, Bf, bf`` at speed index V: ``V / convective_V0``, or 1.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        float
+        """
+        return 1.0 if self.convective_V0 is None else float(V) / float(self.convective_V0)
 
     @classmethod
-    def from_parts(cls, sigma_f, structure: ModalStructure, *, warn_unstable: bool = True
-                   ) -> "AeroelasticSystem":
+    def from_parts(cls, sigma_f, structure: ModalStructure, *, warn_unstable: bool = True,
+                   convective_V0: float | None = None) -> "AeroelasticSystem":
         """Build from Σf (continuous ``control.StateSpace``) and Σs.
 
         Parameters
@@ -221,6 +300,9 @@ class AeroelasticSystem:
             Σs (a truth's :meth:`modal_structure` goes in as it is).
         warn_unstable : bool
             Warn when Σf is unstable on its own.
+        convective_V0 : float, optional
+            Scale Σf's time with the speed from this identification speed index (class
+            attribute ``convective_V0``).
 
         Returns
         -------
@@ -241,7 +323,7 @@ class AeroelasticSystem:
             raise DimensionError(f"structure must be a casflutter.structure.ModalStructure "
                                  f"(Σs), got {type(structure).__name__}")
         parts = split_sigma_f(sigma_f, structure.n_modes)
-        sys = cls(structure, *parts)
+        sys = cls(structure, *parts, convective_V0=convective_V0)
         if warn_unstable and not sys.rom_stable:
             warnings.warn(
                 f"Σf is unstable on its own (spectral abscissa {sys.rom_spectral_abscissa:.3g} > 0), "
@@ -293,10 +375,10 @@ class AeroelasticSystem:
         ndarray, shape (2N + nf, 2N + nf)
         """
         s = self.structure
-        V2 = float(V) ** 2
+        V2, r = float(V) ** 2, self.lag_scale(V)
         As, Bs, Cs = s.As, s.Bs, s.Cs
         top = np.hstack([As + V2 * Bs @ self.Df @ Cs, V2 * Bs @ self.Cf])
-        bot = np.hstack([self.Bf @ Cs, self.Af])
+        bot = np.hstack([r * self.Bf @ Cs, r * self.Af])
         return np.vstack([top, bot])
 
     def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
@@ -334,7 +416,7 @@ class AeroelasticSystem:
         Bs, Cs = s.Bs, s.Cs
         A = self.state_matrix(V)
         B1 = np.vstack([Bs, np.zeros((nf, s.n_modes))])
-        B2 = np.concatenate([V2 * Bs @ self.df, self.bf])
+        B2 = np.concatenate([V2 * Bs @ self.df, self.lag_scale(V) * self.bf])
         Hx, Hf = s.sensor_matrices()
         C2 = np.hstack([Hx + V2 * Hf @ self.Df @ Cs, V2 * Hf @ self.Cf])
         D21 = Hf.copy()
@@ -402,6 +484,37 @@ class ParametricSystem:
         """
         return AeroelasticSystem.from_parts(self.rom.sigma_f(V), self.structure,
                                             warn_unstable=False)
+
+    def loop(self, V: float) -> AeroelasticLoop:
+        """ΣAE at speed index V (eq. 8-9) with Σf interpolated at the same V.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        AeroelasticLoop
+        """
+        return AeroelasticSystem(self.structure, *self.rom.sigma_f_matrices(V)).loop(V)
+
+    def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
+        """State matrix of :meth:`loop` closed with ``v = K zm`` (positive feedback).
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+        controller : control.StateSpace
+            Continuous K with ``n_sensors`` inputs and one output.
+
+        Returns
+        -------
+        ndarray
+            The state matrix of ``(x, x_K)``.
+        """
+        return self.loop(V).closed_loop_state_matrix(controller)
 
     def state_matrix(self, V: float) -> np.ndarray:
         """Â(V) of eq. 8a with Σf interpolated at the same V.

@@ -144,9 +144,18 @@ class RomSection(IdentificationSettings):
     the ROM equals the truth at its flutter speed."""
     v0_rtol: float = 2e-3
     """Stop when ``|Vf - V0| <= v0_rtol Vf``."""
+    convective: bool = False
+    """Scale Σf's time with the speed, ``Σf(s; V) = Σf(s V0 / V)``
+    (:class:`casflutter.aeroelastic.AeroelasticSystem` ``convective_V0``): the aerodynamics of
+    strip theory depend on the reduced frequency, so one ROM identified at ``V0`` holds at
+    every speed.  ``false`` is eq. 8 as the paper writes it (Σf frozen at ``V0``, forces
+    scaled by V²).  The flutter route only: the paper's LFT (eq. 14) and the ROM's sampled
+    loop (``lco``) take Σf frozen."""
 
     def __post_init__(self):
         super().__post_init__()
+        if not isinstance(self.convective, bool):
+            raise ConfigError(f"convective = {self.convective!r}: true or false")
         if self.method not in ("hwl", "common_denominator"):
             raise ConfigError(f"method = {self.method!r}: allowed 'hwl', 'common_denominator'")
         o = self.orders
@@ -488,6 +497,13 @@ class RunConfig:
         if "parametric" in stages and self.rom.method != "common_denominator":
             raise ConfigError("stages: 'parametric' interpolates common-denominator ROMs; set "
                               "rom.method = \"common_denominator\"")
+        frozen_only = [s for s in ("lco", "controller", "closed_loop", "suppression")
+                       if s in stages]
+        if self.rom.convective and frozen_only:
+            raise ConfigError(f"rom.convective = true scales Σf's time with V, but stage "
+                              f"{frozen_only[0]!r} takes the ROM frozen at V0 (the paper's "
+                              "LFT and the sampled ROM loop); set rom.convective = false or "
+                              f"leave {', '.join(map(repr, frozen_only))} out of stages")
         if "closed_loop" in stages and self.sensors.kind != "displacement":
             raise ConfigError("stages: 'closed_loop' sweeps the truth's linear loop read by "
                               "displacement sensors; set sensors.kind = \"displacement\"")

@@ -303,7 +303,11 @@ class RunResult:
 
     @property
     def identification_error(self) -> float | None:
-        """``(Vf_rom - Vf_frozen) / Vf_frozen``: what identification and Tustin add."""
+        """What identification and Tustin add: ``(Vf_rom - Vf_frozen) / Vf_frozen`` for the
+        ROM of eq. 8 (frozen at V0, as the frozen-aero truth), the :attr:`rom_error` for a
+        ROM whose time scales with V (``rom.convective``: it stands for the truth itself)."""
+        if self.system is not None and self.system.convective_V0 is not None:
+            return self.rom_error
         return None if self.flutter_frozen is None else _rel(self.Vf,
                                                              self.flutter_frozen.Vf)
 
@@ -328,7 +332,15 @@ class RunResult:
                else "")
         text = (f"ROM identified at speed index V0 = {V0['speed_index']:g}{air}: Vf error "
                 f"{pct(self.rom_error)} vs the truth.")
-        if self.flutter_frozen is not None:
+        convective = self.system is not None and self.system.convective_V0 is not None
+        if convective:
+            text += (" Its time is scaled with the speed (rom.convective), so its aerodynamic "
+                     "lags follow the reduced frequency as the truth's do.")
+            if self.flutter_frozen is not None:
+                text += (f" Without that scaling (eq. 8 as the paper writes it) the ROM "
+                         f"would stand for the truth with its aerodynamics frozen at V0, "
+                         f"which flutters at {pct(self.scaling_error)}.")
+        elif self.flutter_frozen is not None:
             text += (f" The V² scaling of ΣAE freezes the aerodynamic time scale (reduced "
                      f"frequency, Wagner lag rates, apparent mass and damping) at V0; the truth "
                      f"with its aerodynamics frozen at V0 flutters at "
@@ -422,6 +434,8 @@ class RunResult:
         }
         if self.skipped:
             out["skipped"] = dict(self.skipped)
+        if self.system is not None and self.system.convective_V0 is not None:
+            out["convective_V0"] = float(self.system.convective_V0)
         if cfg.rom.v0_iterations > 1:
             out["v0_history"] = [list(map(float, p)) for p in self.identification_history]
         if self.flutter_frozen is not None:

@@ -325,6 +325,9 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
     needs_vf = cfg.rom.v0_iterations > 1 or bool(set(cfg.stages) & {"lco", "controller"})
     out: dict = {"config": cfg, "truth": truth, "problem": problem, "skipped": skipped}
     if isinstance(problem, GAFProblem):
+        if cfg.rom.convective:
+            raise ConfigError("rom.convective: a GAF problem's rational-function "
+                              "aerodynamics already scale with the speed; leave it false")
         _run_gaf(cfg, problem, rfa_settings, structure, prog, out)
         Vf = out.pop("gaf_Vf", None)
         out.update(data=None, identification=None, identification_history=(), fit=None,
@@ -344,7 +347,9 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
         with prog.stage("realize"):
             real = realize(model, cfg.rom.nf)
         with prog.stage("structure"):
-            system = AeroelasticSystem.from_parts(real.sigma_f, structure, warn_unstable=False)
+            system = AeroelasticSystem.from_parts(
+                real.sigma_f, structure, warn_unstable=False,
+                convective_V0=float(V0) if cfg.rom.convective else None)
             if not system.rom_stable:
                 prog.note("warning: Σf is unstable on its own (ΣAE unstable at V = 0)")
         with prog.stage("flutter"):

@@ -1,11 +1,12 @@
-"""The witness that the seed wing itself admits one linear controller over V ∈ (0, 2.4).
+"""The witnesses that the seed wing itself admits one linear controller over V ∈ (0, 2.4).
 
-``problems/seed_wing/truth_interval_controller.json`` is a full-order controller found by
-continuation on the truth's own linearisation with the flap behind its 40 Hz servo
-(:class:`casflutter.aeroelastic.TruthLoop`; see the file's ``about``).  Whether it holds the
-wing is not taken from the optimiser: the verification layer certifies the exact stable
-interval (polynomial guardian map, the loop closed by python-control), and a dense
-eigenvalue scan computed here agrees.
+``problems/seed_wing/truth_interval_controller.json`` is a full-order controller (32 states,
+minimal order 20) found by continuation on the truth's own linearisation with the flap behind
+its 40 Hz servo (:class:`casflutter.aeroelastic.TruthLoop`);
+``truth_interval_controller_order8.json`` is an order-8 controller reduced from it (see each
+file's ``about``).  Whether they hold the wing is not taken from the optimiser: the
+verification layer certifies the exact stable interval (polynomial guardian map, the loop
+closed by python-control), and a dense eigenvalue scan computed here agrees.
 """
 
 from __future__ import annotations
@@ -20,30 +21,31 @@ from casflutter.truth import SeedWing
 from casflutter.verify import load_controller, speed_family_interval
 
 SERVO = 251.3     # rad/s, the seed wing's 40 Hz servo (run.toml: controller.flap_rate_bandwidth)
+WITNESSES = {"truth_interval_controller.json": 32, "truth_interval_controller_order8.json": 8}
 
 
 @pytest.fixture(scope="module")
-def witness():
+def plant():
     fam = TruthLoop(SeedWing(), SERVO)
-
-    def plant(V):
-        return fam.loop(V).flap_to_sensors()
-
-    K = load_controller(problems_dir() / "seed_wing" / "truth_interval_controller.json")
-    return plant, K
+    return lambda V: fam.loop(V).flap_to_sensors()
 
 
-def test_the_verification_layer_certifies_the_paper_interval_on_the_truth(witness):
-    plant, K = witness
-    cert = speed_family_interval(plant, K, 1.2)
+@pytest.fixture(scope="module", params=sorted(WITNESSES))
+def witness(request):
+    K = load_controller(problems_dir() / "seed_wing" / request.param)
+    assert K.nstates == WITNESSES[request.param]
+    return K
+
+
+def test_the_verification_layer_certifies_the_paper_interval_on_the_truth(plant, witness):
+    cert = speed_family_interval(plant, witness, 1.2)
     assert cert.upper >= 2.4
     # stable down to V = 0, where the lag states (∝ V) put eigenvalues at 0
     assert cert.lower == 0.0
 
 
-def test_a_dense_scan_agrees(witness):
-    plant, K = witness
-    worst = max(float(np.max(control.feedback(plant(V), K, sign=1).poles().real))
+def test_a_dense_scan_agrees(plant, witness):
+    worst = max(float(np.max(control.feedback(plant(V), witness, sign=1).poles().real))
                 for V in np.linspace(0.05, 2.4, 48))
     assert worst < 0
     # and the open loop flutters inside the interval: the controller does the work
