@@ -3,8 +3,8 @@
 ``problems/seed_wing/truth_interval_controller.json`` is a full-order controller (32 states,
 minimal order 20) found by continuation on the truth's own linearisation with the flap behind
 its 40 Hz servo (:class:`casflutter.aeroelastic.TruthLoop`);
-``truth_interval_controller_order8.json`` is an order-8 controller reduced from it (see each
-file's ``about``).  Whether they hold the wing is not taken from the optimiser: the
+``truth_interval_controller_order8.json`` and ``..._order7.json`` are order-8 and order-7
+controllers reduced from it, the lowest orders found (see each file's ``about``).  Whether they hold the wing is not taken from the optimiser: the
 verification layer certifies the exact stable interval (polynomial guardian map, the loop
 closed by python-control), and a dense eigenvalue scan computed here agrees.
 """
@@ -21,7 +21,8 @@ from casflutter.truth import SeedWing
 from casflutter.verify import load_controller, speed_family_interval
 
 SERVO = 251.3     # rad/s, the seed wing's 40 Hz servo (run.toml: controller.flap_rate_bandwidth)
-WITNESSES = {"truth_interval_controller.json": 32, "truth_interval_controller_order8.json": 8}
+WITNESSES = {"truth_interval_controller.json": 32, "truth_interval_controller_order8.json": 8,
+             "truth_interval_controller_order7.json": 7}
 
 
 @pytest.fixture(scope="module")
