@@ -153,7 +153,10 @@ def build_lft(system: AeroelasticSystem, Vf: float) -> AeroelasticLFT:
     Parameters
     ----------
     system : AeroelasticSystem
-        Σf and Σs.
+        Σf and Σs.  A system whose ROM is scaled in time (``convective_V0``) is first frozen
+        at ``Vf`` (:meth:`AeroelasticSystem.frozen_at`): the nominal loop is exact, and the
+        V² uncertainty of eq. 10 keeps the lags of ``Vf`` (its exact stable interval is then
+        :func:`casflutter.verify.speed_family_interval`'s, not the LFT's).
     Vf : float
         Nominal flutter speed index (e.g. ``find_flutter(system, ...).Vf``).
 
@@ -180,12 +183,7 @@ def build_lft(system: AeroelasticSystem, Vf: float) -> AeroelasticLFT:
     if Vf is None or not np.isfinite(Vf):
         raise ConfigError(f"Vf must be a finite speed index, got {Vf!r} (no flutter found?)")
     if getattr(system, "convective_V0", None) is not None:
-        raise ConfigError(
-            "the LFT of eq. 14 takes V only through V² (Σf frozen at its identification "
-            "speed); this system scales Σf's time with V (convective_V0 = "
-            f"{system.convective_V0!r}), so eq. 14 does not describe it: build the LFT on "
-            "the system without convective_V0, or certify a controller with "
-            "casflutter.verify.speed_family_interval (exact for a loop polynomial in V)")
+        system = system.frozen_at(Vf)      # eq. 14 with the lags of Vf: exact at Vf
     s = system.structure
     N, nf = s.n_modes, system.n_f
     Vf2 = float(Vf) ** 2

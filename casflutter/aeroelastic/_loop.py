@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import numbers
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import control
 import numpy as np
@@ -247,8 +247,9 @@ class AeroelasticSystem:
         aerodynamics of a wing in incompressible flow depend on the reduced frequency
         ``ω b / U``, so their lags speed up with V; eq. 8 as the paper writes it (``None``,
         the default) scales only the forces by ``V²`` and keeps the lags of ``V0``.  With the
-        scaling, ΣAE(V) is a quadratic polynomial in V (the lags ∝ V, the forces ∝ V²);
-        the paper's LFT in ``V²`` (eq. 14) no longer describes it.
+        scaling, ΣAE(V) is a quadratic polynomial in V (the lags ∝ V, the forces ∝ V²), and
+        the paper's LFT in ``V²`` (eq. 14) describes it only near its nominal speed
+        (:func:`build_lft` uses :meth:`frozen_at` that speed).
 
     Notes
     -----
@@ -286,6 +287,29 @@ class AeroelasticSystem:
         float
         """
         return 1.0 if self.convective_V0 is None else float(V) / float(self.convective_V0)
+
+    def frozen_at(self, V: float) -> "AeroelasticSystem":
+        """This system with Σf's time scale held at that of speed index V (eq. 8 as the paper
+        writes it, Σf identified at V): the same loop at V, the forces alone scaled by V²
+        elsewhere.  Without ``convective_V0`` the system itself.
+
+        Parameters
+        ----------
+        V : float
+            Speed index (> 0).
+
+        Returns
+        -------
+        AeroelasticSystem
+            ``convective_V0`` None; ``loop(V)`` equals this system's ``loop(V)``.
+        """
+        if self.convective_V0 is None:
+            return self
+        r = self.lag_scale(V)
+        if not r > 0:
+            raise ConfigError(f"V = {V!r}: freezing the ROM's time scale needs a speed > 0")
+        return replace(self, Af=r * self.Af, Bf=r * self.Bf, bf=r * self.bf,
+                       convective_V0=None)
 
     @classmethod
     def from_parts(cls, sigma_f, structure: ModalStructure, *, warn_unstable: bool = True,
