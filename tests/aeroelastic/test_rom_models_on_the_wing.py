@@ -11,9 +11,12 @@ reference):
 * the convective ROM (one linear ROM at V0, its time scaled by V/V0:
   ``AeroelasticSystem(convective_V0=V0)``), which is what strip theory's dependence on the
   reduced frequency implies;
-* the frozen ROM of eq. 8 as the paper writes it, which loses the loop below the flutter speed.
+* the frozen ROM of eq. 8 as the paper writes it (the run's HWL ROM, and the linear ROM
+  unscaled), which loses the loop below the flutter speed.
 
-Every loop has the flap behind the same 40 Hz servo.
+Every loop has the flap behind the same 40 Hz servo.  Last, the paper's order-3 design at Vf
+is made on the convective and on the frozen linear ROM, and the interval each certifies on
+its own loop is compared with the one the wing certifies.
 """
 
 from __future__ import annotations
