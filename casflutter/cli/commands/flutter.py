@@ -41,6 +41,9 @@ def register(subparsers) -> None:
                    help="speed range of the analysis, in the problem's speed unit")
     p.add_argument("--v0", type=float, default=None,
                    help="nominal speed of the single-speed ROM, in the problem's speed unit")
+    p.add_argument("--convective", action="store_true",
+                   help="scale the single-speed ROM's time with the speed (rom.convective: "
+                        "its lags follow the reduced frequency, as strip theory's do)")
     p.add_argument("--no-parametric", action="store_true",
                    help="skip the parametric ROM (its block is then null)")
     p.add_argument("--figure", default=None, metavar="PATH",
@@ -117,6 +120,7 @@ def summarize(result, problem: str) -> dict:
                   "relative_errors": "fraction (0.01 = 1 %)", "timings": "s",
                   "speed_index": truth.modal_structure().speed_index},
         "rom_V0": to_unit(result.config.data.V0),
+        "rom_convective": bool(result.config.rom.convective),
         "V_range": [to_unit(v) for v in result.config.flutter.V_range],
         "parametric_speeds": (None if result.parametric is None
                               else [to_unit(v) for v in result.parametric.rom.speeds]),
@@ -136,7 +140,9 @@ def _figure(result, path: str, omega_max: float, xlabel: str) -> None:
 
     from ...report import plot_vg_vf
 
-    panels = [("truth", result.flutter_truth), ("ROM at V0 (V² scaling)", result.flutter)]
+    rom = ("ROM at V0 (time scaled with V)" if result.config.rom.convective
+           else "ROM at V0 (V² scaling)")
+    panels = [("truth", result.flutter_truth), (rom, result.flutter)]
     if result.parametric is not None:
         panels.append(("parametric ROM", result.parametric.flutter))
     fig, axes = plt.subplots(2, len(panels), sharex=True, figsize=(5.0 * len(panels), 6.5),
@@ -197,6 +203,9 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
     from ...errors import ConfigError
     from ...pipeline import RunConfig, run as run_config
 
+    if args.convective:
+        raise ConfigError(f"--convective does not apply to the GAF wing file {problem.path}: "
+                          "its rational-function aerodynamics already scale with the airspeed")
     for flag, given in (("--v0", args.v0 is not None), ("--vrange", args.vrange is not None)):
         if given:
             raise ConfigError(f"{flag} does not apply to the GAF wing file {problem.path}: it "
@@ -281,6 +290,8 @@ def run(args) -> int:
         updates["flutter.V_range"] = [from_unit(lo), from_unit(hi)]
     if args.v0 is not None:
         updates["data.V0"] = from_unit(args.v0)
+    if args.convective:
+        updates["rom.convective"] = True
     cfg = flutter_config(args.problem, updates=updates)
     if args.no_parametric:
         cfg = replace(cfg, stages=tuple(s for s in cfg.stages if s != "parametric"))
@@ -299,16 +310,18 @@ def run(args) -> int:
     u = doc["units"]
     vu = "m/s" if u["V_flutter"] == "m/s" else "index"
     print(f"{label}: flutter speed ({u['V_flutter']}), frequency ({u['omega_flutter']})")
-    print(f"  {'':20} {f'V_flutter [{vu}]':>18} {'omega_flutter':>14} {'mode':>12} "
-          f"{f'V_divergence [{vu}]':>20}")
     v0 = f"{doc['rom_V0']:.4g}" + (" m/s" if vu == "m/s" else "")
-    for key, label in (("truth", "truth"), ("rom", f"ROM at V0={v0}"),
+    rom_label = ("scaled " if result.config.rom.convective else "") + f"ROM at V0={v0}"
+    w = max(20, len(rom_label))
+    print(f"  {'':{w}} {f'V_flutter [{vu}]':>18} {'omega_flutter':>14} {'mode':>12} "
+          f"{f'V_divergence [{vu}]':>20}")
+    for key, label in (("truth", "truth"), ("rom", rom_label),
                        ("frozen_aero_truth", "frozen-aero truth"),
                        ("parametric_rom", "parametric ROM")):
         b = doc[key]
         if b is None:
             continue
-        print(f"  {label:20} {_fmt(b['V_flutter']):>18} {_fmt(b['omega_flutter']):>14} "
+        print(f"  {label:{w}} {_fmt(b['V_flutter']):>18} {_fmt(b['omega_flutter']):>14} "
               f"{str(b['mode']):>12} {_fmt(b['V_divergence']):>20}")
     print(f"  {doc['explanation']}")
     for w in doc["warnings"]:
