@@ -302,11 +302,17 @@ class RunResult:
                                                              self.Vf_truth)
 
     @property
+    def convective_V0(self) -> float | None:
+        """The speed index from which the ROM's time is scaled (``rom.convective``), or
+        ``None`` for Σf frozen at V0 (eq. 8)."""
+        return None if self.system is None else self.system.convective_V0
+
+    @property
     def identification_error(self) -> float | None:
         """What identification and Tustin add: ``(Vf_rom - Vf_frozen) / Vf_frozen`` for the
         ROM of eq. 8 (frozen at V0, as the frozen-aero truth), the :attr:`rom_error` for a
         ROM whose time scales with V (``rom.convective``: it stands for the truth itself)."""
-        if self.system is not None and self.system.convective_V0 is not None:
+        if self.convective_V0 is not None:
             return self.rom_error
         return None if self.flutter_frozen is None else _rel(self.Vf,
                                                              self.flutter_frozen.Vf)
@@ -332,8 +338,7 @@ class RunResult:
                else "")
         text = (f"ROM identified at speed index V0 = {V0['speed_index']:g}{air}: Vf error "
                 f"{pct(self.rom_error)} vs the truth.")
-        convective = self.system is not None and self.system.convective_V0 is not None
-        if convective:
+        if self.convective_V0 is not None:
             text += (" Its time is scaled with the speed (rom.convective), so its aerodynamic "
                      "lags follow the reduced frequency as the truth's do.")
             if self.flutter_frozen is not None:
@@ -434,8 +439,8 @@ class RunResult:
         }
         if self.skipped:
             out["skipped"] = dict(self.skipped)
-        if self.system is not None and self.system.convective_V0 is not None:
-            out["convective_V0"] = float(self.system.convective_V0)
+        if self.convective_V0 is not None:
+            out["convective_V0"] = float(self.convective_V0)
         if cfg.rom.v0_iterations > 1:
             out["v0_history"] = [list(map(float, p)) for p in self.identification_history]
         if self.flutter_frozen is not None:

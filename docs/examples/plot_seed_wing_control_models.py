@@ -30,8 +30,7 @@ import numpy as np
 from casflutter._resources import problems_dir
 from casflutter.aeroelastic import AeroelasticSystem, ParametricSystem, TruthLoop
 from casflutter.ident import identify_common_denominator
-from casflutter.realize import (ParametricROM, canonical_realization, speed_nodes,
-                                tustin_to_continuous)
+from casflutter.realize import ParametricROM, realize, speed_nodes
 from casflutter.truth import RecordSettings, SeedWing, truth_records
 from casflutter.verify import load_controller, speed_family_interval
 
@@ -49,7 +48,7 @@ records = RecordSettings(amplitude=0.002, coupling_delay=0)
 # one at V0 for the frozen and the convective loop, seven at Chebyshev-Lobatto speeds over
 # (0.3, 2.5) for the parametric loop.
 rom_V0 = identify_common_denominator(truth_records(truth, records, V0=V0), 2, 6)
-sigma_f = tustin_to_continuous(canonical_realization(rom_V0.model))
+sigma_f = realize(rom_V0.model).sigma_f     # ERA at the exact order, Tustin
 frozen = AeroelasticSystem.from_parts(sigma_f, structure)
 convective = AeroelasticSystem.from_parts(sigma_f, structure, convective_V0=V0)
 nodes = speed_nodes((0.3, 2.5), 7)

@@ -31,8 +31,7 @@ from casflutter.aeroelastic import (AeroelasticSystem, ParametricSystem, TruthLo
 from casflutter.cli.bench.interval import DEFAULT_ROM, load_rom_loop
 from casflutter.errors import ConfigError
 from casflutter.ident import identify_common_denominator
-from casflutter.realize import (ParametricROM, canonical_realization, speed_nodes,
-                                tustin_to_continuous)
+from casflutter.realize import ParametricROM, realize, speed_nodes
 from casflutter.truth import RecordSettings, SeedWing, truth_records
 from casflutter.verify import load_controller, speed_family_interval
 
@@ -117,7 +116,7 @@ def convective():
     truth = SeedWing()
     rom = identify_common_denominator(
         truth_records(truth, RecordSettings(amplitude=0.002, coupling_delay=0), V0=V0), 2, 6)
-    sigma_f = tustin_to_continuous(canonical_realization(rom.model))
+    sigma_f = realize(rom.model).sigma_f        # ERA at the exact order, Tustin
     return (AeroelasticSystem.from_parts(sigma_f, truth.modal_structure(), convective_V0=V0),
             AeroelasticSystem.from_parts(sigma_f, truth.modal_structure()))
 
