@@ -20,6 +20,12 @@ Pushing from the low end with a low-order controller and from the high end with 
 one brackets what the family allows: where the two continuations stall, no controller that
 either method could reach holds the loop.  The result states the interval reached; its exact
 interval is for the independent verification layer to certify.
+
+:func:`reduce_order` then lowers the order of a controller that holds the whole interval,
+one truncation at a time (continuation in the order rather than in the speed): each balanced
+truncation is re-optimised on the same objective over the fixed interval, and continued from
+the low end when the truncation has lost the top.  It is how the order-8 and order-7
+controllers that hold the seed wing over (0, 2.4) were found from the full-order one.
 """
 
 from __future__ import annotations
@@ -37,7 +43,8 @@ from .._threads import single_threaded
 from ..aeroelastic import AeroelasticSystem
 from ..errors import ConfigError, DimensionError
 
-__all__ = ["IntervalReach", "full_order_start", "stabilize_interval"]
+__all__ = ["IntervalReach", "OrderReduction", "OrderStep", "full_order_start", "reduce_order",
+           "stabilize_interval"]
 
 log = logging.getLogger("casflutter.design")
 
@@ -122,6 +129,27 @@ class _LoopFamily:
         w = np.exp((a - a[k]) / tau)
         total = float(np.sum(w))
         return float(a[k] + tau * math.log(total)), sum((wi / total) * gi for wi, gi in zip(w, g))
+
+
+def _polish(system, K: control.StateSpace, speeds, max_iter: int, good: float
+            ) -> tuple[control.StateSpace, float]:
+    """``K`` re-optimised for the worst spectral abscissa over ``speeds``: BFGS on the
+    log-sum-exp of decreasing temperature, then on the maximum itself; stops early once the
+    worst is below ``good``.  Returns the best controller met and its worst abscissa."""
+    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (K.A, K.B, K.C, K.D))
+    n, m = K.nstates, Dk.shape[1]
+    fam = _LoopFamily(system, speeds, n, Dk)
+    p = np.concatenate([Ak.ravel(), Bk.ravel(), Ck.ravel()])
+    best = fam.smoothed(p, None)[0]
+    for tau in (1.0, 0.3, 0.1, 0.03, 0.01, None):
+        if best <= good:
+            break
+        res = minimize(fam.smoothed, p, args=(tau,), jac=True, method="BFGS",
+                       options={"maxiter": int(max_iter)})
+        worst = fam.smoothed(res.x, None)[0]
+        if np.all(np.isfinite(res.x)) and worst < best:
+            p, best = res.x, worst
+    return control.ss(*_unpack(p, n, m), Dk), float(best)
 
 
 def _dense_worst(system: AeroelasticSystem, K: control.StateSpace, lo: float, hi: float,
@@ -294,3 +322,150 @@ def full_order_start(system: AeroelasticSystem, V: float, *, state_weight: float
     D22 = lp.D22[:, None]
     return control.ss(lp.A - B2 @ Kx - L @ lp.C2 + L @ D22 @ Kx, L, -Kx, np.zeros((1, m)))
 
+
+
+@dataclass(frozen=True)
+class OrderStep:
+    """One order of :func:`reduce_order`.
+
+    Attributes
+    ----------
+    order : int
+        Controller order.
+    controller : control.StateSpace
+        The re-optimised truncation (``v = K zm``).
+    worst_abscissa : float
+        Largest closed-loop spectral abscissa (rad/s) on the dense scan of the interval.
+    met : bool
+        The loop decays at the rate ``decay`` on the whole dense scan.
+    continued : bool
+        The fixed-interval re-optimisation missed and the interval was continued from the
+        low end (:func:`stabilize_interval`).
+    """
+
+    order: int
+    controller: control.StateSpace
+    worst_abscissa: float
+    met: bool
+    continued: bool
+
+
+@dataclass(frozen=True)
+class OrderReduction:
+    """Outcome of :func:`reduce_order`.
+
+    Attributes
+    ----------
+    interval : tuple of float
+        ``(lo, hi)`` held at every order.
+    decay : float
+        Decay rate (rad/s) required on it.
+    steps : tuple of OrderStep
+        The orders tried, highest first; the sequence stops at the first order that misses.
+    """
+
+    interval: tuple
+    decay: float
+    steps: tuple
+
+    @property
+    def lowest(self) -> OrderStep | None:
+        """The lowest-order step that holds the interval (``None`` if none does)."""
+        met = [s for s in self.steps if s.met]
+        return met[-1] if met else None
+
+
+def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
+                 n_speeds: int = 48, max_iter: int = 600) -> OrderReduction:
+    """Lower the order of a controller that keeps ΣAE(V) decaying over a speed interval.
+
+    At each order of ``orders`` the previous controller is truncated
+    (:func:`control.balred`: balanced truncation of its stable part, its unstable modes
+    kept) and re-optimised for the worst closed-loop spectral abscissa over ``n_speeds``
+    speeds of the fixed interval (the objective of :func:`stabilize_interval`).  If the dense
+    scan (8x as many speeds) then misses the rate ``decay`` and the truncation still decays
+    at the low end, the interval is continued from there with fine steps.  The sequence
+    stops at the first order that misses: a lower order would start from a controller that
+    does not hold the interval.
+
+    Parameters
+    ----------
+    system
+        The loop family: an :class:`~casflutter.aeroelastic.AeroelasticSystem`, a
+        :class:`~casflutter.aeroelastic.TruthLoop` or anything with ``loop(V)`` and
+        ``closed_loop_state_matrix(V, K)``.
+    controller : control.StateSpace
+        The start, which should hold the interval (``v = K zm``, its ``D`` kept).
+    interval : (lo, hi)
+        Speed-index interval, ``0 <= lo < hi``.
+    orders : sequence of int
+        Strictly decreasing orders, each below the start's, >= 1.
+    decay : float
+        Decay rate (rad/s) required at every speed of the interval.
+    n_speeds : int
+        Speeds of the objective (>= 2).
+    max_iter : int
+        BFGS iterations per temperature of the smoothed maximum.
+
+    Returns
+    -------
+    OrderReduction
+        Its exact stable intervals are for the verification layer to certify
+        (:func:`casflutter.verify.speed_family_interval`).
+
+    Raises
+    ------
+    ConfigError
+        A bad interval or order sequence, or a setting out of range.
+    DimensionError
+        A controller that does not map the sensors to the flap.
+
+    See Also
+    --------
+    stabilize_interval : continuation in speed at a fixed order.
+    """
+    lo, hi = (float(x) for x in interval)
+    if not (0 <= lo < hi and math.isfinite(hi)):
+        raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
+    K = control.ss(controller)
+    seq = [int(n) for n in orders]
+    if (not seq or any(n < 1 for n in seq) or any(a <= b for a, b in zip(seq, seq[1:]))
+            or seq[0] >= K.nstates):
+        raise ConfigError(f"orders = {list(orders)!r}: strictly decreasing orders >= 1, each "
+                          f"below the start's order {K.nstates}")
+    if not (decay >= 0 and n_speeds >= 2 and max_iter >= 1):
+        raise ConfigError(f"need decay >= 0, n_speeds >= 2, max_iter >= 1; got "
+                          f"decay={decay!r}, n_speeds={n_speeds!r}, max_iter={max_iter!r}")
+    m = system.loop(lo).C2.shape[0]
+    if np.atleast_2d(np.asarray(K.D)).shape != (1, m):
+        raise DimensionError(f"need a controller with {m} inputs (the sensors) and 1 output "
+                             f"(the flap); got D of shape {np.shape(K.D)}")
+    speeds = np.linspace(lo, hi, n_speeds)
+    steps = []
+    with single_threaded():
+        for n in seq:
+            try:
+                Kr = control.balred(K, n, method="truncate")
+            except ValueError as exc:       # more unstable modes than n
+                log.info("order reduction: order %d not reached (%s)", n, exc)
+                break
+            Kr = control.ss(Kr.A, Kr.B, Kr.C, K.D)
+            Kn, _ = _polish(system, Kr, speeds, max_iter, -6 * decay)
+            worst = _dense_worst(system, Kn, lo, hi, 8 * n_speeds)
+            continued = False
+            if worst > -decay and _dense_worst(system, Kn, lo, lo, 1) < 0:
+                reach = stabilize_interval(system, Kn, (lo, hi), anchor="low", decay=decay,
+                                           n_speeds=n_speeds, first_step=0.01,
+                                           min_step=0.001, max_iter=max_iter)
+                continued = True
+                if reach.met:
+                    Kn, worst = reach.controller, reach.worst_abscissa
+            met = bool(worst <= -decay)
+            log.info("order reduction: order %d worst abscissa %.4g on [%.4g, %.4g]%s -> %s",
+                     n, worst, lo, hi, " (continued)" if continued else "",
+                     "held" if met else "missed")
+            steps.append(OrderStep(n, Kn, float(worst), met, continued))
+            if not met:
+                break
+            K = Kn
+    return OrderReduction((lo, hi), float(decay), tuple(steps))

@@ -149,8 +149,11 @@ class RomSection(IdentificationSettings):
     (:class:`casflutter.aeroelastic.AeroelasticSystem` ``convective_V0``): the aerodynamics of
     strip theory depend on the reduced frequency, so one ROM identified at ``V0`` holds at
     every speed.  ``false`` is eq. 8 as the paper writes it (Σf frozen at ``V0``, forces
-    scaled by V²).  The flutter route only: the paper's LFT (eq. 14) and the ROM's sampled
-    loop (``lco``) take Σf frozen."""
+    scaled by V²).  With the ``controller`` stage the design is made on the LFT frozen at Vf
+    (exact there) and the ROM's exact stable interval is certified on the scaled loop with
+    the flap behind the servo (``RunResult.rom_interval``); the stages that simulate the
+    ROM's sampled loop (``lco``, ``closed_loop``, ``suppression``) take Σf frozen and are
+    refused."""
 
     def __post_init__(self):
         super().__post_init__()
@@ -497,13 +500,16 @@ class RunConfig:
         if "parametric" in stages and self.rom.method != "common_denominator":
             raise ConfigError("stages: 'parametric' interpolates common-denominator ROMs; set "
                               "rom.method = \"common_denominator\"")
-        frozen_only = [s for s in ("lco", "controller", "closed_loop", "suppression")
-                       if s in stages]
+        frozen_only = [s for s in ("lco", "closed_loop", "suppression") if s in stages]
         if self.rom.convective and frozen_only:
             raise ConfigError(f"rom.convective = true scales Σf's time with V, but stage "
-                              f"{frozen_only[0]!r} takes the ROM frozen at V0 (the paper's "
-                              "LFT and the sampled ROM loop); set rom.convective = false or "
-                              f"leave {', '.join(map(repr, frozen_only))} out of stages")
+                              f"{frozen_only[0]!r} simulates the sampled ROM loop, whose "
+                              "time is frozen at V0; set rom.convective = false or leave "
+                              f"{', '.join(map(repr, frozen_only))} out of stages")
+        if self.rom.convective and "controller" in stages and self.verify.sweep:
+            raise ConfigError("verify.sweep sweeps the LFT frozen at Vf; with rom.convective "
+                              "= true the run certifies the scaled loop itself at every "
+                              "speed: leave verify.sweep empty")
         if "closed_loop" in stages and self.sensors.kind != "displacement":
             raise ConfigError("stages: 'closed_loop' sweeps the truth's linear loop read by "
                               "displacement sensors; set sensors.kind = \"displacement\"")

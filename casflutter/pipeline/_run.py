@@ -447,9 +447,26 @@ def _controller_stages(cfg: RunConfig, system, Vf: float, prog, out: dict, truth
             out["rom_sweep"] = speed_sweep(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf,
                                            n_delta=lft.n_delta,
                                            V=np.linspace(lo * Vf, hi * Vf, cfg.verify.n_sweep))
+        if system.convective_V0 is not None:
+            out["rom_interval"] = _rom_interval(system, K, cfg, prog)
         if truth is not None:
             out["truth_interval"] = _truth_interval(truth, structure, K, cfg, prog)
     out.update(lft=lft, synthesis=syn, controller=K, verification=ver)
+
+
+def _rom_interval(system, K, cfg: RunConfig, prog) -> StabilityInterval | None:
+    """The exact stable speed interval of a ROM loop whose time scales with V
+    (``rom.convective``) closed by ``K``, the flap behind the truth's servo
+    (``controller.flap_rate_bandwidth``), grown from ``data.V0``: the LFT frozen at Vf is
+    exact only at Vf, this loop at every speed.  ``None`` when K does not hold it at V0."""
+    family = system.with_servo(cfg.controller.flap_rate_bandwidth)
+    try:
+        return speed_family_interval(lambda V: family.loop(V).flap_to_sensors(), K,
+                                     cfg.data.V0)
+    except NotHurwitzError:
+        prog.note(f"the controller does not stabilise the scaled ROM loop at "
+                  f"V0 = {cfg.data.V0:.4g}")
+        return None
 
 
 def _truth_interval(truth, structure, K, cfg: RunConfig, prog) -> StabilityInterval | None:

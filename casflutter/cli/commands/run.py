@@ -61,6 +61,10 @@ def _main(args) -> int:
         lines.append(f"controller order {c['order']}: verified gamma = {c['gamma']}, small-gain "
                      f"V in {c['small_gain_V']}, exact stable V in {c['stable_V']} (speed "
                      "index)")
+        if c.get("rom_servo_omega") is not None:
+            lines.append(f"  the ROM's time scales with V: that interval is its scaled loop's "
+                         f"(servo {c['rom_servo_omega']} rad/s); the LFT frozen at Vf holds "
+                         f"V in {c['stable_V_frozen_at_Vf']}")
         if c.get("truth_servo_omega") is not None:
             lines.append(f"  on the truth's own linearisation (servo {c['truth_servo_omega']} "
                          f"rad/s): exact stable V in {c['truth_stable_V']}")
