@@ -13,7 +13,7 @@ import numpy as np
 from ..aeroelastic import (AeroelasticLFT, AeroelasticSystem, FlutterResult, LoopSimulation,
                            ParametricSystem, PKResult, RFASystem)
 from ..data import IOData
-from ..design import SynthesisResult
+from ..design import IntervalDesign, SynthesisResult
 from .._outputs import plain_json
 from ..ident import CommonDenominatorResult, FitReport, IdentificationResult
 from ..lco import LCOBranch
@@ -207,7 +207,10 @@ class RunResult:
     lft : AeroelasticLFT or None
         LFT at the ROM's Vf (eq. 14; stage ``controller``).
     synthesis : SynthesisResult or None
-        The fixed-order synthesis.
+        The fixed-order synthesis (``None`` with ``controller.method = "interval"``).
+    interval_design : IntervalDesign or None
+        The design of ``controller.method = "interval"``: the full-order continuation and
+        the order reduction.
     controller : control.StateSpace or None
         ``K`` from the sensors to the flap (``v = K zm``).
     verification : VerificationReport or None
@@ -269,6 +272,7 @@ class RunResult:
     lco: LcoResult | None = None
     lft: AeroelasticLFT | None = None
     synthesis: SynthesisResult | None = None
+    interval_design: IntervalDesign | None = None
     controller: control.StateSpace | None = None
     verification: VerificationReport | None = None
     rom_sweep: SpeedSweep | None = None
@@ -473,8 +477,10 @@ class RunResult:
                 "gamma_delta": float(ver.hinf_delta.gamma),
                 "small_gain_V_delta": _pair(ver.small_gain_V_delta),
                 "required_V": _pair(self.required_V), "interval_ok": self.interval_ok,
-                "synthesis_gammas": [float(g) for g in self.synthesis.gammas],
-                "synthesis_converged": bool(self.synthesis.converged),
+                "synthesis_gammas": (None if self.synthesis is None
+                                     else [float(g) for g in self.synthesis.gammas]),
+                "synthesis_converged": (None if self.synthesis is None
+                                        else bool(self.synthesis.converged)),
                 "success": self.success}
         U_ref = getattr(self.problem, "U_ref", None)
         if U_ref is not None and out["flutter"] is not None and out["flutter"]["V"] is not None:
@@ -533,7 +539,7 @@ class RunResult:
             return None
         ver = self.verification
         ti = self.truth_interval
-        out = {"order": self.synthesis.order, "gamma": ver.gamma,
+        out = {"order": int(self.controller.nstates), "gamma": ver.gamma,
                 "small_gain_V": _pair(ver.small_gain_V), "stable_V": _pair(self.rom_stable_V),
                 "stable": bool(ver.stable),
                 # an upper end without a crossing is written as null
@@ -541,6 +547,14 @@ class RunResult:
                     float(ti.lower), float(ti.upper) if math.isfinite(ti.upper) else None],
                 "truth_servo_omega": (self.config.controller.flap_rate_bandwidth
                                       if self.truth is not None else None)}
+        d = self.interval_design
+        if d is not None:
+            red = () if d.reduction is None else d.reduction.steps
+            out["interval_design"] = {
+                "order_requested": d.order, "met": d.met,
+                "full_order": int(d.full_order.controller.nstates),
+                "full_order_reached": list(d.full_order.reached),
+                "orders_held": {str(st.order): st.met for st in red}}
         if self.convective_V0 is not None:
             # stable_V is the scaled loop's; the LFT's intervals hold for Σf frozen at Vf
             out["rom_servo_omega"] = self.config.controller.flap_rate_bandwidth

@@ -63,7 +63,7 @@ from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, R
                            TruthLoop, build_lft, pk_flutter,
                            find_flutter, simulate_loop)
 from ..data import envelope_growth_rate
-from ..design import SynthesisOptions, design_flutter_controller
+from ..design import SynthesisOptions, design_flutter_controller, design_interval_controller
 from ..errors import CasflutterError, ConfigError, ConvergenceError
 from ..ident import (IdentificationResult, IdentificationSettings, fit_report, identify,
                      identify_common_denominator)
@@ -432,14 +432,29 @@ def _controller_stages(cfg: RunConfig, system, Vf: float, prog, out: dict, truth
         c = cfg.controller
         options = replace(settings_as(c, SynthesisOptions),
                           ipopt={**cfg.solver.ipopt, **c.ipopt})
-        # γ of the LFT at Vf (eq. 14-16), each design plant with its own loop shift, and
-        # ΣAE(V) kept stable over controller.interval; K acts on the physical sensors
-        design = design_flutter_controller(
-            system, Vf, c.order, speeds=tuple(c.speeds), interval=tuple(c.interval),
-            n_speeds=c.n_speeds, decay=c.interval_decay, steps=c.steps, starts=c.starts,
-            seed=cfg.seed, options=options, flap_rate_weight=c.flap_rate_weight,
-            flap_rate_bandwidth=c.flap_rate_bandwidth)
-        syn, K = design.synthesis, design.controller
+        if c.method == "interval":
+            # stability of the scaled ROM loop (flap behind the servo) over the whole
+            # interval first, then the order; no synthesis, γ is the verification's
+            design = design_interval_controller(
+                system.with_servo(c.flap_rate_bandwidth), c.interval, c.order,
+                orders=c.reduction_orders, decay=c.interval_decay, n_speeds=c.n_speeds)
+            syn, K = None, design.controller
+            out["interval_design"] = design
+            if not design.met:
+                held = design.full_order.met
+                prog.note(f"no order-{c.order} controller found that holds the interval "
+                          f"{list(c.interval)}; kept the order-{K.nstates} controller "
+                          + ("that holds it" if held else "of the full-order continuation, "
+                             f"which reached {list(design.full_order.reached)}"))
+        else:
+            # γ of the LFT at Vf (eq. 14-16), each design plant with its own loop shift, and
+            # ΣAE(V) kept stable over controller.interval; K acts on the physical sensors
+            design = design_flutter_controller(
+                system, Vf, c.order, speeds=tuple(c.speeds), interval=tuple(c.interval),
+                n_speeds=c.n_speeds, decay=c.interval_decay, steps=c.steps, starts=c.starts,
+                seed=cfg.seed, options=options, flap_rate_weight=c.flap_rate_weight,
+                flap_rate_bandwidth=c.flap_rate_bandwidth)
+            syn, K = design.synthesis, design.controller
     with prog.stage("verify"):
         ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
         if cfg.verify.sweep:

@@ -56,3 +56,35 @@ def test_stages_that_simulate_the_frozen_loop_are_refused():
             load_config(path, updates={"stages": ["controller", stage]})
     with pytest.raises(ConfigError, match="verify.sweep"):
         load_config(path, updates={"verify.sweep": [0.5, 2.0]})
+
+
+@pytest.mark.parametrize("updates, match", [
+    ({"controller.method": "hifoo"}, "controller.method = 'hifoo': allowed 'hinf', 'interval'"),
+    ({"controller.method": "interval"}, "give the interval and order >= 1"),
+    ({"controller.method": "interval", "controller.interval": [0.05, 2.4],
+      "controller.order": 0}, "order >= 1"),
+    ({"controller.method": "interval", "controller.interval": [0.05, 2.4],
+      "rom.convective": False}, "set rom.convective = true"),
+    ({"controller.reduction_orders": [8, "six"]}, "reduction_orders"),
+])
+def test_the_interval_design_is_refused_where_it_cannot_work(updates, match):
+    with pytest.raises(ConfigError, match=match):
+        load_config(config_path("seed_wing", "convective"), updates=updates)
+
+
+def test_the_interval_design_holds_the_scaled_loop_and_the_wing():
+    """``controller.method = "interval"`` on the scaled ROM loop (servo in front of the flap):
+    full order at 1.45 (34 % above the flutter speed), reduced to order 4."""
+    cfg = load_config(config_path("seed_wing", "convective"), updates={
+        "controller.method": "interval", "controller.interval": [0.05, 1.45],
+        "controller.order": 4, "controller.reduction_orders": [14, 8]})
+    res = run(cfg, quiet=True, write=False)
+    assert res.synthesis is None and res.controller.nstates == 4
+    assert res.interval_design.met
+    rom, wing = res.rom_interval, res.truth_interval
+    assert rom.lower == 0.0 and rom.upper >= 1.45
+    assert wing.lower == 0.0 and wing.upper >= 1.45        # certified on the wing too
+    c = res.summary()["controller"]
+    assert c["order"] == 4 and c["interval_design"]["met"] is True
+    assert c["interval_design"]["orders_held"] == {"14": True, "8": True, "4": True}
+    assert np.isfinite(c["gamma"])                          # measured by the verification
