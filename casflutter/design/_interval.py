@@ -155,6 +155,25 @@ def _polish(system, K: control.StateSpace, speeds, max_iter: int, good: float
     return control.ss(*_unpack(p, n, m), Dk), float(best)
 
 
+def _truncation_polished(system, Kr, Dk, speeds, lo: float, hi: float, decay: float,
+                         n_speeds: int, max_iter: int) -> tuple[control.StateSpace, float]:
+    """A truncated controller re-optimised over ``speeds`` and checked on a dense scan of
+    ``[lo, hi]``; the scan's peaks between those speeds are added to them and the controller
+    re-optimised, up to three times.  Returns it and its worst dense abscissa."""
+    Kn, grid = control.ss(Kr.A, Kr.B, Kr.C, Dk), speeds
+    for _ in range(4):
+        Kn, _ = _polish(system, Kn, grid, max_iter, -6 * decay)
+        dense, values = _dense_abscissae(system, Kn, lo, hi, 8 * n_speeds)
+        worst = float(np.max(values))
+        if worst <= -decay:
+            break
+        peaks = [j for j in range(len(values)) if values[j] > -decay
+                 and values[j] >= values[max(j - 1, 0)]
+                 and values[j] >= values[min(j + 1, len(values) - 1)]]
+        grid = np.union1d(grid, dense[sorted(peaks, key=lambda j: -values[j])[:8]])
+    return Kn, worst
+
+
 def _dense_abscissae(system, K: control.StateSpace, lo: float, hi: float, n: int
                      ) -> tuple[np.ndarray, np.ndarray]:
     """The speeds of a dense scan of ``[lo, hi]`` and the closed loop's spectral abscissa
@@ -372,7 +391,8 @@ class OrderReduction:
     decay : float
         Decay rate (rad/s) required on it.
     steps : tuple of OrderStep
-        The orders tried, highest first; the sequence stops at the first order that misses.
+        The orders held, highest first (with the half-way orders of split steps), and last
+        the first order that missed, if one did.
     """
 
     interval: tuple
@@ -395,11 +415,11 @@ def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
     kept) and re-optimised for the worst closed-loop spectral abscissa over ``n_speeds``
     speeds of the fixed interval (the objective of :func:`stabilize_interval`).  A dense scan
     (8x as many speeds) checks the result; the peaks it finds between the objective's speeds
-    are added to them and the controller re-optimised, up to three times.  If it still misses
-    the rate ``decay`` and decays at the low end, the interval is continued from there with
-    fine steps.  The sequence
-    stops at the first order that misses: a lower order would start from a controller that
-    does not hold the interval.
+    are added to them and the controller re-optimised, up to three times.  A step of more
+    than one order that still misses the rate ``decay`` is split (the order half-way is
+    held first); a one-order step that misses, and still decays at the low end, is continued
+    from there with fine steps.  The sequence stops at the first order that misses: a lower
+    order would start from a controller that does not hold the interval.
 
     Parameters
     ----------
@@ -455,27 +475,24 @@ def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
                              f"(the flap); got D of shape {np.shape(K.D)}")
     speeds = np.linspace(lo, hi, n_speeds)
     steps = []
+    queue = list(seq)
     with single_threaded():
-        for n in seq:
+        while queue:
+            n = queue[0]
             try:
                 Kr = control.balred(K, n, method="truncate")
             except ValueError as exc:       # more unstable modes than n
                 log.info("order reduction: order %d not reached (%s)", n, exc)
                 break
-            Kn = control.ss(Kr.A, Kr.B, Kr.C, K.D)
-            grid = speeds
-            for _ in range(4):
-                Kn, _ = _polish(system, Kn, grid, max_iter, -6 * decay)
-                dense, values = _dense_abscissae(system, Kn, lo, hi, 8 * n_speeds)
-                worst = float(np.max(values))
-                if worst <= -decay:
-                    break
-                # a peak between the objective's speeds: add the worst local maxima
-                peaks = [j for j in range(len(values)) if values[j] > -decay
-                         and values[j] >= values[max(j - 1, 0)]
-                         and values[j] >= values[min(j + 1, len(values) - 1)]]
-                peaks = sorted(peaks, key=lambda j: -values[j])[:8]
-                grid = np.union1d(grid, dense[peaks])
+            Kn, worst = _truncation_polished(system, Kr, K.D, speeds, lo, hi, decay,
+                                             n_speeds, max_iter)
+            p = K.nstates
+            if worst > -decay and p - n > 1:
+                # a smaller step first: the order half-way
+                log.info("order reduction: %d -> %d missed (worst abscissa %.4g); via %d", p,
+                         n, worst, (p + n) // 2)
+                queue.insert(0, (p + n) // 2)
+                continue
             continued = False
             if worst > -decay and _dense_worst(system, Kn, lo, lo, 1) < 0:
                 reach = stabilize_interval(system, Kn, (lo, hi), anchor="low", decay=decay,
@@ -492,6 +509,7 @@ def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
             if not met:
                 break
             K = Kn
+            queue.pop(0)
     return OrderReduction((lo, hi), float(decay), tuple(steps))
 
 
