@@ -8,6 +8,8 @@ flutter-speed error of the convective ROM (0.4 %) with room; measured 0.09 %.
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -88,3 +90,17 @@ def test_the_interval_design_holds_the_scaled_loop_and_the_wing():
     assert c["order"] == 4 and c["interval_design"]["met"] is True
     assert c["interval_design"]["orders_held"] == {"14": True, "8": True, "4": True}
     assert np.isfinite(c["gamma"])                          # measured by the verification
+
+
+def test_a_run_whose_check_fails_writes_its_outputs_and_exits_3(tmp_path, capsys):
+    """The paper's order-3 design holds the wing to 1.19 Vf: a target of 2.2 Vf fails."""
+    from casflutter.cli import main
+
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(config_path("seed_wing", "convective").read_text()
+                   + "\n[verify]\nrequired = [0.05, 2.2]\n")
+    out = tmp_path / "out"
+    assert main(["run", str(cfg), "--out", str(out), "--quiet"]) == 3
+    s = json.loads((out / "summary.json").read_text())
+    assert s["verification"]["interval_ok"] is False and s["verification"]["success"] is False
+    assert "a check failed" in capsys.readouterr().err
