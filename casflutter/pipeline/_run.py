@@ -471,31 +471,30 @@ def _controller_stages(cfg: RunConfig, system, Vf: float, prog, out: dict, truth
 
 def _rom_interval(system, K, cfg: RunConfig, prog) -> StabilityInterval | None:
     """The exact stable speed interval of a ROM loop whose time scales with V
-    (``rom.convective``) closed by ``K``, the flap behind the truth's servo
-    (``controller.flap_rate_bandwidth``), grown from ``data.V0``: the LFT frozen at Vf is
-    exact only at Vf, this loop at every speed.  ``None`` when K does not hold it at V0."""
-    family = system.with_servo(cfg.controller.flap_rate_bandwidth)
-    try:
-        return speed_family_interval(lambda V: family.loop(V).flap_to_sensors(), K,
-                                     cfg.data.V0)
-    except NotHurwitzError:
-        prog.note(f"the controller does not stabilise the scaled ROM loop at "
-                  f"V0 = {cfg.data.V0:.4g}")
-        return None
+    (``rom.convective``) closed by ``K``, the flap behind the truth's servo: the LFT frozen
+    at Vf is exact only at Vf, this loop at every speed.  See :func:`_family_interval`."""
+    return _family_interval(system.with_servo(cfg.controller.flap_rate_bandwidth), K, cfg,
+                            prog, "the scaled ROM loop")
 
 
 def _truth_interval(truth, structure, K, cfg: RunConfig, prog) -> StabilityInterval | None:
     """The exact stable speed interval of the truth's own linearisation closed by ``K``, the
-    flap behind a servo of ``controller.flap_rate_bandwidth``, grown from ``data.V0``: the
-    interval on the wing the ROM stands in for.  ``None`` when K does not hold the truth
-    at V0."""
-    family = TruthLoop(truth, cfg.controller.flap_rate_bandwidth, sensors=structure)
+    flap behind the servo: the interval on the wing the ROM stands in for.  See
+    :func:`_family_interval`."""
+    return _family_interval(TruthLoop(truth, cfg.controller.flap_rate_bandwidth,
+                                      sensors=structure), K, cfg, prog,
+                            "the truth's linear loop")
+
+
+def _family_interval(family, K, cfg: RunConfig, prog, what: str) -> StabilityInterval | None:
+    """The verification layer's exact stable interval of a loop family closed by ``K``
+    (servo of ``controller.flap_rate_bandwidth``), grown from ``data.V0``; ``None`` (and a
+    note) when K does not hold the loop at V0."""
     try:
         return speed_family_interval(lambda V: family.loop(V).flap_to_sensors(), K,
                                      cfg.data.V0)
     except NotHurwitzError:
-        prog.note(f"the controller does not stabilise the truth's linear loop at "
-                  f"V0 = {cfg.data.V0:.4g}")
+        prog.note(f"the controller does not stabilise {what} at V0 = {cfg.data.V0:.4g}")
         return None
 
 
