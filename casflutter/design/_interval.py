@@ -13,8 +13,10 @@ constructively, the way HIFOO's stabilisation phase does for one plant:
   :meth:`~casflutter.aeroelastic.AeroelasticSystem.closed_loop_state_matrix`;
 * continuation: starting where the given controller already decays, one end of the interval
   is pushed a step towards the target; a step is kept when the loop decays at the rate
-  ``decay`` on a dense scan of the new interval, grows 1.5x after a success and halves after
-  a failure, until the target is met or the step falls below ``min_step``.
+  ``decay`` on a dense scan of the new interval (a peak the scan finds between the
+  objective's speeds joins them and the step is optimised again, twice at most); the step
+  grows 1.5x after a success and halves after a failure, until the target is met or the step
+  falls below ``min_step``.
 
 Pushing from the low end with a low-order controller and from the high end with a full-order
 one brackets what the family allows: where the two continuations stall, no controller that
@@ -167,11 +169,16 @@ def _truncation_polished(system, Kr, Dk, speeds, lo: float, hi: float, decay: fl
         worst = float(np.max(values))
         if worst <= -decay:
             break
-        peaks = [j for j in range(len(values)) if values[j] > -decay
-                 and values[j] >= values[max(j - 1, 0)]
-                 and values[j] >= values[min(j + 1, len(values) - 1)]]
-        grid = np.union1d(grid, dense[sorted(peaks, key=lambda j: -values[j])[:8]])
+        grid = np.union1d(grid, dense[_peaks(values, decay)])
     return Kn, worst
+
+
+def _peaks(values: np.ndarray, decay: float, most: int = 8) -> list[int]:
+    """Indices of the ``most`` highest local maxima of a dense scan above ``-decay``."""
+    n = len(values)
+    peaks = [j for j in range(n) if values[j] > -decay and values[j] >= values[max(j - 1, 0)]
+             and values[j] >= values[min(j + 1, n - 1)]]
+    return sorted(peaks, key=lambda j: -values[j])[:most]
 
 
 def _dense_abscissae(system, K: control.StateSpace, lo: float, hi: float, n: int
@@ -281,22 +288,30 @@ def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
             rounds += 1
             trial = ((cur[0], min(hi, cur[1] + step)) if anchor == "low"
                      else (max(lo, cur[0] - step), cur[1]))
-            fam = _LoopFamily(system, np.linspace(*trial, n_speeds), order, Dk)
+            speeds = np.linspace(*trial, n_speeds)
             q = p
-            for tau in (0.3, 0.1, 0.03, None):
-                if fam.smoothed(q, None)[0] <= -2 * decay:
+            for _ in range(3):
+                fam = _LoopFamily(system, speeds, order, Dk)
+                for tau in (0.3, 0.1, 0.03, None):
+                    if fam.smoothed(q, None)[0] <= -2 * decay:
+                        break
+                    res = minimize(fam.smoothed, q, args=(tau,), jac=True, method="BFGS",
+                                   options={"maxiter": int(max_iter)})
+                    if np.all(np.isfinite(res.x)) and \
+                            fam.smoothed(res.x, None)[0] < fam.smoothed(q, None)[0]:
+                        q = res.x
+                worst = fam.smoothed(q, None)[0]
+                ok = worst <= -decay
+                if not ok:
                     break
-                res = minimize(fam.smoothed, q, args=(tau,), jac=True, method="BFGS",
-                               options={"maxiter": int(max_iter)})
-                if np.all(np.isfinite(res.x)) and \
-                        fam.smoothed(res.x, None)[0] < fam.smoothed(q, None)[0]:
-                    q = res.x
-            worst = fam.smoothed(q, None)[0]
+                # the dense scan decides; a peak between the objective's speeds joins them
+                scan, values = _dense_abscissae(system, control.ss(*_unpack(q, order, m), Dk),
+                                                *trial, dense)
+                ok = float(np.max(values)) <= -decay
+                if ok:
+                    break
+                speeds = np.union1d(speeds, scan[_peaks(values, decay)])
             history.append((trial[0], trial[1], worst))
-            ok = worst <= -decay
-            if ok:
-                Kq = control.ss(*_unpack(q, order, m), Dk)
-                ok = _dense_worst(system, Kq, *trial, dense) <= -decay
             log.info("interval continuation: [%.4g, %.4g] worst abscissa %.4g -> %s", *trial,
                      worst, "kept" if ok else f"step {step / 2:.3g}")
             if ok:
