@@ -30,7 +30,8 @@ from .._linalg import spectral_abscissa
 from ..errors import ConfigError, DimensionError
 from ..structure import ModalStructure
 
-__all__ = ["AeroelasticSystem", "AeroelasticLoop", "ParametricSystem", "aeroelastic_loop",
+__all__ = ["AeroelasticSystem", "AeroelasticLoop", "ParametricSystem", "ServoSystem",
+           "aeroelastic_loop",
            "split_sigma_f"]
 
 
@@ -422,6 +423,28 @@ class AeroelasticSystem:
         """
         return self.loop(V).closed_loop_state_matrix(controller)
 
+    def with_servo(self, omega: float, zeta: float = 0.7) -> "ServoSystem":
+        """ΣAE(V) with the flap behind a second-order servo at every speed (what a wind-tunnel
+        model has, and :class:`~casflutter.aeroelastic.TruthLoop` puts in front of the truth).
+
+        Parameters
+        ----------
+        omega : float
+            Servo natural frequency [rad per time unit] (> 0).
+        zeta : float
+            Servo damping ratio (>= 0).
+
+        Returns
+        -------
+        ServoSystem
+
+        Raises
+        ------
+        ConfigError
+            A frequency or damping out of range.
+        """
+        return ServoSystem(self, omega, zeta)
+
     def loop(self, V: float) -> AeroelasticLoop:
         """ΣAE at speed index V (eq. 8-9), with flap input v and disturbance w.
 
@@ -558,3 +581,86 @@ class ParametricSystem:
         ndarray
         """
         return AeroelasticSystem(self.structure, *self.rom.sigma_f_matrices(V)).state_matrix(V)
+
+
+@dataclass(frozen=True)
+class ServoSystem:
+    """A loop family with the flap behind a second-order servo, ``v̈ = ω² (c − v) − 2ζω v̇``.
+
+    Every speed's loop is the family's :meth:`AeroelasticLoop.with_servo`: the controller
+    commands ``c`` and the flap position becomes a state.  It has the interface of the other
+    families (``loop``, ``state_matrix``, ``closed_loop_state_matrix``), so the interval
+    design (:func:`casflutter.design.stabilize_interval`) and the verification
+    (:func:`casflutter.verify.speed_family_interval` on ``loop(V).flap_to_sensors()``) take
+    it as they take the truth's :class:`~casflutter.aeroelastic.TruthLoop`.
+
+    Attributes
+    ----------
+    system : AeroelasticSystem or ParametricSystem
+        The family without the servo.
+    servo_omega : float
+        Servo natural frequency [rad per time unit] (> 0).
+    servo_zeta : float
+        Servo damping ratio (>= 0).
+
+    Raises
+    ------
+    ConfigError
+        A frequency or damping out of range.
+    """
+
+    system: object
+    servo_omega: float
+    servo_zeta: float = 0.7
+
+    def __post_init__(self):
+        if not (math.isfinite(self.servo_omega) and self.servo_omega > 0
+                and math.isfinite(self.servo_zeta) and self.servo_zeta >= 0):
+            raise ConfigError(f"servo omega = {self.servo_omega!r} must be > 0 and zeta = "
+                              f"{self.servo_zeta!r} >= 0")
+
+    def loop(self, V: float) -> AeroelasticLoop:
+        """The family's loop at speed index V, flap behind the servo.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        AeroelasticLoop
+            States ``(x, v, v̇)``.
+        """
+        return self.system.loop(V).with_servo(self.servo_omega, self.servo_zeta)
+
+    def state_matrix(self, V: float) -> np.ndarray:
+        """The open-loop state matrix at speed index V (servo at rest).
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        ndarray
+        """
+        return self.loop(V).A
+
+    def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
+        """State matrix at V closed with ``c = K zm`` (positive feedback, paper Fig. 3).
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+        controller : control.StateSpace
+            Continuous K with ``n_sensors`` inputs and one output (the servo command).
+
+        Returns
+        -------
+        ndarray
+            The state matrix of ``(x, v, v̇, x_K)``.
+        """
+        return self.loop(V).closed_loop_state_matrix(controller)

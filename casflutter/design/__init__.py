@@ -6,12 +6,16 @@ LFT at Vf plus stability of ΣAE(V) over an interval, eq. 8-16); :func:`load_com
 the benchmark plants; :func:`partition`, :class:`Partition`; :func:`hinf_norm` /
 :func:`exact_hinf_norm` (the synthesis' own Hamiltonian norm) and :func:`verify_closed_loop`;
 :func:`stabilize_interval` with :func:`full_order_start` and :class:`IntervalReach` (how far
-one controller holds ΣAE(V) stable, by continuation in speed); :func:`order_relaxation` with
+one controller holds ΣAE(V) stable, by continuation in speed) and :func:`reduce_order` with
+:class:`OrderReduction` (the same interval at lower orders, by continuation in the order),
+chained by :func:`design_interval_controller` (:class:`IntervalDesign`); :func:`order_relaxation` with
 :class:`OrderBound` (what order ``k`` can reach at a few frequencies: the rank relaxation).
 """
 
 from ._flutter import FlutterDesign, design_flutter_controller, loop_abscissa, with_flap_rate
-from ._interval import IntervalReach, full_order_start, stabilize_interval
+from ._interval import (IntervalDesign, IntervalReach, OrderReduction, OrderStep,
+                        design_interval_controller, full_order_start, reduce_order,
+                        stabilize_interval)
 from ._norm import hinf_norm
 from ._orderbound import OrderBound, order_relaxation
 from ._plant import Partition, exact_hinf_norm, load_compleib, partition
@@ -21,4 +25,6 @@ from ._synthesis import (StartRecord, SynthesisOptions, SynthesisResult, synthes
 __all__ = ["synthesize", "SynthesisOptions", "SynthesisResult", "StartRecord",
            "design_flutter_controller", "with_flap_rate", "FlutterDesign", "loop_abscissa",
            "stabilize_interval", "full_order_start", "IntervalReach",
+           "reduce_order", "OrderReduction", "OrderStep", "design_interval_controller",
+           "IntervalDesign",
            "order_relaxation", "OrderBound", "load_compleib", "partition", "Partition", "exact_hinf_norm", "hinf_norm", "verify_closed_loop"]

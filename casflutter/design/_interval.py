@@ -13,13 +13,23 @@ constructively, the way HIFOO's stabilisation phase does for one plant:
   :meth:`~casflutter.aeroelastic.AeroelasticSystem.closed_loop_state_matrix`;
 * continuation: starting where the given controller already decays, one end of the interval
   is pushed a step towards the target; a step is kept when the loop decays at the rate
-  ``decay`` on a dense scan of the new interval, grows 1.5x after a success and halves after
-  a failure, until the target is met or the step falls below ``min_step``.
+  ``decay`` on a dense scan of the new interval (a peak the scan finds between the
+  objective's speeds joins them and the step is optimised again, twice at most); the step
+  grows 1.5x after a success and halves after a failure, until the target is met or the step
+  falls below ``min_step``.
 
 Pushing from the low end with a low-order controller and from the high end with a full-order
 one brackets what the family allows: where the two continuations stall, no controller that
 either method could reach holds the loop.  The result states the interval reached; its exact
 interval is for the independent verification layer to certify.
+
+:func:`reduce_order` then lowers the order of a controller that holds the whole interval,
+one truncation at a time (continuation in the order rather than in the speed): each balanced
+truncation is re-optimised on the same objective over the fixed interval, and continued from
+the low end when the truncation has lost the top.  It is how the order-8 and order-7
+controllers that hold the seed wing over (0, 2.4) were found from the full-order one.
+:func:`design_interval_controller` chains the two: stability over the interval first, the
+order second.
 """
 
 from __future__ import annotations
@@ -37,7 +47,9 @@ from .._threads import single_threaded
 from ..aeroelastic import AeroelasticSystem
 from ..errors import ConfigError, DimensionError
 
-__all__ = ["IntervalReach", "full_order_start", "stabilize_interval"]
+__all__ = ["IntervalDesign", "IntervalReach", "OrderReduction", "OrderStep",
+           "design_interval_controller", "full_order_start", "reduce_order",
+           "stabilize_interval"]
 
 log = logging.getLogger("casflutter.design")
 
@@ -124,16 +136,69 @@ class _LoopFamily:
         return float(a[k] + tau * math.log(total)), sum((wi / total) * gi for wi, gi in zip(w, g))
 
 
-def _dense_worst(system: AeroelasticSystem, K: control.StateSpace, lo: float, hi: float,
-                 n: int) -> float:
-    worst = -np.inf
-    for V in np.linspace(lo, hi, n):
+def _polish(system, K: control.StateSpace, speeds, max_iter: int, good: float
+            ) -> tuple[control.StateSpace, float]:
+    """``K`` re-optimised for the worst spectral abscissa over ``speeds``: BFGS on the
+    log-sum-exp of decreasing temperature, then on the maximum itself; stops early once the
+    worst is below ``good``.  Returns the best controller met and its worst abscissa."""
+    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (K.A, K.B, K.C, K.D))
+    n, m = K.nstates, Dk.shape[1]
+    fam = _LoopFamily(system, speeds, n, Dk)
+    p = np.concatenate([Ak.ravel(), Bk.ravel(), Ck.ravel()])
+    best = fam.smoothed(p, None)[0]
+    for tau in (1.0, 0.3, 0.1, 0.03, 0.01, None):
+        if best <= good:
+            break
+        res = minimize(fam.smoothed, p, args=(tau,), jac=True, method="BFGS",
+                       options={"maxiter": int(max_iter)})
+        worst = fam.smoothed(res.x, None)[0]
+        if np.all(np.isfinite(res.x)) and worst < best:
+            p, best = res.x, worst
+    return control.ss(*_unpack(p, n, m), Dk), float(best)
+
+
+def _truncation_polished(system, Kr, Dk, speeds, lo: float, hi: float, decay: float,
+                         n_speeds: int, max_iter: int) -> tuple[control.StateSpace, float]:
+    """A truncated controller re-optimised over ``speeds`` and checked on a dense scan of
+    ``[lo, hi]``; the scan's peaks between those speeds are added to them and the controller
+    re-optimised, up to three times.  Returns it and its worst dense abscissa."""
+    Kn, grid = control.ss(Kr.A, Kr.B, Kr.C, Dk), speeds
+    for _ in range(4):
+        Kn, _ = _polish(system, Kn, grid, max_iter, -6 * decay)
+        dense, values = _dense_abscissae(system, Kn, lo, hi, 8 * n_speeds)
+        worst = float(np.max(values))
+        if worst <= -decay:
+            break
+        grid = np.union1d(grid, dense[_peaks(values, decay)])
+    return Kn, worst
+
+
+def _peaks(values: np.ndarray, decay: float, most: int = 8) -> list[int]:
+    """Indices of the ``most`` highest local maxima of a dense scan above ``-decay``."""
+    n = len(values)
+    peaks = [j for j in range(n) if values[j] > -decay and values[j] >= values[max(j - 1, 0)]
+             and values[j] >= values[min(j + 1, n - 1)]]
+    return sorted(peaks, key=lambda j: -values[j])[:most]
+
+
+def _dense_abscissae(system, K: control.StateSpace, lo: float, hi: float, n: int
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """The speeds of a dense scan of ``[lo, hi]`` and the closed loop's spectral abscissa
+    at each (``inf`` where the loop is algebraically singular)."""
+    grid = np.linspace(lo, hi, n)
+    values = np.empty(n)
+    for j, V in enumerate(grid):
         try:
             A = system.closed_loop_state_matrix(float(V), K)
         except DimensionError:                 # a singular algebraic loop
-            return np.inf
-        worst = max(worst, float(np.max(np.linalg.eigvals(A).real)))
-    return worst
+            values[j] = np.inf
+            continue
+        values[j] = float(np.max(np.linalg.eigvals(A).real))
+    return grid, values
+
+
+def _dense_worst(system, K: control.StateSpace, lo: float, hi: float, n: int) -> float:
+    return float(np.max(_dense_abscissae(system, K, lo, hi, n)[1]))
 
 
 def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
@@ -223,22 +288,30 @@ def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
             rounds += 1
             trial = ((cur[0], min(hi, cur[1] + step)) if anchor == "low"
                      else (max(lo, cur[0] - step), cur[1]))
-            fam = _LoopFamily(system, np.linspace(*trial, n_speeds), order, Dk)
+            speeds = np.linspace(*trial, n_speeds)
             q = p
-            for tau in (0.3, 0.1, 0.03, None):
-                if fam.smoothed(q, None)[0] <= -2 * decay:
+            for _ in range(3):
+                fam = _LoopFamily(system, speeds, order, Dk)
+                for tau in (0.3, 0.1, 0.03, None):
+                    if fam.smoothed(q, None)[0] <= -2 * decay:
+                        break
+                    res = minimize(fam.smoothed, q, args=(tau,), jac=True, method="BFGS",
+                                   options={"maxiter": int(max_iter)})
+                    if np.all(np.isfinite(res.x)) and \
+                            fam.smoothed(res.x, None)[0] < fam.smoothed(q, None)[0]:
+                        q = res.x
+                worst = fam.smoothed(q, None)[0]
+                ok = worst <= -decay
+                if not ok:
                     break
-                res = minimize(fam.smoothed, q, args=(tau,), jac=True, method="BFGS",
-                               options={"maxiter": int(max_iter)})
-                if np.all(np.isfinite(res.x)) and \
-                        fam.smoothed(res.x, None)[0] < fam.smoothed(q, None)[0]:
-                    q = res.x
-            worst = fam.smoothed(q, None)[0]
+                # the dense scan decides; a peak between the objective's speeds joins them
+                scan, values = _dense_abscissae(system, control.ss(*_unpack(q, order, m), Dk),
+                                                *trial, dense)
+                ok = float(np.max(values)) <= -decay
+                if ok:
+                    break
+                speeds = np.union1d(speeds, scan[_peaks(values, decay)])
             history.append((trial[0], trial[1], worst))
-            ok = worst <= -decay
-            if ok:
-                Kq = control.ss(*_unpack(q, order, m), Dk)
-                ok = _dense_worst(system, Kq, *trial, dense) <= -decay
             log.info("interval continuation: [%.4g, %.4g] worst abscissa %.4g -> %s", *trial,
                      worst, "kept" if ok else f"step {step / 2:.3g}")
             if ok:
@@ -294,3 +367,254 @@ def full_order_start(system: AeroelasticSystem, V: float, *, state_weight: float
     D22 = lp.D22[:, None]
     return control.ss(lp.A - B2 @ Kx - L @ lp.C2 + L @ D22 @ Kx, L, -Kx, np.zeros((1, m)))
 
+
+
+@dataclass(frozen=True)
+class OrderStep:
+    """One order of :func:`reduce_order`.
+
+    Attributes
+    ----------
+    order : int
+        Controller order.
+    controller : control.StateSpace
+        The re-optimised truncation (``v = K zm``).
+    worst_abscissa : float
+        Largest closed-loop spectral abscissa (rad/s) on the dense scan of the interval.
+    met : bool
+        The loop decays at the rate ``decay`` on the whole dense scan.
+    continued : bool
+        The fixed-interval re-optimisation missed and the interval was continued from the
+        low end (:func:`stabilize_interval`).
+    """
+
+    order: int
+    controller: control.StateSpace
+    worst_abscissa: float
+    met: bool
+    continued: bool
+
+
+@dataclass(frozen=True)
+class OrderReduction:
+    """Outcome of :func:`reduce_order`.
+
+    Attributes
+    ----------
+    interval : tuple of float
+        ``(lo, hi)`` held at every order.
+    decay : float
+        Decay rate (rad/s) required on it.
+    steps : tuple of OrderStep
+        The orders held, highest first (with the half-way orders of split steps), and last
+        the first order that missed, if one did.
+    """
+
+    interval: tuple
+    decay: float
+    steps: tuple
+
+    @property
+    def lowest(self) -> OrderStep | None:
+        """The lowest-order step that holds the interval (``None`` if none does)."""
+        met = [s for s in self.steps if s.met]
+        return met[-1] if met else None
+
+
+def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
+                 n_speeds: int = 48, max_iter: int = 600) -> OrderReduction:
+    """Lower the order of a controller that keeps ΣAE(V) decaying over a speed interval.
+
+    At each order of ``orders`` the previous controller is truncated
+    (:func:`control.balred`: balanced truncation of its stable part, its unstable modes
+    kept) and re-optimised for the worst closed-loop spectral abscissa over ``n_speeds``
+    speeds of the fixed interval (the objective of :func:`stabilize_interval`).  A dense scan
+    (8x as many speeds) checks the result; the peaks it finds between the objective's speeds
+    are added to them and the controller re-optimised, up to three times.  A step of more
+    than one order that still misses the rate ``decay`` is split (the order half-way is
+    held first); a one-order step that misses, and still decays at the low end, is continued
+    from there with fine steps.  The sequence stops at the first order that misses: a lower
+    order would start from a controller that does not hold the interval.
+
+    Parameters
+    ----------
+    system
+        The loop family: an :class:`~casflutter.aeroelastic.AeroelasticSystem`, a
+        :class:`~casflutter.aeroelastic.TruthLoop` or anything with ``loop(V)`` and
+        ``closed_loop_state_matrix(V, K)``.
+    controller : control.StateSpace
+        The start, which should hold the interval (``v = K zm``, its ``D`` kept).
+    interval : (lo, hi)
+        Speed-index interval, ``0 <= lo < hi``.
+    orders : sequence of int
+        Strictly decreasing orders, each below the start's, >= 1.
+    decay : float
+        Decay rate (rad/s) required at every speed of the interval.
+    n_speeds : int
+        Speeds of the objective (>= 2).
+    max_iter : int
+        BFGS iterations per temperature of the smoothed maximum.
+
+    Returns
+    -------
+    OrderReduction
+        Its exact stable intervals are for the verification layer to certify
+        (:func:`casflutter.verify.speed_family_interval`).
+
+    Raises
+    ------
+    ConfigError
+        A bad interval or order sequence, or a setting out of range.
+    DimensionError
+        A controller that does not map the sensors to the flap.
+
+    See Also
+    --------
+    stabilize_interval : continuation in speed at a fixed order.
+    """
+    lo, hi = (float(x) for x in interval)
+    if not (0 <= lo < hi and math.isfinite(hi)):
+        raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
+    K = control.ss(controller)
+    seq = [int(n) for n in orders]
+    if (not seq or any(n < 1 for n in seq) or any(a <= b for a, b in zip(seq, seq[1:]))
+            or seq[0] >= K.nstates):
+        raise ConfigError(f"orders = {list(orders)!r}: strictly decreasing orders >= 1, each "
+                          f"below the start's order {K.nstates}")
+    if not (decay >= 0 and n_speeds >= 2 and max_iter >= 1):
+        raise ConfigError(f"need decay >= 0, n_speeds >= 2, max_iter >= 1; got "
+                          f"decay={decay!r}, n_speeds={n_speeds!r}, max_iter={max_iter!r}")
+    m = system.loop(lo).C2.shape[0]
+    if np.atleast_2d(np.asarray(K.D)).shape != (1, m):
+        raise DimensionError(f"need a controller with {m} inputs (the sensors) and 1 output "
+                             f"(the flap); got D of shape {np.shape(K.D)}")
+    speeds = np.linspace(lo, hi, n_speeds)
+    steps = []
+    queue = list(seq)
+    with single_threaded():
+        while queue:
+            n = queue[0]
+            try:
+                Kr = control.balred(K, n, method="truncate")
+            except ValueError as exc:       # more unstable modes than n
+                log.info("order reduction: order %d not reached (%s)", n, exc)
+                break
+            Kn, worst = _truncation_polished(system, Kr, K.D, speeds, lo, hi, decay,
+                                             n_speeds, max_iter)
+            p = K.nstates
+            if worst > -decay and p - n > 1:
+                # a smaller step first: the order half-way
+                log.info("order reduction: %d -> %d missed (worst abscissa %.4g); via %d", p,
+                         n, worst, (p + n) // 2)
+                queue.insert(0, (p + n) // 2)
+                continue
+            continued = False
+            if worst > -decay and _dense_worst(system, Kn, lo, lo, 1) < 0:
+                reach = stabilize_interval(system, Kn, (lo, hi), anchor="low", decay=decay,
+                                           n_speeds=n_speeds, first_step=0.01,
+                                           min_step=0.001, max_iter=max_iter)
+                continued = True
+                if reach.met:
+                    Kn, worst = reach.controller, reach.worst_abscissa
+            met = bool(worst <= -decay)
+            log.info("order reduction: order %d worst abscissa %.4g on [%.4g, %.4g]%s -> %s",
+                     n, worst, lo, hi, " (continued)" if continued else "",
+                     "held" if met else "missed")
+            steps.append(OrderStep(n, Kn, float(worst), met, continued))
+            if not met:
+                break
+            K = Kn
+            queue.pop(0)
+    return OrderReduction((lo, hi), float(decay), tuple(steps))
+
+
+@dataclass(frozen=True)
+class IntervalDesign:
+    """Outcome of :func:`design_interval_controller`.
+
+    Attributes
+    ----------
+    controller : control.StateSpace
+        The requested order when it holds the interval; otherwise the lowest order that
+        does (or the full-order controller when no reduction held, or the full-order
+        continuation's result when even that missed).
+    order : int
+        The requested order.
+    full_order : IntervalReach
+        The full-order continuation from the interval's top.
+    reduction : OrderReduction or None
+        The order continuation (``None`` when the full order missed the interval).
+    met : bool
+        ``controller`` has the requested order and holds the interval.
+    """
+
+    controller: control.StateSpace
+    order: int
+    full_order: IntervalReach
+    reduction: OrderReduction | None
+    met: bool
+
+
+def design_interval_controller(system, interval, order: int, *,
+                               orders: tuple = (20, 14, 10, 8), decay: float = 0.05,
+                               n_speeds: int = 40) -> IntervalDesign:
+    """A fixed-order controller that keeps ΣAE(V) decaying over a whole speed interval.
+
+    Stability over the interval first, the order second: a full-order LQG controller of the
+    loop at the interval's top (:func:`full_order_start`) is continued down to its bottom
+    (:func:`stabilize_interval`, anchor ``"high"``), then its order is lowered through
+    ``orders`` to ``order`` (:func:`reduce_order`).  The paper's design goes the other way
+    (γ at Vf, then as far as the order allows); on the seed wing it stops near 1.5 Vf, where
+    this one holds 2.2 Vf.  γ is not optimised: the verification layer measures it.
+
+    Parameters
+    ----------
+    system
+        The loop family (an :class:`~casflutter.aeroelastic.AeroelasticSystem`, a
+        :class:`~casflutter.aeroelastic.ServoSystem`, a
+        :class:`~casflutter.aeroelastic.TruthLoop`, ...).
+    interval : (lo, hi)
+        Speed-index interval, ``0 <= lo < hi``.
+    order : int
+        Controller order (>= 1).
+    orders : tuple of int
+        Intermediate orders of the reduction; those between ``order`` and the full order
+        are used, highest first.
+    decay : float
+        Decay rate (rad/s) required at every speed of the interval.
+    n_speeds : int
+        Speeds of the continuations' objective.
+
+    Returns
+    -------
+    IntervalDesign
+
+    Raises
+    ------
+    ConfigError
+        A bad interval, order or setting.
+
+    See Also
+    --------
+    design_flutter_controller : the paper's design at Vf, with an interval continuation.
+    """
+    lo, hi = (float(x) for x in interval)
+    if not (0 <= lo < hi and math.isfinite(hi)):
+        raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
+    if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order < 1:
+        raise ConfigError(f"order = {order!r}: an integer >= 1 (a dynamic controller)")
+    start = full_order_start(system, hi)
+    full = stabilize_interval(system, start, (lo, hi), anchor="high", decay=decay,
+                              n_speeds=n_speeds)
+    n = full.controller.nstates
+    log.info("interval design: full order %d holds [%.4g, %.4g] (target [%.4g, %.4g])", n,
+             *full.reached, lo, hi)
+    if not full.met:
+        return IntervalDesign(full.controller, int(order), full, None, False)
+    if order >= n:
+        return IntervalDesign(full.controller, int(order), full, None, True)
+    seq = [int(o) for o in sorted(set(orders), reverse=True) if order < o < n] + [int(order)]
+    red = reduce_order(system, full.controller, (lo, hi), seq, decay=decay)
+    low = red.lowest
+    K = full.controller if low is None else low.controller
+    return IntervalDesign(K, int(order), full, red, bool(low is not None and low.order == order))

@@ -149,8 +149,11 @@ class RomSection(IdentificationSettings):
     (:class:`casflutter.aeroelastic.AeroelasticSystem` ``convective_V0``): the aerodynamics of
     strip theory depend on the reduced frequency, so one ROM identified at ``V0`` holds at
     every speed.  ``false`` is eq. 8 as the paper writes it (Σf frozen at ``V0``, forces
-    scaled by V²).  The flutter route only: the paper's LFT (eq. 14) and the ROM's sampled
-    loop (``lco``) take Σf frozen."""
+    scaled by V²).  With the ``controller`` stage the design is made on the LFT frozen at Vf
+    (exact there) and the ROM's exact stable interval is certified on the scaled loop with
+    the flap behind the servo (``RunResult.rom_interval``); the stages that simulate the
+    ROM's sampled loop (``lco``, ``closed_loop``, ``suppression``) take Σf frozen and are
+    refused."""
 
     def __post_init__(self):
         super().__post_init__()
@@ -232,6 +235,18 @@ class ControllerSettings(SynthesisOptions):
 
     order: int = 3
     """Controller order."""
+    method: str = "hinf"
+    """``"hinf"``: the paper's design, γ of the LFT at Vf (eq. 14-16), with ``interval`` a
+    continuation of its stable interval (:func:`casflutter.design.design_flutter_controller`).
+    ``"interval"``: stability over ``interval`` first, the order second
+    (:func:`casflutter.design.design_interval_controller`): a full-order controller of the
+    ROM loop with the flap behind the servo of ``flap_rate_bandwidth``, continued down over
+    the interval, then reduced through ``reduction_orders`` to ``order``; γ is measured, not
+    optimised.  Needs ``interval`` and ``rom.convective = true`` (a loop that stands for the
+    wing at every speed).  Minutes, not seconds: the full order is continued first."""
+    reduction_orders: tuple = (20, 14, 10, 8)
+    """Intermediate orders of ``method = "interval"`` (those between ``order`` and the full
+    order are used, highest first)."""
     starts: int = 4
     """Starts of the synthesis (the first is the zero controller unless ``zero_start`` is
     false, the others seeded random)."""
@@ -292,6 +307,17 @@ class ControllerSettings(SynthesisOptions):
         object.__setattr__(self, "interval", iv)
         _integer("n_speeds", self.n_speeds, 2)
         _integer("steps", self.steps, 1)
+        if self.method not in ("hinf", "interval"):
+            raise ConfigError(f"controller.method = {self.method!r}: allowed 'hinf', 'interval'")
+        if self.method == "interval" and (not iv or self.order < 1):
+            raise ConfigError("controller.method = \"interval\" holds controller.interval = "
+                              "[lo, hi] with a dynamic controller: give the interval and "
+                              f"order >= 1 (got interval {list(iv)!r}, order {self.order!r})")
+        ro = self.reduction_orders
+        if isinstance(ro, (str, bytes)) or not all(
+                isinstance(o, int) and not isinstance(o, bool) and o >= 1 for o in ro):
+            raise ConfigError(f"controller.reduction_orders = {ro!r}: a list of integers >= 1")
+        object.__setattr__(self, "reduction_orders", tuple(ro))
         if not self.interval_decay >= 0:
             raise ConfigError(f"interval_decay = {self.interval_decay!r}: must be >= 0")
         object.__setattr__(self, "ipopt", check_solver_options(self.ipopt, "ipopt"))
@@ -497,13 +523,22 @@ class RunConfig:
         if "parametric" in stages and self.rom.method != "common_denominator":
             raise ConfigError("stages: 'parametric' interpolates common-denominator ROMs; set "
                               "rom.method = \"common_denominator\"")
-        frozen_only = [s for s in ("lco", "controller", "closed_loop", "suppression")
-                       if s in stages]
+        frozen_only = [s for s in ("lco", "closed_loop", "suppression") if s in stages]
         if self.rom.convective and frozen_only:
             raise ConfigError(f"rom.convective = true scales Σf's time with V, but stage "
-                              f"{frozen_only[0]!r} takes the ROM frozen at V0 (the paper's "
-                              "LFT and the sampled ROM loop); set rom.convective = false or "
-                              f"leave {', '.join(map(repr, frozen_only))} out of stages")
+                              f"{frozen_only[0]!r} simulates the sampled ROM loop, whose "
+                              "time is frozen at V0; set rom.convective = false or leave "
+                              f"{', '.join(map(repr, frozen_only))} out of stages")
+        if (self.controller.method == "interval" and "controller" in stages
+                and not self.rom.convective):
+            raise ConfigError("controller.method = \"interval\" designs on the ROM loop with "
+                              "the flap behind the servo at every speed of the interval, which "
+                              "the ROM of eq. 8 (Σf frozen at V0) does not stand for: set "
+                              "rom.convective = true")
+        if self.rom.convective and "controller" in stages and self.verify.sweep:
+            raise ConfigError("verify.sweep sweeps the LFT frozen at Vf; with rom.convective "
+                              "= true the run certifies the scaled loop itself at every "
+                              "speed: leave verify.sweep empty")
         if "closed_loop" in stages and self.sensors.kind != "displacement":
             raise ConfigError("stages: 'closed_loop' sweeps the truth's linear loop read by "
                               "displacement sensors; set sensors.kind = \"displacement\"")

@@ -176,17 +176,23 @@ def _time_base(sys, time_unit: str) -> dict:
             "frequency_unit": f"rad/{time_unit}"}
 
 
-def _certified(ver, scale) -> dict:
+def _certified(ver, scale, result=None) -> dict:
+    """γ and the certified speed intervals of ``ver``; with a ``result`` whose ROM's time
+    scales with V, the exact interval is the scaled loop's (``RunResult.rom_stable_V``)."""
     def num(x):
         return None if x is None or not math.isfinite(float(x)) else float(x)
+    scaled = result is not None and result.convective_V0 is not None
+    note = ("speed intervals over which the loop is certified stable: small-gain "
+            "(eq. 16, from gamma) and exact (eq. 10-15); each in every unit the problem has")
+    if scaled:
+        note += ("; the ROM's time scales with V, so exact_V is its scaled loop's (flap "
+                 "behind the servo), the small-gain intervals the LFT's frozen at Vf")
     return {"stable": bool(ver.stable), "gamma": num(ver.gamma),
             "gamma_delta": None if ver.hinf_delta is None else num(ver.hinf_delta.gamma),
             "small_gain_V": interval_values(ver.small_gain_V, scale),
             "small_gain_V_delta": interval_values(ver.small_gain_V_delta, scale),
-            "exact_V": interval_values(ver.exact_V, scale),
-            "note": "speed intervals over which the loop is certified stable: small-gain "
-                    "(eq. 16, from gamma) and exact (eq. 10-15); each in every unit the "
-                    "problem has"}
+            "exact_V": interval_values(result.rom_stable_V if scaled else ver.exact_V, scale),
+            "note": note}
 
 
 def controller_document(result) -> dict:
@@ -226,7 +232,7 @@ def controller_document(result) -> dict:
                       "speed_index_definition": scale.definition,
                       "Vf": speed_values(ver.Vf if ver is not None else result.Vf, scale),
                       "seed": cfg.seed},
-           "certified": None if ver is None else _certified(ver, scale),
+           "certified": None if ver is None else _certified(ver, scale, result),
            "poles": _pole_check(result)}
     return doc
 
@@ -319,10 +325,11 @@ def _controller_mat(result, doc: dict) -> dict:
         mat[f"Vf_{key}"] = np.nan if value is None else float(value)
     if ver is not None:
         mat["small_gain_V"] = _mat_interval(ver.small_gain_V)
-        mat["exact_V"] = _mat_interval(ver.exact_V)
+        exact = result.rom_stable_V
+        mat["exact_V"] = _mat_interval(exact)
         scale = speed_scale(_problem(result))
         if scale.to_airspeed is not None:
-            for name, pair in (("small_gain", ver.small_gain_V), ("exact", ver.exact_V)):
+            for name, pair in (("small_gain", ver.small_gain_V), ("exact", exact)):
                 iv = interval_values(pair, scale)
                 mat[f"{name}_airspeed_m_s"] = (np.zeros((0, 2)) if iv is None else np.array(
                     [[np.inf if x is None else x for x in iv["airspeed_m_s"]]]))
@@ -364,7 +371,7 @@ def label_summary(summary: dict, result) -> dict:
     if isinstance(ctl, dict) and ver is not None:
         ctl["Vf"] = speed_values(ver.Vf if ver.Vf is not None else result.Vf, scale)
         ctl["certified"] = {"small_gain_V": interval_values(ver.small_gain_V, scale),
-                            "exact_V": interval_values(ver.exact_V, scale)}
+                            "exact_V": interval_values(result.rom_stable_V, scale)}
         ctl["poles"] = check
     info = dict(getattr(result, "provenance", None) or {}) or provenance(seed=result.config.seed)
     summary["casflutter_version"] = info.get("casflutter_version")

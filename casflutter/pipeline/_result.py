@@ -13,7 +13,7 @@ import numpy as np
 from ..aeroelastic import (AeroelasticLFT, AeroelasticSystem, FlutterResult, LoopSimulation,
                            ParametricSystem, PKResult, RFASystem)
 from ..data import IOData
-from ..design import SynthesisResult
+from ..design import IntervalDesign, SynthesisResult
 from .._outputs import plain_json
 from ..ident import CommonDenominatorResult, FitReport, IdentificationResult
 from ..lco import LCOBranch
@@ -207,13 +207,23 @@ class RunResult:
     lft : AeroelasticLFT or None
         LFT at the ROM's Vf (eq. 14; stage ``controller``).
     synthesis : SynthesisResult or None
-        The fixed-order synthesis.
+        The fixed-order synthesis (``None`` with ``controller.method = "interval"``).
+    interval_design : IntervalDesign or None
+        The design of ``controller.method = "interval"``: the full-order continuation and
+        the order reduction.
     controller : control.StateSpace or None
         ``K`` from the sensors to the flap (``v = K zm``).
     verification : VerificationReport or None
         γ and the speed intervals (eq. 10-16).
     rom_sweep : SpeedSweep or None
         Dense eigenvalue sweep of the ROM loop (``verify.sweep``).
+    rom_interval : StabilityInterval or None
+        For a ROM whose time scales with V (``rom.convective``): the exact stable speed
+        interval of its loop closed by the controller, the flap behind the same servo as the
+        truth's (:meth:`casflutter.aeroelastic.AeroelasticSystem.with_servo`), grown from
+        ``data.V0``.  ``None`` for the paper's frozen ROM, whose exact interval is the
+        verification's (the LFT is exact at every speed), or when the controller does not
+        hold the scaled loop at V0.
     truth_interval : StabilityInterval or None
         Exact stable speed interval of the truth's own linearisation closed by the
         controller, the flap behind a servo of ``controller.flap_rate_bandwidth``
@@ -262,9 +272,11 @@ class RunResult:
     lco: LcoResult | None = None
     lft: AeroelasticLFT | None = None
     synthesis: SynthesisResult | None = None
+    interval_design: IntervalDesign | None = None
     controller: control.StateSpace | None = None
     verification: VerificationReport | None = None
     rom_sweep: SpeedSweep | None = None
+    rom_interval: StabilityInterval | None = None
     truth_interval: StabilityInterval | None = None
     closed_loop: ClosedLoopChecks | None = None
     suppression: SuppressionResult | None = None
@@ -371,15 +383,27 @@ class RunResult:
         return (req[0] * self.Vf, req[1] * self.Vf)
 
     @property
+    def rom_stable_V(self) -> tuple | None:
+        """The exact stable speed interval of the ROM loop closed by the controller: the
+        verification's (on the LFT, eq. 10-15) for the paper's frozen ROM, the scaled loop's
+        (:attr:`rom_interval`) for a ROM whose time scales with V.  ``None`` without a
+        controller or when it does not hold the loop."""
+        if self.verification is None:
+            return None
+        if self.convective_V0 is not None:
+            ri = self.rom_interval
+            return None if ri is None else (float(ri.lower), float(ri.upper))
+        return self.verification.exact_V if self.verification.stable else None
+
+    @property
     def interval_ok(self) -> bool | None:
-        """The verified exact stable interval contains :attr:`required_V` (``None`` without a
-        target or a verification)."""
+        """The verified exact stable interval (:attr:`rom_stable_V`) contains
+        :attr:`required_V` (``None`` without a target or a verification)."""
         if self.required_V is None or self.verification is None:
             return None
-        ex = self.verification.exact_V
+        ex = self.rom_stable_V
         lo, hi = self.required_V
-        return bool(self.verification.stable and ex is not None and ex[0] <= lo
-                    and ex[1] >= hi)
+        return bool(ex is not None and ex[0] <= lo and ex[1] >= hi)
 
     @property
     def success(self) -> bool:
@@ -453,8 +477,10 @@ class RunResult:
                 "gamma_delta": float(ver.hinf_delta.gamma),
                 "small_gain_V_delta": _pair(ver.small_gain_V_delta),
                 "required_V": _pair(self.required_V), "interval_ok": self.interval_ok,
-                "synthesis_gammas": [float(g) for g in self.synthesis.gammas],
-                "synthesis_converged": bool(self.synthesis.converged),
+                "synthesis_gammas": (None if self.synthesis is None
+                                     else [float(g) for g in self.synthesis.gammas]),
+                "synthesis_converged": (None if self.synthesis is None
+                                        else bool(self.synthesis.converged)),
                 "success": self.success}
         U_ref = getattr(self.problem, "U_ref", None)
         if U_ref is not None and out["flutter"] is not None and out["flutter"]["V"] is not None:
@@ -513,11 +539,24 @@ class RunResult:
             return None
         ver = self.verification
         ti = self.truth_interval
-        return {"order": self.synthesis.order, "gamma": ver.gamma,
-                "small_gain_V": _pair(ver.small_gain_V), "stable_V": _pair(ver.exact_V),
+        out = {"order": int(self.controller.nstates), "gamma": ver.gamma,
+                "small_gain_V": _pair(ver.small_gain_V), "stable_V": _pair(self.rom_stable_V),
                 "stable": bool(ver.stable),
                 # an upper end without a crossing is written as null
                 "truth_stable_V": None if ti is None else [
                     float(ti.lower), float(ti.upper) if math.isfinite(ti.upper) else None],
                 "truth_servo_omega": (self.config.controller.flap_rate_bandwidth
                                       if self.truth is not None else None)}
+        d = self.interval_design
+        if d is not None:
+            red = () if d.reduction is None else d.reduction.steps
+            out["interval_design"] = {
+                "order_requested": d.order, "met": d.met,
+                "full_order": int(d.full_order.controller.nstates),
+                "full_order_reached": list(d.full_order.reached),
+                "orders_held": {str(st.order): st.met for st in red}}
+        if self.convective_V0 is not None:
+            # stable_V is the scaled loop's; the LFT's intervals hold for Σf frozen at Vf
+            out["rom_servo_omega"] = self.config.controller.flap_rate_bandwidth
+            out["stable_V_frozen_at_Vf"] = _pair(ver.exact_V)
+        return out

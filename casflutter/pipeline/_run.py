@@ -63,7 +63,7 @@ from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, R
                            TruthLoop, build_lft, pk_flutter,
                            find_flutter, simulate_loop)
 from ..data import envelope_growth_rate
-from ..design import SynthesisOptions, design_flutter_controller
+from ..design import SynthesisOptions, design_flutter_controller, design_interval_controller
 from ..errors import CasflutterError, ConfigError, ConvergenceError
 from ..ident import (IdentificationResult, IdentificationSettings, fit_report, identify,
                      identify_common_denominator)
@@ -432,14 +432,29 @@ def _controller_stages(cfg: RunConfig, system, Vf: float, prog, out: dict, truth
         c = cfg.controller
         options = replace(settings_as(c, SynthesisOptions),
                           ipopt={**cfg.solver.ipopt, **c.ipopt})
-        # γ of the LFT at Vf (eq. 14-16), each design plant with its own loop shift, and
-        # ΣAE(V) kept stable over controller.interval; K acts on the physical sensors
-        design = design_flutter_controller(
-            system, Vf, c.order, speeds=tuple(c.speeds), interval=tuple(c.interval),
-            n_speeds=c.n_speeds, decay=c.interval_decay, steps=c.steps, starts=c.starts,
-            seed=cfg.seed, options=options, flap_rate_weight=c.flap_rate_weight,
-            flap_rate_bandwidth=c.flap_rate_bandwidth)
-        syn, K = design.synthesis, design.controller
+        if c.method == "interval":
+            # stability of the scaled ROM loop (flap behind the servo) over the whole
+            # interval first, then the order; no synthesis, γ is the verification's
+            design = design_interval_controller(
+                system.with_servo(c.flap_rate_bandwidth), c.interval, c.order,
+                orders=c.reduction_orders, decay=c.interval_decay, n_speeds=c.n_speeds)
+            syn, K = None, design.controller
+            out["interval_design"] = design
+            if not design.met:
+                held = design.full_order.met
+                prog.note(f"no order-{c.order} controller found that holds the interval "
+                          f"{list(c.interval)}; kept the order-{K.nstates} controller "
+                          + ("that holds it" if held else "of the full-order continuation, "
+                             f"which reached {list(design.full_order.reached)}"))
+        else:
+            # γ of the LFT at Vf (eq. 14-16), each design plant with its own loop shift, and
+            # ΣAE(V) kept stable over controller.interval; K acts on the physical sensors
+            design = design_flutter_controller(
+                system, Vf, c.order, speeds=tuple(c.speeds), interval=tuple(c.interval),
+                n_speeds=c.n_speeds, decay=c.interval_decay, steps=c.steps, starts=c.starts,
+                seed=cfg.seed, options=options, flap_rate_weight=c.flap_rate_weight,
+                flap_rate_bandwidth=c.flap_rate_bandwidth)
+            syn, K = design.synthesis, design.controller
     with prog.stage("verify"):
         ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
         if cfg.verify.sweep:
@@ -447,23 +462,39 @@ def _controller_stages(cfg: RunConfig, system, Vf: float, prog, out: dict, truth
             out["rom_sweep"] = speed_sweep(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf,
                                            n_delta=lft.n_delta,
                                            V=np.linspace(lo * Vf, hi * Vf, cfg.verify.n_sweep))
+        if system.convective_V0 is not None:
+            out["rom_interval"] = _rom_interval(system, K, cfg, prog)
         if truth is not None:
             out["truth_interval"] = _truth_interval(truth, structure, K, cfg, prog)
     out.update(lft=lft, synthesis=syn, controller=K, verification=ver)
 
 
+def _rom_interval(system, K, cfg: RunConfig, prog) -> StabilityInterval | None:
+    """The exact stable speed interval of a ROM loop whose time scales with V
+    (``rom.convective``) closed by ``K``, the flap behind the truth's servo: the LFT frozen
+    at Vf is exact only at Vf, this loop at every speed.  See :func:`_family_interval`."""
+    return _family_interval(system.with_servo(cfg.controller.flap_rate_bandwidth), K, cfg,
+                            prog, "the scaled ROM loop")
+
+
 def _truth_interval(truth, structure, K, cfg: RunConfig, prog) -> StabilityInterval | None:
     """The exact stable speed interval of the truth's own linearisation closed by ``K``, the
-    flap behind a servo of ``controller.flap_rate_bandwidth``, grown from ``data.V0``: the
-    interval on the wing the ROM stands in for.  ``None`` when K does not hold the truth
-    at V0."""
-    family = TruthLoop(truth, cfg.controller.flap_rate_bandwidth, sensors=structure)
+    flap behind the servo: the interval on the wing the ROM stands in for.  See
+    :func:`_family_interval`."""
+    return _family_interval(TruthLoop(truth, cfg.controller.flap_rate_bandwidth,
+                                      sensors=structure), K, cfg, prog,
+                            "the truth's linear loop")
+
+
+def _family_interval(family, K, cfg: RunConfig, prog, what: str) -> StabilityInterval | None:
+    """The verification layer's exact stable interval of a loop family closed by ``K``
+    (servo of ``controller.flap_rate_bandwidth``), grown from ``data.V0``; ``None`` (and a
+    note) when K does not hold the loop at V0."""
     try:
         return speed_family_interval(lambda V: family.loop(V).flap_to_sensors(), K,
                                      cfg.data.V0)
     except NotHurwitzError:
-        prog.note(f"the controller does not stabilise the truth's linear loop at "
-                  f"V0 = {cfg.data.V0:.4g}")
+        prog.note(f"the controller does not stabilise {what} at V0 = {cfg.data.V0:.4g}")
         return None
 
 

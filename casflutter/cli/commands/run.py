@@ -1,9 +1,15 @@
 """``casflutter run``: a study run of a configuration (default: the paper's study on the seed
-wing, ``problems/seed_wing/run.toml``)."""
+wing, ``problems/seed_wing/run.toml``).
+
+Exit status: 0 when the run finished and every check it made passed (the ``verify.required``
+interval, the closed-loop simulations), 3 when it finished and wrote its outputs but a check
+failed (``checks passed: False``; summary.json says which), 1 or 2 for a run refused or
+stopped."""
 
 from __future__ import annotations
 
 import json
+import sys
 
 from ..._outputs import check_output_path
 
@@ -61,6 +67,10 @@ def _main(args) -> int:
         lines.append(f"controller order {c['order']}: verified gamma = {c['gamma']}, small-gain "
                      f"V in {c['small_gain_V']}, exact stable V in {c['stable_V']} (speed "
                      "index)")
+        if c.get("rom_servo_omega") is not None:
+            lines.append(f"  the ROM's time scales with V: that interval is its scaled loop's "
+                         f"(servo {c['rom_servo_omega']} rad/s); the LFT frozen at Vf holds "
+                         f"V in {c['stable_V_frozen_at_Vf']}")
         if c.get("truth_servo_omega") is not None:
             lines.append(f"  on the truth's own linearisation (servo {c['truth_servo_omega']} "
                          f"rad/s): exact stable V in {c['truth_stable_V']}")
@@ -81,6 +91,10 @@ def _main(args) -> int:
         print(json.dumps(s, indent=2))
     elif not args.quiet:
         print("\n".join(lines))
+    if (res.interval_ok is not None or res.closed_loop is not None) and not res.success:
+        print(f"casflutter run: a check failed (see {res.out_dir}/summary.json)",
+              file=sys.stderr)
+        return 3
     return 0
 
 
