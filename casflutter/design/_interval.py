@@ -564,8 +564,10 @@ def design_interval_controller(system, interval, order: int, *,
     loop at the interval's top (:func:`full_order_start`) is continued down to its bottom
     (:func:`stabilize_interval`, anchor ``"high"``), then its order is lowered through
     ``orders`` to ``order`` (:func:`reduce_order`).  The paper's design goes the other way
-    (γ at Vf, then as far as the order allows); on the seed wing it stops near 1.5 Vf, where
-    this one holds 2.2 Vf.  γ is not optimised: the verification layer measures it.
+    (γ at Vf, then as far as the order allows).  On the seed wing's scaled ROM with the servo
+    (``problems/seed_wing/interval.toml``) that route stops at 1.43 Vf; this one holds
+    (0, 2.22 Vf) at order 4 on the ROM loop, and the wing itself to 2.19 Vf.  γ is not
+    optimised: the verification layer measures it.
 
     Parameters
     ----------
