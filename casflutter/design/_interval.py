@@ -92,7 +92,7 @@ def _unpack(p: np.ndarray, n: int, m: int):
             p[n * n + n * m:].reshape(1, n))
 
 
-class _LoopFamily:
+class _ClosedLoopsAtSpeeds:
     """ΣAE(V_j) at a set of speeds and the closed loop's rightmost eigenvalue and its gradient
     with respect to ``(Ak, Bk, Ck)`` (``Dk`` held fixed)."""
 
@@ -143,7 +143,7 @@ def _polish(system, K: control.StateSpace, speeds, max_iter: int, good: float
     worst is below ``good``.  Returns the best controller met and its worst abscissa."""
     Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (K.A, K.B, K.C, K.D))
     n, m = K.nstates, Dk.shape[1]
-    fam = _LoopFamily(system, speeds, n, Dk)
+    fam = _ClosedLoopsAtSpeeds(system, speeds, n, Dk)
     p = np.concatenate([Ak.ravel(), Bk.ravel(), Ck.ravel()])
     best = fam.smoothed(p, None)[0]
     for tau in (1.0, 0.3, 0.1, 0.03, 0.01, None):
@@ -291,7 +291,7 @@ def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
             speeds = np.linspace(*trial, n_speeds)
             q = p
             for _ in range(3):
-                fam = _LoopFamily(system, speeds, order, Dk)
+                fam = _ClosedLoopsAtSpeeds(system, speeds, order, Dk)
                 for tau in (0.3, 0.1, 0.03, None):
                     if fam.smoothed(q, None)[0] <= -2 * decay:
                         break
