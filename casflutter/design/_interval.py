@@ -566,8 +566,9 @@ def design_interval_controller(system, interval, order: int, *,
     ``orders`` to ``order`` (:func:`reduce_order`).  The paper's design goes the other way
     (γ at Vf, then as far as the order allows).  On the seed wing's scaled ROM with the servo
     (``problems/seed_wing/interval.toml``) that route stops at 1.43 Vf; this one holds
-    (0, 2.22 Vf) at order 4 on the ROM loop, and the wing itself to 2.19 Vf.  γ is not
-    optimised: the verification layer measures it.
+    (0, 2.22 Vf) at order 4 on the ROM loop and the wing itself to 2.19 Vf (continued on the
+    wing, the same controller holds it to 2.23 Vf).  γ is not optimised: the verification
+    layer measures it.
 
     Parameters
     ----------

@@ -4,7 +4,9 @@
 minimal order 20) found by continuation on the truth's own linearisation with the flap behind
 its 40 Hz servo (:class:`casflutter.aeroelastic.TruthLoop`);
 ``truth_interval_controller_order8.json`` and ``..._order7.json`` are order-8 and order-7
-controllers reduced from it, the lowest orders found (see each file's ``about``).  Whether they hold the wing is not taken from the optimiser: the
+controllers reduced from it; ``..._order4.json``, the lowest order found, is the order-4 result
+of ``problems/seed_wing/interval.toml`` (designed on the scaled ROM loop) continued on the wing
+(see each file's ``about``).  Whether they hold the wing is not taken from the optimiser: the
 verification layer certifies the exact stable interval (polynomial guardian map, the loop
 closed by python-control), and a dense eigenvalue scan computed here agrees.
 """
@@ -22,7 +24,8 @@ from casflutter.verify import load_controller, speed_family_interval
 
 SERVO = 251.3     # rad/s, the seed wing's 40 Hz servo (run.toml: controller.flap_rate_bandwidth)
 WITNESSES = {"truth_interval_controller.json": 32, "truth_interval_controller_order8.json": 8,
-             "truth_interval_controller_order7.json": 7}
+             "truth_interval_controller_order7.json": 7,
+             "truth_interval_controller_order4.json": 4}
 
 
 @pytest.fixture(scope="module")
