@@ -56,10 +56,10 @@ def test_a_dense_scan_agrees(plant, witness):
     assert np.max(plant(2.4).poles().real) > 0
 
 
-def test_the_best_order_3_controller_found_holds_the_wing_to_2_22(plant):
+def test_the_best_order_3_controller_found_holds_the_wing_to_2_26(plant):
     """The figure the documentation quotes for order 3 (the paper's order): certified, and
     short of the paper's 2.4."""
     K = load_controller(problems_dir() / "seed_wing" / "truth_best_order3_controller.json")
     assert K.nstates == 3
     cert = speed_family_interval(plant, K, 1.2)
-    assert cert.lower == 0.0 and 2.22 < cert.upper < 2.4
+    assert cert.lower == 0.0 and 2.259 < cert.upper < 2.4
