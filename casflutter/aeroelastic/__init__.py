@@ -4,7 +4,8 @@
   and the modal structure Σs (:class:`casflutter.structure.ModalStructure`, eq. 6-7);
   :class:`ParametricSystem` — the same with Σf interpolated in V; :class:`TruthLoop` — the
   truth's own linearisation as the same loop (flap behind a servo), what the ROM stands in for;
-  :class:`ServoSystem` (``AeroelasticSystem.with_servo``) — a ROM family behind the same servo.
+  :class:`ServoSystem` (``AeroelasticSystem.with_servo``) — a ROM family behind the same servo;
+  :class:`LoopFamily` — the interface they share (a loop at every speed index).
 - :func:`track_eigenvalues`, :func:`find_flutter` — branch tracking by eigenvector
   continuity, V–g / V–f data, flutter (Hopf) and divergence speeds.
 - :func:`simulate_loop` — the nonlinear discrete ROM in feedback with Σs (paper Fig. 9).
@@ -15,8 +16,8 @@
 
 from ._flutter import Crossing, FlutterResult, find_flutter, origin_modes
 from ._lft import AeroelasticLFT, build_lft
-from ._loop import (AeroelasticLoop, AeroelasticSystem, ParametricSystem, ServoSystem,
-                    aeroelastic_loop, split_sigma_f)
+from ._loop import (AeroelasticLoop, AeroelasticSystem, LoopFamily, ParametricSystem,
+                    ServoSystem, aeroelastic_loop, split_sigma_f)
 from ._pk import PKResult, pk_flutter
 from ._rfa_system import RFASystem
 from ._simulate import LoopSimulation, simulate_loop
@@ -24,7 +25,8 @@ from ._tracking import EigenTracking, eig_sorted_by_reference, track_eigenvalues
 from ._truth_loop import TruthLoop
 
 __all__ = [
-    "AeroelasticSystem", "AeroelasticLoop", "ParametricSystem", "ServoSystem", "aeroelastic_loop",
+    "AeroelasticSystem", "AeroelasticLoop", "LoopFamily", "ParametricSystem", "ServoSystem",
+    "aeroelastic_loop",
     "split_sigma_f",
     "EigenTracking", "track_eigenvalues", "eig_sorted_by_reference",
     "Crossing", "FlutterResult", "find_flutter", "origin_modes",

@@ -30,8 +30,8 @@ from .._linalg import spectral_abscissa
 from ..errors import ConfigError, DimensionError
 from ..structure import ModalStructure
 
-__all__ = ["AeroelasticSystem", "AeroelasticLoop", "ParametricSystem", "ServoSystem",
-           "aeroelastic_loop",
+__all__ = ["AeroelasticSystem", "AeroelasticLoop", "LoopFamily", "ParametricSystem",
+           "ServoSystem", "aeroelastic_loop", "check_servo",
            "split_sigma_f"]
 
 
@@ -203,8 +203,7 @@ class AeroelasticLoop:
         ConfigError
             A frequency or damping out of range.
         """
-        if not (np.isfinite(omega) and omega > 0 and np.isfinite(zeta) and zeta >= 0):
-            raise ConfigError(f"servo omega = {omega!r} must be > 0 and zeta = {zeta!r} >= 0")
+        check_servo(omega, zeta)
         n, m = self.A.shape[0], self.C2.shape[0]
         w2 = float(omega) ** 2
         A = np.zeros((n + 2, n + 2))
@@ -229,8 +228,74 @@ class AeroelasticLoop:
         return np.linalg.eigvals(self.A)
 
 
+def check_servo(omega: float, zeta: float, names: tuple = ("servo omega", "zeta")) -> None:
+    """Raise :class:`~casflutter.errors.ConfigError` unless ``omega > 0`` and ``zeta >= 0``
+    are finite (a second-order flap servo, ``v̈ = ω² (c − v) − 2ζω v̇``); ``names`` are the
+    caller's names of the two, for the message."""
+    if not (math.isfinite(omega) and omega > 0 and math.isfinite(zeta) and zeta >= 0):
+        raise ConfigError(f"{names[0]} = {omega!r} must be > 0 and {names[1]} = {zeta!r} >= 0")
+
+
+class LoopFamily:
+    """A linear aeroelastic loop at every speed index: the interface that the flutter
+    analysis, the interval design (:func:`casflutter.design.stabilize_interval`,
+    :func:`casflutter.design.reduce_order`) and the verification
+    (:func:`casflutter.verify.speed_family_interval` on ``loop(V).flap_to_sensors()``) take.
+
+    A family defines :meth:`loop`; the state matrices follow from it (a family may compute
+    :meth:`state_matrix` more directly).
+    """
+
+    def loop(self, V: float) -> AeroelasticLoop:
+        """The loop at speed index V.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        AeroelasticLoop
+        """
+        raise NotImplementedError
+
+    def state_matrix(self, V: float) -> np.ndarray:
+        """The open-loop state matrix at speed index V.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        ndarray
+        """
+        return self.loop(V).A
+
+    def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
+        """State matrix at V closed with ``v = K zm`` (positive feedback, paper Fig. 3); see
+        :meth:`AeroelasticLoop.closed_loop_state_matrix`.
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+        controller : control.StateSpace
+            Continuous K with ``n_sensors`` inputs and one output (the flap, or the servo's
+            command for a family with a servo).
+
+        Returns
+        -------
+        ndarray
+            The state matrix of ``(x, x_K)``.
+        """
+        return self.loop(V).closed_loop_state_matrix(controller)
+
+
 @dataclass(frozen=True)
-class AeroelasticSystem:
+class AeroelasticSystem(LoopFamily):
     """Σf and Σs together, giving ΣAE(V) at any speed index (eq. 8-9).
 
     Use :func:`AeroelasticSystem.from_parts` (or :func:`aeroelastic_loop`) to build it
@@ -406,23 +471,6 @@ class AeroelasticSystem:
         bot = np.hstack([r * self.Bf @ Cs, r * self.Af])
         return np.vstack([top, bot])
 
-    def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
-        """State matrix of ΣAE(V) closed with ``v = K zm`` (positive feedback, paper Fig. 3).
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-        controller : control.StateSpace
-            Continuous K with ``n_sensors`` inputs and one output.
-
-        Returns
-        -------
-        ndarray
-            The state matrix of ``(x, x_K)``; see :meth:`AeroelasticLoop.closed_loop_state_matrix`.
-        """
-        return self.loop(V).closed_loop_state_matrix(controller)
-
     def with_servo(self, omega: float, zeta: float = 0.7) -> "ServoSystem":
         """ΣAE(V) with the flap behind a second-order servo at every speed (what a wind-tunnel
         model has, and :class:`~casflutter.aeroelastic.TruthLoop` puts in front of the truth).
@@ -443,6 +491,7 @@ class AeroelasticSystem:
         ConfigError
             A frequency or damping out of range.
         """
+        check_servo(omega, zeta)
         return ServoSystem(self, omega, zeta)
 
     def loop(self, V: float) -> AeroelasticLoop:
@@ -492,7 +541,7 @@ def aeroelastic_loop(sigma_f, structure: ModalStructure, V: float) -> Aeroelasti
 
 
 @dataclass(frozen=True)
-class ParametricSystem:
+class ParametricSystem(LoopFamily):
     """ΣAE(V) of a parametric ROM: Σf interpolated at the same V as the loop is closed.
 
     Attributes
@@ -546,23 +595,6 @@ class ParametricSystem:
         """
         return AeroelasticSystem(self.structure, *self.rom.sigma_f_matrices(V)).loop(V)
 
-    def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
-        """State matrix of :meth:`loop` closed with ``v = K zm`` (positive feedback).
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-        controller : control.StateSpace
-            Continuous K with ``n_sensors`` inputs and one output.
-
-        Returns
-        -------
-        ndarray
-            The state matrix of ``(x, x_K)``.
-        """
-        return self.loop(V).closed_loop_state_matrix(controller)
-
     def state_matrix(self, V: float) -> np.ndarray:
         """Â(V) of eq. 8a with Σf interpolated at the same V.
 
@@ -584,15 +616,13 @@ class ParametricSystem:
 
 
 @dataclass(frozen=True)
-class ServoSystem:
+class ServoSystem(LoopFamily):
     """A loop family with the flap behind a second-order servo, ``v̈ = ω² (c − v) − 2ζω v̇``.
 
     Every speed's loop is the family's :meth:`AeroelasticLoop.with_servo`: the controller
-    commands ``c`` and the flap position becomes a state.  It has the interface of the other
-    families (``loop``, ``state_matrix``, ``closed_loop_state_matrix``), so the interval
-    design (:func:`casflutter.design.stabilize_interval`) and the verification
-    (:func:`casflutter.verify.speed_family_interval` on ``loop(V).flap_to_sensors()``) take
-    it as they take the truth's :class:`~casflutter.aeroelastic.TruthLoop`.
+    commands ``c`` and the flap position becomes a state.  It is a :class:`LoopFamily`, so the
+    interval design and the verification take it as they take the truth's
+    :class:`~casflutter.aeroelastic.TruthLoop`.
 
     Attributes
     ----------
@@ -614,10 +644,7 @@ class ServoSystem:
     servo_zeta: float = 0.7
 
     def __post_init__(self):
-        if not (math.isfinite(self.servo_omega) and self.servo_omega > 0
-                and math.isfinite(self.servo_zeta) and self.servo_zeta >= 0):
-            raise ConfigError(f"servo omega = {self.servo_omega!r} must be > 0 and zeta = "
-                              f"{self.servo_zeta!r} >= 0")
+        check_servo(self.servo_omega, self.servo_zeta, ("servo_omega", "servo_zeta"))
 
     def loop(self, V: float) -> AeroelasticLoop:
         """The family's loop at speed index V, flap behind the servo.
@@ -633,34 +660,3 @@ class ServoSystem:
             States ``(x, v, v̇)``.
         """
         return self.system.loop(V).with_servo(self.servo_omega, self.servo_zeta)
-
-    def state_matrix(self, V: float) -> np.ndarray:
-        """The open-loop state matrix at speed index V (servo at rest).
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        ndarray
-        """
-        return self.loop(V).A
-
-    def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
-        """State matrix at V closed with ``c = K zm`` (positive feedback, paper Fig. 3).
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-        controller : control.StateSpace
-            Continuous K with ``n_sensors`` inputs and one output (the servo command).
-
-        Returns
-        -------
-        ndarray
-            The state matrix of ``(x, v, v̇, x_K)``.
-        """
-        return self.loop(V).closed_loop_state_matrix(controller)

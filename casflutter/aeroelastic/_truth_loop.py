@@ -13,7 +13,6 @@ inputs, so everything that takes the ROM loop (:func:`casflutter.design.stabiliz
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,13 +20,13 @@ import numpy as np
 from ..errors import ConfigError
 from ..structure import ModalStructure
 from ..truth import AeroelasticTruth
-from ._loop import AeroelasticLoop
+from ._loop import AeroelasticLoop, LoopFamily, check_servo
 
 __all__ = ["TruthLoop"]
 
 
 @dataclass(frozen=True)
-class TruthLoop:
+class TruthLoop(LoopFamily):
     """The truth's linear aeroelastic loop at any speed index, flap behind a servo.
 
     Attributes
@@ -65,10 +64,7 @@ class TruthLoop:
         if not isinstance(self.truth, AeroelasticTruth):
             raise ConfigError(f"truth must be a casflutter.truth.AeroelasticTruth, got "
                               f"{type(self.truth).__name__}")
-        if not (math.isfinite(self.servo_omega) and self.servo_omega > 0
-                and math.isfinite(self.servo_zeta) and self.servo_zeta >= 0):
-            raise ConfigError(f"servo_omega = {self.servo_omega!r} must be > 0 and "
-                              f"servo_zeta = {self.servo_zeta!r} >= 0")
+        check_servo(self.servo_omega, self.servo_zeta, ("servo_omega", "servo_zeta"))
         if self.sensors is not None and (not isinstance(self.sensors, ModalStructure) or
                                          self.sensors.n_modes != self.truth.n_modes):
             raise ConfigError(f"sensors must be a ModalStructure on the truth's "
@@ -108,34 +104,3 @@ class TruthLoop:
         Cu = np.eye(nx)[:N]
         return AeroelasticLoop(float(V), A, B[:, 1:], B[:, 0].copy(), C2, D2[:, 1:],
                                D2[:, 0].copy(), Cu, N, nx - 2 * N)
-
-    def state_matrix(self, V: float) -> np.ndarray:
-        """The open-loop state matrix at speed index V (flap servo at rest).
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        ndarray
-        """
-        return self.loop(V).A
-
-    def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
-        """State matrix at V closed with ``v = K zm`` (positive feedback, paper Fig. 3).
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-        controller : control.StateSpace
-            Continuous K with ``n_sensors`` inputs and one output (the servo command).
-
-        Returns
-        -------
-        ndarray
-            The state matrix of ``(x, x_K)``.
-        """
-        return self.loop(V).closed_loop_state_matrix(controller)

@@ -86,15 +86,30 @@ class IntervalReach:
     met: bool
 
 
-def _unpack(p: np.ndarray, n: int, m: int):
-    """``(Ak, Bk, Ck)`` of an order-``n`` controller on ``m`` sensors from its parameters."""
-    return (p[:n * n].reshape(n, n), p[n * n:n * n + n * m].reshape(n, m),
-            p[n * n + n * m:].reshape(1, n))
+def _unpack(p: np.ndarray, n: int, m: int, Dk: np.ndarray):
+    """``(Ak, Bk, Ck, Dk)`` of an order-``n`` controller on ``m`` sensors from its parameters;
+    ``Dk`` is the last ``m`` of them when they are there (a free feed-through), the given one
+    otherwise."""
+    L = n * n + n * m + n
+    D = p[L:L + m].reshape(1, m) if len(p) == L + m else Dk
+    return p[:n * n].reshape(n, n), p[n * n:n * n + n * m].reshape(n, m), \
+        p[n * n + n * m:L].reshape(1, n), D
 
 
-class _LoopFamily:
+def _pack(K: control.StateSpace, free_feedthrough: bool) -> np.ndarray:
+    """The parameters of ``K`` that the continuation moves (``Dk`` only when free)."""
+    parts = [K.A, K.B, K.C] + ([K.D] if free_feedthrough else [])
+    return np.concatenate([np.asarray(M, dtype=float).ravel() for M in parts])
+
+
+def _controller(p: np.ndarray, n: int, m: int, Dk: np.ndarray) -> control.StateSpace:
+    return control.ss(*_unpack(p, n, m, Dk))
+
+
+class _ClosedLoopsAtSpeeds:
     """ΣAE(V_j) at a set of speeds and the closed loop's rightmost eigenvalue and its gradient
-    with respect to ``(Ak, Bk, Ck)`` (``Dk`` held fixed)."""
+    with respect to ``(Ak, Bk, Ck)``, and ``Dk`` when the parameters include it (otherwise
+    ``Dk`` is held at the given value)."""
 
     def __init__(self, system: AeroelasticSystem, speeds, order: int, Dk: np.ndarray):
         self.order, self.Dk = order, Dk
@@ -103,12 +118,13 @@ class _LoopFamily:
         self.m = m
 
     def rightmost(self, p: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
-        Ak, Bk, Ck = _unpack(p, self.order, self.m)
+        Ak, Bk, Ck, Dk = _unpack(p, self.order, self.m, self.Dk)
+        free_d = Dk is not self.Dk
         values, grads = [], []
         for lp in self.loops:
-            s = 1.0 - float((self.Dk @ lp.D22)[0])
+            s = 1.0 - float((Dk @ lp.D22)[0])
             B2 = lp.B2[:, None] / s
-            vx = (self.Dk @ lp.C2) / s
+            vx = (Dk @ lp.C2) / s
             zx = lp.C2 + lp.D22[:, None] @ vx
             D22 = lp.D22[:, None]
             Acl = np.block([[lp.A + lp.B2[:, None] @ vx, B2 @ Ck],
@@ -118,12 +134,19 @@ class _LoopFamily:
             u, v = VL[:, i].conj(), VR[:, i]
             G = np.real(np.outer(u, v) / (u @ v))            # ∂λ/∂A_cl, real part
             nx = lp.A.shape[0]
-            Gxk, Gkx, Gkk = G[:nx, nx:], G[nx:, :nx], G[nx:, nx:]
+            Gxx, Gxk, Gkx, Gkk = G[:nx, :nx], G[:nx, nx:], G[nx:, :nx], G[nx:, nx:]
             dAk = Gkk
             dBk = Gkx @ zx.T + Gkk @ (D22 @ Ck / s).T
             dCk = B2.T @ Gxk + (Bk @ D22 / s).T @ Gkk
+            parts = [dAk.ravel(), dBk.ravel(), dCk.ravel()]
+            if free_d:
+                # Dk enters through 1/s = 1/(1 - Dk D22) and vx = Dk C2 / s
+                g = lp.B2 @ Gxx + (Bk @ D22)[:, 0] @ Gkx                   # ∂λ/∂vx
+                a = float(lp.B2 @ Gxk @ Ck[0] + (Bk @ D22)[:, 0] @ Gkk @ Ck[0])  # ∂λ/∂(1/s)
+                dvx = lp.C2 / s + np.outer(lp.D22, vx[0]) / s           # row j: ∂vx/∂Dk_j
+                parts.append(dvx @ g + a * lp.D22 / s ** 2)
             values.append(float(lam[i].real))
-            grads.append(np.concatenate([dAk.ravel(), dBk.ravel(), dCk.ravel()]))
+            grads.append(np.concatenate(parts))
         return np.array(values), grads
 
     def smoothed(self, p: np.ndarray, tau: float | None) -> tuple[float, np.ndarray]:
@@ -136,15 +159,15 @@ class _LoopFamily:
         return float(a[k] + tau * math.log(total)), sum((wi / total) * gi for wi, gi in zip(w, g))
 
 
-def _polish(system, K: control.StateSpace, speeds, max_iter: int, good: float
-            ) -> tuple[control.StateSpace, float]:
+def _polish(system, K: control.StateSpace, speeds, max_iter: int, good: float,
+            free_feedthrough: bool = False) -> tuple[control.StateSpace, float]:
     """``K`` re-optimised for the worst spectral abscissa over ``speeds``: BFGS on the
     log-sum-exp of decreasing temperature, then on the maximum itself; stops early once the
     worst is below ``good``.  Returns the best controller met and its worst abscissa."""
     Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (K.A, K.B, K.C, K.D))
     n, m = K.nstates, Dk.shape[1]
-    fam = _LoopFamily(system, speeds, n, Dk)
-    p = np.concatenate([Ak.ravel(), Bk.ravel(), Ck.ravel()])
+    fam = _ClosedLoopsAtSpeeds(system, speeds, n, Dk)
+    p = _pack(K, free_feedthrough)
     best = fam.smoothed(p, None)[0]
     for tau in (1.0, 0.3, 0.1, 0.03, 0.01, None):
         if best <= good:
@@ -154,17 +177,18 @@ def _polish(system, K: control.StateSpace, speeds, max_iter: int, good: float
         worst = fam.smoothed(res.x, None)[0]
         if np.all(np.isfinite(res.x)) and worst < best:
             p, best = res.x, worst
-    return control.ss(*_unpack(p, n, m), Dk), float(best)
+    return _controller(p, n, m, Dk), float(best)
 
 
 def _truncation_polished(system, Kr, Dk, speeds, lo: float, hi: float, decay: float,
-                         n_speeds: int, max_iter: int) -> tuple[control.StateSpace, float]:
+                         n_speeds: int, max_iter: int, free_feedthrough: bool = False
+                         ) -> tuple[control.StateSpace, float]:
     """A truncated controller re-optimised over ``speeds`` and checked on a dense scan of
     ``[lo, hi]``; the scan's peaks between those speeds are added to them and the controller
     re-optimised, up to three times.  Returns it and its worst dense abscissa."""
     Kn, grid = control.ss(Kr.A, Kr.B, Kr.C, Dk), speeds
     for _ in range(4):
-        Kn, _ = _polish(system, Kn, grid, max_iter, -6 * decay)
+        Kn, _ = _polish(system, Kn, grid, max_iter, -6 * decay, free_feedthrough)
         dense, values = _dense_abscissae(system, Kn, lo, hi, 8 * n_speeds)
         worst = float(np.max(values))
         if worst <= -decay:
@@ -204,7 +228,8 @@ def _dense_worst(system, K: control.StateSpace, lo: float, hi: float, n: int) ->
 def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
                        anchor: str = "low", decay: float = 0.05, n_speeds: int = 40,
                        first_step: float = 0.05, min_step: float = 0.0025,
-                       max_iter: int = 300, max_rounds: int = 200) -> IntervalReach:
+                       max_iter: int = 300, max_rounds: int = 200,
+                       free_feedthrough: bool = False) -> IntervalReach:
     """Extend the speed interval over which one controller keeps ΣAE(V) decaying.
 
     Parameters
@@ -213,8 +238,8 @@ def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
         Σf and Σs: ΣAE(V) of eq. 8-9 at any speed index.
     controller : control.StateSpace
         The start ``K(s)`` (``v = K zm``, as :meth:`AeroelasticSystem.closed_loop_state_matrix`);
-        its order is kept and its ``D`` is held fixed (0 for a strictly proper controller).
-        It must stabilise ΣAE at the anchor end of the interval.
+        its order is kept, and its ``D`` is held fixed (0 for a strictly proper controller)
+        unless ``free_feedthrough``.  It must stabilise ΣAE at the anchor end of the interval.
     interval : (lo, hi)
         Target speed-index interval, ``0 <= lo < hi``.
     anchor : {"low", "high"}
@@ -229,6 +254,9 @@ def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
         BFGS iterations per temperature of the smoothed maximum (0.3, 0.1, 0.03, exact).
     max_rounds : int
         Continuation steps at most.
+    free_feedthrough : bool
+        Optimise ``D`` with ``(A, B, C)`` (a static path from the sensors to the flap: two
+        more parameters at no cost in order).
 
     Returns
     -------
@@ -279,7 +307,7 @@ def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
                 break
             edge = float(V)
         cur = (lo, edge) if anchor == "low" else (edge, hi)
-        p = np.concatenate([Ak.ravel(), Bk.ravel(), Ck.ravel()])
+        p = _pack(K, free_feedthrough)
         step, history = float(first_step), []
         log.info("interval continuation (%s end, order %d): the start decays on [%.4g, %.4g]",
                  anchor, order, *cur)
@@ -291,7 +319,7 @@ def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
             speeds = np.linspace(*trial, n_speeds)
             q = p
             for _ in range(3):
-                fam = _LoopFamily(system, speeds, order, Dk)
+                fam = _ClosedLoopsAtSpeeds(system, speeds, order, Dk)
                 for tau in (0.3, 0.1, 0.03, None):
                     if fam.smoothed(q, None)[0] <= -2 * decay:
                         break
@@ -305,7 +333,7 @@ def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
                 if not ok:
                     break
                 # the dense scan decides; a peak between the objective's speeds joins them
-                scan, values = _dense_abscissae(system, control.ss(*_unpack(q, order, m), Dk),
+                scan, values = _dense_abscissae(system, _controller(q, order, m, Dk),
                                                 *trial, dense)
                 ok = float(np.max(values)) <= -decay
                 if ok:
@@ -318,7 +346,7 @@ def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
                 p, cur, step = q, trial, 1.5 * step
             else:
                 step *= 0.5
-        Kout = control.ss(*_unpack(p, order, m), Dk) if rounds else K
+        Kout = _controller(p, order, m, Dk) if rounds else K
         worst = _dense_worst(system, Kout, *cur, dense)
     return IntervalReach(Kout, cur, (lo, hi), anchor, worst, tuple(history), cur == (lo, hi))
 
@@ -422,7 +450,8 @@ class OrderReduction:
 
 
 def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
-                 n_speeds: int = 48, max_iter: int = 600) -> OrderReduction:
+                 n_speeds: int = 48, max_iter: int = 600,
+                 free_feedthrough: bool = False) -> OrderReduction:
     """Lower the order of a controller that keeps ΣAE(V) decaying over a speed interval.
 
     At each order of ``orders`` the previous controller is truncated
@@ -443,7 +472,7 @@ def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
         :class:`~casflutter.aeroelastic.TruthLoop` or anything with ``loop(V)`` and
         ``closed_loop_state_matrix(V, K)``.
     controller : control.StateSpace
-        The start, which should hold the interval (``v = K zm``, its ``D`` kept).
+        The start, which should hold the interval (``v = K zm``).
     interval : (lo, hi)
         Speed-index interval, ``0 <= lo < hi``.
     orders : sequence of int
@@ -454,6 +483,9 @@ def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
         Speeds of the objective (>= 2).
     max_iter : int
         BFGS iterations per temperature of the smoothed maximum.
+    free_feedthrough : bool
+        Optimise the controller's ``D`` as well (see :func:`stabilize_interval`); otherwise
+        the start's ``D`` is kept.
 
     Returns
     -------
@@ -500,7 +532,7 @@ def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
                 log.info("order reduction: order %d not reached (%s)", n, exc)
                 break
             Kn, worst = _truncation_polished(system, Kr, K.D, speeds, lo, hi, decay,
-                                             n_speeds, max_iter)
+                                             n_speeds, max_iter, free_feedthrough)
             p = K.nstates
             if worst > -decay and p - n > 1:
                 # a smaller step first: the order half-way
@@ -512,7 +544,8 @@ def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
             if worst > -decay and _dense_worst(system, Kn, lo, lo, 1) < 0:
                 reach = stabilize_interval(system, Kn, (lo, hi), anchor="low", decay=decay,
                                            n_speeds=n_speeds, first_step=0.01,
-                                           min_step=0.001, max_iter=max_iter)
+                                           min_step=0.001, max_iter=max_iter,
+                                           free_feedthrough=free_feedthrough)
                 continued = True
                 if reach.met:
                     Kn, worst = reach.controller, reach.worst_abscissa
@@ -557,15 +590,19 @@ class IntervalDesign:
 
 def design_interval_controller(system, interval, order: int, *,
                                orders: tuple = (20, 14, 10, 8), decay: float = 0.05,
-                               n_speeds: int = 40) -> IntervalDesign:
+                               n_speeds: int = 40,
+                               free_feedthrough: bool = False) -> IntervalDesign:
     """A fixed-order controller that keeps ΣAE(V) decaying over a whole speed interval.
 
     Stability over the interval first, the order second: a full-order LQG controller of the
     loop at the interval's top (:func:`full_order_start`) is continued down to its bottom
     (:func:`stabilize_interval`, anchor ``"high"``), then its order is lowered through
     ``orders`` to ``order`` (:func:`reduce_order`).  The paper's design goes the other way
-    (γ at Vf, then as far as the order allows); on the seed wing it stops near 1.5 Vf, where
-    this one holds 2.2 Vf.  γ is not optimised: the verification layer measures it.
+    (γ at Vf, then as far as the order allows).  On the seed wing's scaled ROM with the servo
+    (``problems/seed_wing/interval.toml``) that route stops at 1.43 Vf; this one holds
+    (0, 2.22 Vf) at order 4 on the ROM loop and the wing itself to 2.19 Vf (continued on the
+    wing, the same controller holds it to 2.23 Vf).  γ is not optimised: the verification
+    layer measures it.
 
     Parameters
     ----------
@@ -584,6 +621,8 @@ def design_interval_controller(system, interval, order: int, *,
         Decay rate (rad/s) required at every speed of the interval.
     n_speeds : int
         Speeds of the continuations' objective.
+    free_feedthrough : bool
+        Optimise the controller's ``D`` as well (see :func:`stabilize_interval`).
 
     Returns
     -------
@@ -605,7 +644,7 @@ def design_interval_controller(system, interval, order: int, *,
         raise ConfigError(f"order = {order!r}: an integer >= 1 (a dynamic controller)")
     start = full_order_start(system, hi)
     full = stabilize_interval(system, start, (lo, hi), anchor="high", decay=decay,
-                              n_speeds=n_speeds)
+                              n_speeds=n_speeds, free_feedthrough=free_feedthrough)
     n = full.controller.nstates
     log.info("interval design: full order %d holds [%.4g, %.4g] (target [%.4g, %.4g])", n,
              *full.reached, lo, hi)
@@ -614,7 +653,8 @@ def design_interval_controller(system, interval, order: int, *,
     if order >= n:
         return IntervalDesign(full.controller, int(order), full, None, True)
     seq = [int(o) for o in sorted(set(orders), reverse=True) if order < o < n] + [int(order)]
-    red = reduce_order(system, full.controller, (lo, hi), seq, decay=decay)
+    red = reduce_order(system, full.controller, (lo, hi), seq, decay=decay,
+                       free_feedthrough=free_feedthrough)
     low = red.lowest
     K = full.controller if low is None else low.controller
     return IntervalDesign(K, int(order), full, red, bool(low is not None and low.order == order))

@@ -396,6 +396,19 @@ class RunResult:
         return self.verification.exact_V if self.verification.stable else None
 
     @property
+    def controlled_rom(self):
+        """The ROM loop family that the controller closes and :attr:`rom_stable_V` judges:
+        ΣAE(V) itself (eq. 8), or for a ROM whose time scales with V, ΣAE(V) with the flap
+        behind the servo of ``controller.flap_rate_bandwidth``
+        (:meth:`~casflutter.aeroelastic.AeroelasticSystem.with_servo`).  ``None`` without a
+        ROM loop."""
+        if self.system is None:
+            return None
+        if self.convective_V0 is not None and self.controller is not None:
+            return self.system.with_servo(self.config.controller.flap_rate_bandwidth)
+        return self.system
+
+    @property
     def interval_ok(self) -> bool | None:
         """The verified exact stable interval (:attr:`rom_stable_V`) contains
         :attr:`required_V` (``None`` without a target or a verification)."""

@@ -230,14 +230,21 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
 def plot_pole_loci(system, V_grid, controller=None, *, ax=None) -> Figure:
     """Pole loci of ΣAE over V, open loop and (optionally) closed with ``v = K zm`` (Fig. 10).
 
+    The closed-loop poles are coloured by V (colour bar), so the speed at which a branch
+    crosses into the right half-plane can be read off.
+
     Parameters
     ----------
-    system : AeroelasticSystem
-        Provides ``state_matrix(V)`` and ``closed_loop_state_matrix(V, K)``.
+    system : AeroelasticSystem, ServoSystem or TruthLoop
+        Provides ``state_matrix(V)`` and ``closed_loop_state_matrix(V, K)``; for a controller
+        designed with the flap behind a servo, pass the family with the servo
+        (:meth:`~casflutter.aeroelastic.AeroelasticSystem.with_servo`).
     V_grid : array_like
         Speed indices.
     controller : control.StateSpace, optional
         Continuous controller K (sensors -> flap).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into; a new figure otherwise.
     """
     V_grid = np.asarray(V_grid, dtype=float)
     if ax is None:
@@ -247,9 +254,11 @@ def plot_pole_loci(system, V_grid, controller=None, *, ax=None) -> Figure:
     ax.scatter(ol.real.ravel(), ol.imag.ravel(), s=8, marker="x", color="tab:red", label="open loop")
     if controller is not None:
         cl = [np.linalg.eigvals(system.closed_loop_state_matrix(V, controller)) for V in V_grid]
+        speed = np.concatenate([np.full(len(p), V) for p, V in zip(cl, V_grid)])
         cl = np.concatenate(cl)
-        ax.scatter(cl.real, cl.imag, s=8, marker="o", facecolors="none", edgecolors="tab:blue",
-                   label="closed loop")
+        pts = ax.scatter(cl.real, cl.imag, s=10, marker="o", c=speed, cmap="viridis",
+                         label="closed loop")
+        fig.colorbar(pts, ax=ax, label="V (closed loop)")
     ax.axvline(0.0, color="k", lw=0.8)
     ax.set_xlabel("Re λ [1/s]")
     ax.set_ylabel("Im λ [rad/s]")

@@ -42,6 +42,9 @@ def test_figures_are_built():
                                control.ss([], [], [], -0.5 * np.ones((1, sysae.structure.n_sensors))))):
         assert isinstance(fig, Figure) and fig.axes
     assert "Vf" in fig_title(plot_vg_vf(res))
+    # the closed-loop poles are coloured by speed: a colour bar over the grid's range
+    bar = fig.axes[1]
+    assert bar.get_ylabel() == "V (closed loop)" and bar.get_ylim() == (0.0, 3.0)
 
 
 def fig_title(fig):

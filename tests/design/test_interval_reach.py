@@ -89,3 +89,35 @@ def test_continuation_on_the_truth_loop_is_certified_on_the_truth():
     cert = speed_family_interval(lambda V: fam.loop(V).flap_to_sensors(), reach.controller,
                                  0.5 * (lo + hi))
     assert cert.lower <= lo and cert.upper >= hi
+
+
+def test_the_feedthrough_gradient_is_the_finite_difference_one():
+    """``free_feedthrough``: the eigenvalue gradient with respect to ``Dk`` (through the
+    algebraic loop ``1/(1 - Dk D22)`` of the accelerometers) against central differences."""
+    from casflutter.design._interval import _ClosedLoopsAtSpeeds, _pack
+
+    system, Vf = seed_wing_loop()
+    assert np.any(system.loop(Vf).D22 != 0)        # the algebraic loop is exercised
+    rng = np.random.default_rng(3)
+    K = control.ss(rng.normal(size=(3, 3)) - 3 * np.eye(3), rng.normal(size=(3, 2)),
+                   rng.normal(size=(1, 3)), 0.05 * rng.normal(size=(1, 2)))
+    loops = _ClosedLoopsAtSpeeds(system, [0.5 * Vf, Vf], 3, np.asarray(K.D))
+    p = _pack(K, True)
+    _, grads = loops.rightmost(p)
+    h = 1e-6
+    for k in range(2):
+        fd = np.array([(loops.rightmost(p + h * e)[0][k] - loops.rightmost(p - h * e)[0][k])
+                       / (2 * h) for e in np.eye(len(p))])
+        # relative to the largest entry; the last two are ∂/∂Dk
+        assert np.max(np.abs(fd - grads[k])) < 1e-6 * np.max(np.abs(fd))
+        assert np.all(np.abs(fd[-2:]) > 0)
+
+
+def test_a_free_feedthrough_is_optimised_and_certified():
+    system, Vf = seed_wing_loop()
+    hi, lo = 2.4, 2.15
+    reach = stabilize_interval(system, full_order_start(system, hi), (lo, hi), anchor="high",
+                               n_speeds=20, free_feedthrough=True)
+    assert reach.met and np.any(np.asarray(reach.controller.D) != 0)   # the start has D = 0
+    ver = _exact(system, hi, reach.controller)
+    assert ver.stable and ver.exact_V[0] <= lo and ver.exact_V[1] >= hi

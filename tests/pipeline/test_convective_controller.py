@@ -35,8 +35,12 @@ def test_the_rom_interval_is_the_wings(result):
 
 
 def test_the_interval_is_the_scaled_loops_with_the_servo(result):
+    """``controlled_rom`` (the family Fig. 10 draws) is the loop the certificate is about."""
     K, upper = result.controller, result.rom_interval.upper
-    family = result.system.with_servo(result.config.controller.flap_rate_bandwidth)
+    family = result.controlled_rom
+    assert family.servo_omega == result.config.controller.flap_rate_bandwidth
+    # the flap's position and rate are two more states than ΣAE(V)
+    assert family.state_matrix(1.0).shape[0] == result.system.state_matrix(1.0).shape[0] + 2
     for V in np.linspace(0.05, 0.995 * upper, 12):
         assert np.max(np.linalg.eigvals(family.closed_loop_state_matrix(V, K)).real) < 0, V
     assert np.max(np.linalg.eigvals(family.closed_loop_state_matrix(1.01 * upper, K)).real) > 0

@@ -4,7 +4,9 @@
 minimal order 20) found by continuation on the truth's own linearisation with the flap behind
 its 40 Hz servo (:class:`casflutter.aeroelastic.TruthLoop`);
 ``truth_interval_controller_order8.json`` and ``..._order7.json`` are order-8 and order-7
-controllers reduced from it, the lowest orders found (see each file's ``about``).  Whether they hold the wing is not taken from the optimiser: the
+controllers reduced from it; ``..._order4.json``, the lowest order found, is the order-4 result
+of ``problems/seed_wing/interval.toml`` (designed on the scaled ROM loop) continued on the wing
+(see each file's ``about``).  Whether they hold the wing is not taken from the optimiser: the
 verification layer certifies the exact stable interval (polynomial guardian map, the loop
 closed by python-control), and a dense eigenvalue scan computed here agrees.
 """
@@ -22,7 +24,8 @@ from casflutter.verify import load_controller, speed_family_interval
 
 SERVO = 251.3     # rad/s, the seed wing's 40 Hz servo (run.toml: controller.flap_rate_bandwidth)
 WITNESSES = {"truth_interval_controller.json": 32, "truth_interval_controller_order8.json": 8,
-             "truth_interval_controller_order7.json": 7}
+             "truth_interval_controller_order7.json": 7,
+             "truth_interval_controller_order4.json": 4}
 
 
 @pytest.fixture(scope="module")
@@ -53,10 +56,10 @@ def test_a_dense_scan_agrees(plant, witness):
     assert np.max(plant(2.4).poles().real) > 0
 
 
-def test_the_best_order_3_controller_found_holds_the_wing_to_2_22(plant):
+def test_the_best_order_3_controller_found_holds_the_wing_to_2_26(plant):
     """The figure the documentation quotes for order 3 (the paper's order): certified, and
     short of the paper's 2.4."""
     K = load_controller(problems_dir() / "seed_wing" / "truth_best_order3_controller.json")
     assert K.nstates == 3
     cert = speed_family_interval(plant, K, 1.2)
-    assert cert.lower == 0.0 and 2.22 < cert.upper < 2.4
+    assert cert.lower == 0.0 and 2.259 < cert.upper < 2.4
