@@ -139,14 +139,15 @@ class _ClosedLoopsAtSpeeds:
     with respect to ``(Ak, Bk, Ck)``, and ``Dk`` when the parameters include it (otherwise
     ``Dk`` is held at the given value)."""
 
-    def __init__(self, models: _Models, speeds, order: int, Dk: np.ndarray):
+    def __init__(self, models, speeds, order: int, Dk: np.ndarray):
         self.order, self.Dk = order, Dk
+        models = _Models.of(models)
         self.loops = [lp for V in speeds for lp in models.loops(V)]
         self.m = models.n_sensors
 
     def rightmost(self, p: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
         Ak, Bk, Ck, Dk = _unpack(p, self.order, self.m, self.Dk)
-        free_d = Dk is not self.Dk
+        free_d = p.size > self.order * (self.order + self.m + 1)    # Dk among the parameters
         values, grads = [], []
         for lp in self.loops:
             s = 1.0 - float((Dk @ lp.D22)[0])
@@ -252,7 +253,7 @@ def _dense_worst(system, K: control.StateSpace, lo: float, hi: float, n: int) ->
     return float(np.max(_dense_abscissae(system, K, lo, hi, n)[1]))
 
 
-def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
+def stabilize_interval(system, controller, interval, *,
                        anchor: str = "low", decay: float = 0.05, n_speeds: int = 40,
                        first_step: float = 0.05, min_step: float = 0.0025,
                        max_iter: int = 300, max_rounds: int = 200,
