@@ -106,20 +106,48 @@ def _controller(p: np.ndarray, n: int, m: int, Dk: np.ndarray) -> control.StateS
     return control.ss(*_unpack(p, n, m, Dk))
 
 
+class _Models:
+    """One loop family, or several that one controller must hold together (the worst of
+    them at every speed): a ROM and the models around it."""
+
+    def __init__(self, system):
+        fams = tuple(system) if isinstance(system, (list, tuple)) else (system,)
+        if not fams or not all(callable(getattr(f, "loop", None)) and
+                               callable(getattr(f, "closed_loop_state_matrix", None))
+                               for f in fams):
+            raise ConfigError("system must be a loop family (loop(V), "
+                              "closed_loop_state_matrix(V, K)) or a non-empty sequence of them")
+        m = {f.loop(1.0).C2.shape[0] for f in fams}
+        if len(m) > 1:
+            raise DimensionError(f"the families have different numbers of sensors {sorted(m)}; "
+                                 "one controller needs the same sensors on every model")
+        self.families, self.n_sensors = fams, m.pop()
+
+    @classmethod
+    def of(cls, system) -> "_Models":
+        return system if isinstance(system, cls) else cls(system)
+
+    def loops(self, V: float) -> list:
+        return [f.loop(float(V)) for f in self.families]
+
+    def closed_loop_state_matrices(self, V: float, K) -> list:
+        return [f.closed_loop_state_matrix(float(V), K) for f in self.families]
+
+
 class _ClosedLoopsAtSpeeds:
     """ΣAE(V_j) at a set of speeds and the closed loop's rightmost eigenvalue and its gradient
     with respect to ``(Ak, Bk, Ck)``, and ``Dk`` when the parameters include it (otherwise
     ``Dk`` is held at the given value)."""
 
-    def __init__(self, system: AeroelasticSystem, speeds, order: int, Dk: np.ndarray):
+    def __init__(self, models, speeds, order: int, Dk: np.ndarray):
         self.order, self.Dk = order, Dk
-        self.loops = [system.loop(float(V)) for V in speeds]
-        m = self.loops[0].C2.shape[0]
-        self.m = m
+        models = _Models.of(models)
+        self.loops = [lp for V in speeds for lp in models.loops(V)]
+        self.m = models.n_sensors
 
     def rightmost(self, p: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
         Ak, Bk, Ck, Dk = _unpack(p, self.order, self.m, self.Dk)
-        free_d = Dk is not self.Dk
+        free_d = p.size > self.order * (self.order + self.m + 1)    # Dk among the parameters
         values, grads = [], []
         for lp in self.loops:
             s = 1.0 - float((Dk @ lp.D22)[0])
@@ -205,19 +233,19 @@ def _peaks(values: np.ndarray, decay: float, most: int = 8) -> list[int]:
     return sorted(peaks, key=lambda j: -values[j])[:most]
 
 
-def _dense_abscissae(system, K: control.StateSpace, lo: float, hi: float, n: int
+def _dense_abscissae(models: _Models, K: control.StateSpace, lo: float, hi: float, n: int
                      ) -> tuple[np.ndarray, np.ndarray]:
     """The speeds of a dense scan of ``[lo, hi]`` and the closed loop's spectral abscissa
-    at each (``inf`` where the loop is algebraically singular)."""
+    at each, the worst over the models (``inf`` where a loop is algebraically singular)."""
     grid = np.linspace(lo, hi, n)
     values = np.empty(n)
     for j, V in enumerate(grid):
         try:
-            A = system.closed_loop_state_matrix(float(V), K)
+            mats = models.closed_loop_state_matrices(V, K)
         except DimensionError:                 # a singular algebraic loop
             values[j] = np.inf
             continue
-        values[j] = float(np.max(np.linalg.eigvals(A).real))
+        values[j] = max(float(np.max(np.linalg.eigvals(A).real)) for A in mats)
     return grid, values
 
 
@@ -225,7 +253,7 @@ def _dense_worst(system, K: control.StateSpace, lo: float, hi: float, n: int) ->
     return float(np.max(_dense_abscissae(system, K, lo, hi, n)[1]))
 
 
-def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
+def stabilize_interval(system, controller, interval, *,
                        anchor: str = "low", decay: float = 0.05, n_speeds: int = 40,
                        first_step: float = 0.05, min_step: float = 0.0025,
                        max_iter: int = 300, max_rounds: int = 200,
@@ -234,8 +262,14 @@ def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
 
     Parameters
     ----------
-    system : AeroelasticSystem
-        Σf and Σs: ΣAE(V) of eq. 8-9 at any speed index.
+    system : LoopFamily or sequence of LoopFamily
+        ΣAE(V) of eq. 8-9 at any speed index (a
+        :class:`~casflutter.aeroelastic.LoopFamily`: an
+        :class:`~casflutter.aeroelastic.AeroelasticSystem`, a
+        :class:`~casflutter.aeroelastic.ServoSystem`, a
+        :class:`~casflutter.aeroelastic.TruthLoop`, ...); several families (same sensors) ask
+        one controller to hold all of them: the objective and the dense check take the worst
+        closed-loop abscissa over them at every speed.
     controller : control.StateSpace
         The start ``K(s)`` (``v = K zm``, as :meth:`AeroelasticSystem.closed_loop_state_matrix`);
         its order is kept, and its ``D`` is held fixed (0 for a strictly proper controller)
@@ -287,7 +321,8 @@ def stabilize_interval(system: AeroelasticSystem, controller, interval, *,
     K = control.ss(controller)
     Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (K.A, K.B, K.C, K.D))
     order = K.nstates
-    m = system.loop(lo).C2.shape[0]
+    system = _Models.of(system)
+    m = system.n_sensors
     if Dk.shape != (1, m) or order == 0:
         raise DimensionError(f"need a dynamic controller with {m} inputs (the sensors) and 1 "
                              f"output (the flap); got order {order}, D of shape {Dk.shape}")
@@ -467,10 +502,9 @@ def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
 
     Parameters
     ----------
-    system
-        The loop family: an :class:`~casflutter.aeroelastic.AeroelasticSystem`, a
-        :class:`~casflutter.aeroelastic.TruthLoop` or anything with ``loop(V)`` and
-        ``closed_loop_state_matrix(V, K)``.
+    system : LoopFamily or sequence of LoopFamily
+        The loop family, or several that the controller must hold together (as
+        :func:`stabilize_interval`).
     controller : control.StateSpace
         The start, which should hold the interval (``v = K zm``).
     interval : (lo, hi)
@@ -516,7 +550,8 @@ def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
     if not (decay >= 0 and n_speeds >= 2 and max_iter >= 1):
         raise ConfigError(f"need decay >= 0, n_speeds >= 2, max_iter >= 1; got "
                           f"decay={decay!r}, n_speeds={n_speeds!r}, max_iter={max_iter!r}")
-    m = system.loop(lo).C2.shape[0]
+    system = _Models.of(system)
+    m = system.n_sensors
     if np.atleast_2d(np.asarray(K.D)).shape != (1, m):
         raise DimensionError(f"need a controller with {m} inputs (the sensors) and 1 output "
                              f"(the flap); got D of shape {np.shape(K.D)}")
@@ -606,10 +641,9 @@ def design_interval_controller(system, interval, order: int, *,
 
     Parameters
     ----------
-    system
-        The loop family (an :class:`~casflutter.aeroelastic.AeroelasticSystem`, a
-        :class:`~casflutter.aeroelastic.ServoSystem`, a
-        :class:`~casflutter.aeroelastic.TruthLoop`, ...).
+    system : LoopFamily or sequence of LoopFamily
+        The loop family, or several that the controller must hold together (as
+        :func:`stabilize_interval`); the full-order start is the first one's.
     interval : (lo, hi)
         Speed-index interval, ``0 <= lo < hi``.
     order : int
@@ -642,8 +676,9 @@ def design_interval_controller(system, interval, order: int, *,
         raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
     if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order < 1:
         raise ConfigError(f"order = {order!r}: an integer >= 1 (a dynamic controller)")
-    start = full_order_start(system, hi)
-    full = stabilize_interval(system, start, (lo, hi), anchor="high", decay=decay,
+    models = _Models.of(system)
+    start = full_order_start(models.families[0], hi)
+    full = stabilize_interval(models, start, (lo, hi), anchor="high", decay=decay,
                               n_speeds=n_speeds, free_feedthrough=free_feedthrough)
     n = full.controller.nstates
     log.info("interval design: full order %d holds [%.4g, %.4g] (target [%.4g, %.4g])", n,
@@ -653,7 +688,7 @@ def design_interval_controller(system, interval, order: int, *,
     if order >= n:
         return IntervalDesign(full.controller, int(order), full, None, True)
     seq = [int(o) for o in sorted(set(orders), reverse=True) if order < o < n] + [int(order)]
-    red = reduce_order(system, full.controller, (lo, hi), seq, decay=decay,
+    red = reduce_order(models, full.controller, (lo, hi), seq, decay=decay,
                        free_feedthrough=free_feedthrough)
     low = red.lowest
     K = full.controller if low is None else low.controller

@@ -121,3 +121,42 @@ def test_a_free_feedthrough_is_optimised_and_certified():
     assert reach.met and np.any(np.asarray(reach.controller.D) != 0)   # the start has D = 0
     ver = _exact(system, hi, reach.controller)
     assert ver.stable and ver.exact_V[0] <= lo and ver.exact_V[1] >= hi
+
+
+def test_one_controller_for_several_models():
+    """A sequence of loop families: the continuation holds the worst of them.  Here the ROM
+    loop and the same loop with the flap behind a 40 Hz servo; each result is certified on
+    both by the verification layer."""
+    from casflutter.verify import speed_family_interval
+
+    system, _ = seed_wing_loop()
+    servo = system.with_servo(251.3)
+    hi, lo = 2.4, 2.15
+    reach = stabilize_interval([system, servo], full_order_start(system, hi), (lo, hi),
+                               anchor="high", n_speeds=20)
+    assert reach.met
+    ver = _exact(system, hi, reach.controller)
+    assert ver.stable and ver.exact_V[0] <= lo and ver.exact_V[1] >= hi
+    cert = speed_family_interval(lambda V: servo.loop(V).flap_to_sensors(), reach.controller, hi)
+    assert cert.lower <= lo and cert.upper >= hi
+
+
+def test_models_with_other_sensors_are_refused():
+    from dataclasses import replace
+
+    from casflutter.aeroelastic import LoopFamily
+    from casflutter.errors import DimensionError
+
+    system, _ = seed_wing_loop()
+
+    class ThreeSensors(LoopFamily):          # the first accelerometer twice
+        def loop(self, V):
+            lp = system.loop(V)
+            return replace(lp, C2=np.vstack([lp.C2, lp.C2[:1]]),
+                           D21=np.vstack([lp.D21, lp.D21[:1]]), D22=np.r_[lp.D22, lp.D22[:1]])
+
+    K = full_order_start(system, 2.4)
+    with pytest.raises(DimensionError, match="different numbers of sensors"):
+        stabilize_interval([system, ThreeSensors()], K, (2.15, 2.4), anchor="high")
+    with pytest.raises(ConfigError, match="loop family"):
+        stabilize_interval([], K, (2.15, 2.4), anchor="high")
