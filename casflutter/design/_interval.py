@@ -187,6 +187,23 @@ class _ClosedLoopsAtSpeeds:
         return float(a[k] + tau * math.log(total)), sum((wi / total) * gi for wi, gi in zip(w, g))
 
 
+def _minimise_worst(fam: _ClosedLoopsAtSpeeds, p: np.ndarray, taus, good: float,
+                    max_iter: int) -> tuple[np.ndarray, float]:
+    """BFGS on the smoothed worst abscissa at each temperature of ``taus`` in turn (``None``:
+    the maximum itself), keeping a result only when it lowers the worst; stops once the worst
+    is at most ``good``.  Returns the parameters and their worst abscissa."""
+    best = fam.smoothed(p, None)[0]
+    for tau in taus:
+        if best <= good:
+            break
+        res = minimize(fam.smoothed, p, args=(tau,), jac=True, method="BFGS",
+                       options={"maxiter": int(max_iter)})
+        worst = fam.smoothed(res.x, None)[0]
+        if np.all(np.isfinite(res.x)) and worst < best:
+            p, best = res.x, worst
+    return p, float(best)
+
+
 def _polish(system, K: control.StateSpace, speeds, max_iter: int, good: float,
             free_feedthrough: bool = False) -> tuple[control.StateSpace, float]:
     """``K`` re-optimised for the worst spectral abscissa over ``speeds``: BFGS on the
@@ -195,16 +212,8 @@ def _polish(system, K: control.StateSpace, speeds, max_iter: int, good: float,
     Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (K.A, K.B, K.C, K.D))
     n, m = K.nstates, Dk.shape[1]
     fam = _ClosedLoopsAtSpeeds(system, speeds, n, Dk)
-    p = _pack(K, free_feedthrough)
-    best = fam.smoothed(p, None)[0]
-    for tau in (1.0, 0.3, 0.1, 0.03, 0.01, None):
-        if best <= good:
-            break
-        res = minimize(fam.smoothed, p, args=(tau,), jac=True, method="BFGS",
-                       options={"maxiter": int(max_iter)})
-        worst = fam.smoothed(res.x, None)[0]
-        if np.all(np.isfinite(res.x)) and worst < best:
-            p, best = res.x, worst
+    taus = (1.0, 0.3, 0.1, 0.03, 0.01, None)
+    p, best = _minimise_worst(fam, _pack(K, free_feedthrough), taus, good, max_iter)
     return _controller(p, n, m, Dk), float(best)
 
 
@@ -355,15 +364,8 @@ def stabilize_interval(system, controller, interval, *,
             q = p
             for _ in range(3):
                 fam = _ClosedLoopsAtSpeeds(system, speeds, order, Dk)
-                for tau in (0.3, 0.1, 0.03, None):
-                    if fam.smoothed(q, None)[0] <= -2 * decay:
-                        break
-                    res = minimize(fam.smoothed, q, args=(tau,), jac=True, method="BFGS",
-                                   options={"maxiter": int(max_iter)})
-                    if np.all(np.isfinite(res.x)) and \
-                            fam.smoothed(res.x, None)[0] < fam.smoothed(q, None)[0]:
-                        q = res.x
-                worst = fam.smoothed(q, None)[0]
+                q, worst = _minimise_worst(fam, q, (0.3, 0.1, 0.03, None), -2 * decay,
+                                           max_iter)
                 ok = worst <= -decay
                 if not ok:
                     break
