@@ -145,42 +145,63 @@ class _ClosedLoopsAtSpeeds:
         self.loops = [lp for V in speeds for lp in models.loops(V)]
         self.m = models.n_sensors
 
-    def rightmost(self, p: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
+    def _closed_loop(self, lp, Ak, Bk, Ck, Dk):
+        """A_cl of one loop and the pieces its gradient needs."""
+        s = 1.0 - float((Dk @ lp.D22)[0])
+        B2 = lp.B2[:, None] / s
+        vx = (Dk @ lp.C2) / s
+        zx = lp.C2 + lp.D22[:, None] @ vx
+        D22 = lp.D22[:, None]
+        Acl = np.block([[lp.A + lp.B2[:, None] @ vx, B2 @ Ck],
+                        [Bk @ zx, Ak + Bk @ D22 @ Ck / s]])
+        return Acl, (s, B2, vx, zx, D22)
+
+    def abscissae(self, p: np.ndarray) -> np.ndarray:
+        """The closed loop's spectral abscissa at every speed (eigenvalues only)."""
+        Ak, Bk, Ck, Dk = _unpack(p, self.order, self.m, self.Dk)
+        return np.array([float(np.max(np.linalg.eigvals(
+            self._closed_loop(lp, Ak, Bk, Ck, Dk)[0]).real)) for lp in self.loops])
+
+    def gradient(self, p: np.ndarray, j: int) -> tuple[float, np.ndarray]:
+        """The rightmost eigenvalue's real part of loop ``j`` and its gradient."""
         Ak, Bk, Ck, Dk = _unpack(p, self.order, self.m, self.Dk)
         free_d = p.size > self.order * (self.order + self.m + 1)    # Dk among the parameters
-        values, grads = [], []
-        for lp in self.loops:
-            s = 1.0 - float((Dk @ lp.D22)[0])
-            B2 = lp.B2[:, None] / s
-            vx = (Dk @ lp.C2) / s
-            zx = lp.C2 + lp.D22[:, None] @ vx
-            D22 = lp.D22[:, None]
-            Acl = np.block([[lp.A + lp.B2[:, None] @ vx, B2 @ Ck],
-                            [Bk @ zx, Ak + Bk @ D22 @ Ck / s]])
-            lam, VL, VR = scipy.linalg.eig(Acl, left=True, right=True)
-            i = int(np.argmax(lam.real))
-            u, v = VL[:, i].conj(), VR[:, i]
-            G = np.real(np.outer(u, v) / (u @ v))            # ∂λ/∂A_cl, real part
-            nx = lp.A.shape[0]
-            Gxx, Gxk, Gkx, Gkk = G[:nx, :nx], G[:nx, nx:], G[nx:, :nx], G[nx:, nx:]
-            dAk = Gkk
-            dBk = Gkx @ zx.T + Gkk @ (D22 @ Ck / s).T
-            dCk = B2.T @ Gxk + (Bk @ D22 / s).T @ Gkk
-            parts = [dAk.ravel(), dBk.ravel(), dCk.ravel()]
-            if free_d:
-                # Dk enters through 1/s = 1/(1 - Dk D22) and vx = Dk C2 / s
-                g = lp.B2 @ Gxx + (Bk @ D22)[:, 0] @ Gkx                   # ∂λ/∂vx
-                a = float(lp.B2 @ Gxk @ Ck[0] + (Bk @ D22)[:, 0] @ Gkk @ Ck[0])  # ∂λ/∂(1/s)
-                dvx = lp.C2 / s + np.outer(lp.D22, vx[0]) / s           # row j: ∂vx/∂Dk_j
-                parts.append(dvx @ g + a * lp.D22 / s ** 2)
-            values.append(float(lam[i].real))
-            grads.append(np.concatenate(parts))
-        return np.array(values), grads
+        lp = self.loops[j]
+        Acl, (s, B2, vx, zx, D22) = self._closed_loop(lp, Ak, Bk, Ck, Dk)
+        lam, VL, VR = scipy.linalg.eig(Acl, left=True, right=True)
+        i = int(np.argmax(lam.real))
+        u, v = VL[:, i].conj(), VR[:, i]
+        G = np.real(np.outer(u, v) / (u @ v))            # ∂λ/∂A_cl, real part
+        nx = lp.A.shape[0]
+        Gxx, Gxk, Gkx, Gkk = G[:nx, :nx], G[:nx, nx:], G[nx:, :nx], G[nx:, nx:]
+        dAk = Gkk
+        dBk = Gkx @ zx.T + Gkk @ (D22 @ Ck / s).T
+        dCk = B2.T @ Gxk + (Bk @ D22 / s).T @ Gkk
+        parts = [dAk.ravel(), dBk.ravel(), dCk.ravel()]
+        if free_d:
+            # Dk enters through 1/s = 1/(1 - Dk D22) and vx = Dk C2 / s
+            g = lp.B2 @ Gxx + (Bk @ D22)[:, 0] @ Gkx                   # ∂λ/∂vx
+            a = float(lp.B2 @ Gxk @ Ck[0] + (Bk @ D22)[:, 0] @ Gkk @ Ck[0])  # ∂λ/∂(1/s)
+            dvx = lp.C2 / s + np.outer(lp.D22, vx[0]) / s           # row j: ∂vx/∂Dk_j
+            parts.append(dvx @ g + a * lp.D22 / s ** 2)
+        return float(lam[i].real), np.concatenate(parts)
+
+    def rightmost(self, p: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
+        """The rightmost eigenvalue's real part at every speed and its gradient."""
+        pairs = [self.gradient(p, j) for j in range(len(self.loops))]
+        return np.array([a for a, _ in pairs]), [g for _, g in pairs]
 
     def smoothed(self, p: np.ndarray, tau: float | None) -> tuple[float, np.ndarray]:
+        """The worst abscissa, or its log-sum-exp of temperature ``tau``, and the gradient.
+        For the worst itself (``tau = None``) only its loop needs eigenvectors; the others
+        need their eigenvalues alone."""
+        if tau is None:
+            a = self.abscissae(p)
+            k = int(np.argmax(a))
+            return float(a[k]), self.gradient(p, k)[1]
         a, g = self.rightmost(p)
         k = int(np.argmax(a))
-        if tau is None or not np.isfinite(a[k]):
+        if not np.isfinite(a[k]):
             return float(a[k]), g[k]
         w = np.exp((a - a[k]) / tau)
         total = float(np.sum(w))

@@ -235,8 +235,9 @@ def plot_pole_loci(system, V_grid, controller=None, *, ax=None) -> Figure:
 
     Parameters
     ----------
-    system : AeroelasticSystem, ServoSystem or TruthLoop
-        Provides ``state_matrix(V)`` and ``closed_loop_state_matrix(V, K)``; for a controller
+    system : casflutter.aeroelastic.LoopFamily
+        Any loop family (ROM loop, ROM loop behind a servo, the truth's loop): it provides
+        ``state_matrix(V)`` and ``closed_loop_state_matrix(V, K)``. For a controller
         designed with the flap behind a servo, pass the family with the servo
         (:meth:`~casflutter.aeroelastic.AeroelasticSystem.with_servo`).
     V_grid : array_like

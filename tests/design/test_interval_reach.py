@@ -113,6 +113,27 @@ def test_the_feedthrough_gradient_is_the_finite_difference_one():
         assert np.all(np.abs(fd[-2:]) > 0)
 
 
+def test_the_worst_from_eigenvalues_alone_is_the_full_computation():
+    """The objective at ``tau = None`` takes eigenvectors only at the worst speed: its value
+    and gradient are those of the loop whose every eigenvector is computed (``rightmost``),
+    and its value is the largest real part of eigenvalues computed here."""
+    from casflutter.design._interval import _ClosedLoopsAtSpeeds, _pack
+
+    system, Vf = seed_wing_loop()
+    K = full_order_start(system, Vf)
+    speeds = np.linspace(0.3, 2.4, 12)
+    loops = _ClosedLoopsAtSpeeds(system, speeds, K.nstates, np.asarray(K.D))
+    p = _pack(K, False)
+    value, grad = loops.smoothed(p, None)
+    values, grads = loops.rightmost(p)
+    k = int(np.argmax(values))
+    here = max(float(np.max(np.linalg.eigvals(system.closed_loop_state_matrix(V, K)).real))
+               for V in speeds)
+    assert value == pytest.approx(here, abs=1e-9 * max(1.0, abs(here)))
+    assert value == pytest.approx(values[k], abs=1e-9 * max(1.0, abs(here)))
+    np.testing.assert_allclose(grad, grads[k], rtol=1e-8, atol=1e-10 * np.max(np.abs(grads[k])))
+
+
 def test_a_free_feedthrough_is_optimised_and_certified():
     system, Vf = seed_wing_loop()
     hi, lo = 2.4, 2.15
