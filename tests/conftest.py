@@ -10,3 +10,18 @@ import pytest  # noqa: E402
 def _close_figures():
     yield
     plt.close("all")
+
+
+@pytest.fixture(scope="session")
+def seed_wing_sigma_f():
+    """Σf of the linear ROM identified from the seed wing's records at the paper's V0 = 0.69
+    (``flutter.toml``'s records: amplitude 0.002, no coupling delay; common denominator
+    na = 2, nb = 6; ERA at the exact order, Tustin).  Shared by the tests that close it
+    around the wing's controllers."""
+    from casflutter.ident import identify_common_denominator
+    from casflutter.realize import realize
+    from casflutter.truth import RecordSettings, SeedWing, truth_records
+
+    records = RecordSettings(amplitude=0.002, coupling_delay=0)
+    rom = identify_common_denominator(truth_records(SeedWing(), records, V0=0.69), 2, 6)
+    return realize(rom.model).sigma_f

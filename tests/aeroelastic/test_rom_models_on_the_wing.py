@@ -31,7 +31,7 @@ from casflutter.aeroelastic import (AeroelasticSystem, ParametricSystem, TruthLo
 from casflutter.cli.bench.interval import DEFAULT_ROM, load_rom_loop
 from casflutter.errors import ConfigError
 from casflutter.ident import identify_common_denominator
-from casflutter.realize import ParametricROM, realize, speed_nodes
+from casflutter.realize import ParametricROM, speed_nodes
 from casflutter.truth import RecordSettings, SeedWing, truth_records
 from casflutter.verify import load_controller, speed_family_interval
 
@@ -112,11 +112,8 @@ def test_the_parametric_loop_is_the_system_at_that_speed(models):
 
 
 @pytest.fixture(scope="module")
-def convective():
-    truth = SeedWing()
-    rom = identify_common_denominator(
-        truth_records(truth, RecordSettings(amplitude=0.002, coupling_delay=0), V0=V0), 2, 6)
-    sigma_f = realize(rom.model).sigma_f        # ERA at the exact order, Tustin
+def convective(seed_wing_sigma_f):
+    truth, sigma_f = SeedWing(), seed_wing_sigma_f
     return (AeroelasticSystem.from_parts(sigma_f, truth.modal_structure(), convective_V0=V0),
             AeroelasticSystem.from_parts(sigma_f, truth.modal_structure()))
 

@@ -14,9 +14,7 @@ import pytest
 
 from casflutter._resources import problems_dir
 from casflutter.aeroelastic import AeroelasticSystem, TruthLoop
-from casflutter.ident import identify_common_denominator
-from casflutter.realize import realize
-from casflutter.truth import RecordSettings, SeedWing, truth_records
+from casflutter.truth import SeedWing
 from casflutter.verify import load_controller, speed_family_interval
 
 SERVO = 251.3       # rad/s, the seed wing's 40 Hz servo
@@ -24,11 +22,9 @@ V0 = 0.69           # the paper's identification speed (Table I)
 
 
 @pytest.fixture(scope="module")
-def families():
+def families(seed_wing_sigma_f):
     truth = SeedWing()
-    cd = identify_common_denominator(
-        truth_records(truth, RecordSettings(amplitude=0.002, coupling_delay=0), V0=V0), 2, 6)
-    rom = AeroelasticSystem.from_parts(realize(cd.model).sigma_f, truth.modal_structure(),
+    rom = AeroelasticSystem.from_parts(seed_wing_sigma_f, truth.modal_structure(),
                                        convective_V0=V0).with_servo(SERVO)
     return {"rom": rom, "wing": TruthLoop(truth, SERVO)}
 
