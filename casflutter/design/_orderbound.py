@@ -28,6 +28,10 @@ that the minimiser of the smooth function approaches one of the maximum); the re
 *the best local minimum found*, an estimate of the lower bound, not a certificate: it is a
 lower bound on ``γ_k`` only when it is the global minimum.  The spread of the local minima
 over the starts is returned so that this can be judged.
+
+For one static control direction (or measurement combination) at two frequencies the
+relaxation can be solved globally: :func:`static_direction_bound` eliminates everything but
+``(q, qᵀDk)`` in closed form and certifies the bound with an S-procedure multiplier.
 """
 
 from __future__ import annotations
