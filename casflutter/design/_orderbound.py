@@ -188,6 +188,15 @@ class _Relaxation:
         return float(f), g
 
 
+def _partitioned(plant: control.StateSpace | Partition, nmeas: int, ncon: int) -> Partition:
+    """The plant's blocks, checked against ``nmeas`` and ``ncon``."""
+    P = plant if isinstance(plant, Partition) else partition(plant, nmeas, ncon)
+    if P.dims[2:] != (ncon, nmeas):
+        raise DimensionError(f"plant has (ncon, nmeas) = {P.dims[2:]}, expected "
+                             f"{(ncon, nmeas)}")
+    return P
+
+
 def order_relaxation(plant: control.StateSpace | Partition, nmeas: int, ncon: int, order: int,
                      frequencies: Sequence[float] = (0.0,), *, starts: int = 6,
                      seed: int = 0) -> OrderBound:
@@ -232,10 +241,7 @@ def order_relaxation(plant: control.StateSpace | Partition, nmeas: int, ncon: in
     if not freqs or any(not np.isfinite(w) or w < 0 for w in freqs):
         raise ConfigError(f"frequencies must be finite and >= 0 (at least one), got "
                           f"{list(frequencies)!r}")
-    P = plant if isinstance(plant, Partition) else partition(plant, nmeas, ncon)
-    if P.dims[2:] != (ncon, nmeas):
-        raise DimensionError(f"plant has (ncon, nmeas) = {P.dims[2:]}, expected "
-                             f"{(ncon, nmeas)}")
+    P = _partitioned(plant, nmeas, ncon)
     order = int(order)
     rel = _Relaxation(P, order, freqs)
     rng = np.random.default_rng(seed)
@@ -455,10 +461,7 @@ def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, nc
                           f"got {list(frequencies)!r}")
     if not (0.0 < rtol < 0.1):
         raise ConfigError(f"rtol must be in (0, 0.1), got {rtol!r}")
-    P = plant if isinstance(plant, Partition) else partition(plant, nmeas, ncon)
-    if P.dims[2:] != (ncon, nmeas):
-        raise DimensionError(f"plant has (ncon, nmeas) = {P.dims[2:]}, expected "
-                             f"{(ncon, nmeas)}")
+    P = _partitioned(plant, nmeas, ncon)
     Pd = P if side == "control" else _transposed(P)
     forms = [_StaticDirectionForms(Pd, w, side) for w in freqs]
     tol = 100.0 * np.finfo(float).eps * max(f.kappa for f in forms)
