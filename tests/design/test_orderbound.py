@@ -98,7 +98,7 @@ def test_he6_order3_is_held_above_1p5_gamma_star_by_its_static_control_direction
     assert rel.value * (1 - 1e-3) <= ref.gamma <= 1.01 * rel.value
     # the certificate holds below the verified design, which is within 1 % of the
     # certificate's relaxation minimum
-    cert = static_direction_bound(P, nmeas, ncon)
+    cert = static_direction_bound(P, nmeas, ncon, exact=True)
     assert cert.value <= ref.gamma <= 1.01 * cert.estimate
 
 
@@ -170,21 +170,23 @@ def he6():
 
 def test_he6_certificate_rules_out_1p5_gamma_star_below_four_states(he6):
     """Every controller of HE6 with fewer than 4 states has γ >= the certificate, which is
-    above 4 γ* (the issue's 1.5 γ* is unreachable there).  The certificate's relaxation
-    minimum agrees to 0.1 % with the rank relaxation's best local minimum (BFGS over
-    ``K∞, U, V, W``), a different algorithm on a relaxation that contains this one's
-    constraint; the certified value sits below both."""
+    above 4 γ* (the issue's 1.5 γ* is unreachable there), proven in exact arithmetic up to
+    the relaxation's minimum.  That minimum agrees to 0.1 % with the rank relaxation's best
+    local minimum (BFGS over ``K∞, U, V, W``), a different algorithm on a relaxation that
+    contains this one's constraint; the floating-point certificate sits below it."""
     P, p, nmeas, ncon, meta = he6
-    cert = static_direction_bound(P, nmeas, ncon)
-    assert cert.side == "control" and cert.applies_below_order == ncon == 4
+    cert = static_direction_bound(P, nmeas, ncon, exact=True)
+    assert cert.exact and cert.side == "control" and cert.applies_below_order == ncon == 4
     assert cert.value > 4.0 * meta["gamma_full_order_lmi"]
     assert cert.value <= cert.estimate <= cert.upper
-    assert cert.margin > cert.tolerance > 0
+    np.testing.assert_allclose(cert.value, cert.estimate, rtol=1e-5)
     assert cert.value >= max(cert.per_frequency)
+    fl = static_direction_bound(P, nmeas, ncon)
+    assert not fl.exact and fl.margin > fl.tolerance > 0
+    assert 0.98 * fl.estimate <= fl.value <= cert.value
     rel = order_relaxation(P, nmeas, ncon, 3, (0.0,), starts=3, seed=0)
     assert cert.estimate <= rel.value * (1 + 1e-6)
     assert cert.estimate >= rel.value * (1 - 1e-3)
-    assert cert.value >= 0.98 * cert.estimate
 
 
 def test_he6_certificate_holds_for_random_and_optimised_low_order_controllers(he6):
@@ -194,7 +196,7 @@ def test_he6_certificate_holds_for_random_and_optimised_low_order_controllers(he
     locally for exactly that quantity.  (That the bound is nearly reached at order 3 is the
     slow test above: the verified order-3 design is within 1 % of the relaxation's minimum.)"""
     P, p, nmeas, ncon, meta = he6
-    cert = static_direction_bound(P, nmeas, ncon)
+    cert = static_direction_bound(P, nmeas, ncon, exact=True)
     rng = np.random.default_rng(0)
     for i in range(120):
         k = i % 4
@@ -277,9 +279,34 @@ def test_certificate_below_the_static_design_of_ac4_and_checks_its_inputs():
         static_direction_bound(P, nmeas, ncon, frequencies=(1.0, 1.0))
     with pytest.raises(ConfigError, match="two distinct"):
         static_direction_bound(P, nmeas, ncon, frequencies=(0.0,))
+    with pytest.raises(ConfigError, match="exact"):
+        static_direction_bound(P, nmeas, ncon, frequencies=(0.0, 1.0), exact=True)
     with pytest.raises(ConfigError, match="P21ᵀ .* rank"):     # AC15: D21ᵀ lacks rank at ω = ∞
         Q, m, c, _ = load_compleib(ROOT / "problems" / "compleib" / "AC15.json")
         static_direction_bound(Q, m, c, side="measurement")
     with pytest.raises(ConfigError, match="pole"):     # AC2: an integrator at ω = 0
         Q, m, c, _ = load_compleib(ROOT / "problems" / "compleib" / "AC2.json")
         static_direction_bound(Q, m, c)
+
+
+def test_exact_arithmetic_agrees_with_floating_point_where_it_is_clear():
+    """The exact helpers behind ``exact=True``: a solve matches numpy's to rounding, and
+    positive definiteness matches the sign of the smallest eigenvalue wherever it is not
+    within rounding of zero (random symmetric matrices, half of them indefinite)."""
+    from fractions import Fraction
+
+    from casflutter.design import _exact
+    rng = np.random.default_rng(4)
+    A = rng.standard_normal((6, 6))
+    B = rng.standard_normal((6, 2))
+    X = np.array(_exact.solve(_exact.fractions(A), _exact.fractions(B)), dtype=float)
+    np.testing.assert_allclose(X, np.linalg.solve(A, B), rtol=1e-10, atol=1e-12)
+    for i in range(20):
+        M = rng.standard_normal((5, 5))
+        S = M @ M.T + (-1.5 if i % 2 else 0.2) * np.eye(5)
+        lam = np.linalg.eigvalsh(S)[0]
+        assert abs(lam) > 1e-8
+        assert _exact.is_positive_definite(_exact.fractions(S)) == (lam > 0)
+    assert _exact.fractions([[0.1]])[0][0] == Fraction(0.1)      # the float's own value
+    with pytest.raises(ZeroDivisionError):
+        _exact.solve(_exact.fractions(np.ones((2, 2))), _exact.fractions(np.eye(2)))

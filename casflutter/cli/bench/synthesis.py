@@ -9,7 +9,7 @@ increase with the order.  The file is rewritten after every plant and order, so 
 is stopped keeps what it finished; ``--out`` is checked to be writable before any work.
 Each record of an order below ``ncon`` (or ``nmeas``) gets the certified static-direction
 bound (:func:`casflutter.design.static_direction_bound` at ω = 0 and ∞, both sides where the
-plant allows; not counted in ``wall_time_s``) and ``ratio_to_certified_bound``; the summary
+plant allows, proven in exact arithmetic up to 60 states; not counted in ``wall_time_s``) and ``ratio_to_certified_bound``; the summary
 gives each plant's order-3 γ against the best lower bound known, ``max(γ*, certificate)``.
 With ``--relaxation-starts N`` such records also get the rank relaxation
 (:func:`casflutter.design.order_relaxation` at ω = 0 and ∞, ``N`` seeded starts): its best
@@ -147,13 +147,14 @@ def _certificates(P, nmeas: int, ncon: int) -> list[dict[str, Any]]:
     from ...errors import ConfigError  # noqa: PLC0415
 
     out: list[dict[str, Any]] = []
+    exact = np.asarray(P.A).shape[0] <= 60      # exact rationals: seconds at this size
     for side in ("control", "measurement"):
         try:
-            c = static_direction_bound(P, nmeas, ncon, side=side)
+            c = static_direction_bound(P, nmeas, ncon, side=side, exact=exact)
         except ConfigError as exc:
             out.append({"side": side, "unavailable": str(exc)})
             continue
-        out.append({"side": side, "value": c.value, "estimate": c.estimate,
+        out.append({"side": side, "value": c.value, "exact": c.exact, "estimate": c.estimate,
                     "applies_below_order": c.applies_below_order,
                     "frequencies": ["inf" if np.isinf(w) else w for w in c.frequencies],
                     "per_frequency_floor": max(c.per_frequency)})
