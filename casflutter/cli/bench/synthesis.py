@@ -9,8 +9,9 @@ increase with the order.  The file is rewritten after every plant and order, so 
 is stopped keeps what it finished; ``--out`` is checked to be writable before any work.
 Each record of an order below ``ncon`` (or ``nmeas``) gets the certified static-direction
 bound (:func:`casflutter.design.static_direction_bound` at ω = 0 and ∞, both sides where the
-plant allows, proven in exact arithmetic up to 60 states; not counted in ``wall_time_s``) and ``ratio_to_certified_bound``; the summary
-gives each plant's order-3 γ against the best lower bound known, ``max(γ*, certificate)``.
+plant allows, proven in exact arithmetic up to 60 states; not counted in ``wall_time_s``)
+and ``ratio_to_certified_bound``; the summary gives each plant's order-3 γ against the best
+lower bound known, ``max(γ*, certificate)``.
 With ``--relaxation-starts N`` such records also get the rank relaxation
 (:func:`casflutter.design.order_relaxation` at ω = 0 and ∞, ``N`` seeded starts): its best
 local minimum, a lower bound when it is the global one.
