@@ -12,10 +12,10 @@ export OMP_NUM_THREADS = 1
 export OPENBLAS_NUM_THREADS = 1
 export MKL_NUM_THREADS = 1
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml constraints.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test,slycot,dask]'
+	$(PY) -m pip install --quiet -c constraints.txt -e '.[test,slycot,dask]'
 	touch $(STAMP)
 
 demo: $(STAMP)
@@ -31,8 +31,8 @@ test-all: $(STAMP)
 # a small size (CASFLUTTER_DOCS_QUICK=1)
 DOCS_STAMP := $(VENV)/.docs-installed
 
-$(DOCS_STAMP): pyproject.toml $(STAMP)
-	$(PY) -m pip install --quiet -e '.[docs]'
+$(DOCS_STAMP): pyproject.toml constraints.txt $(STAMP)
+	$(PY) -m pip install --quiet -c constraints.txt -e '.[docs]'
 	touch $(DOCS_STAMP)
 
 docs: $(DOCS_STAMP)

@@ -9,6 +9,7 @@ ORDER = (
     "plot_goland_rfa.py",
     "plot_lco_branches.py",
     "plot_compleib_synthesis.py",
+    "plot_order_certificate.py",
     "plot_seed_wing_pipeline.py",
     "plot_seed_wing_control_models.py",
     "plot_wing_file.py",

@@ -9,7 +9,9 @@ the benchmark plants; :func:`partition`, :class:`Partition`; :func:`hinf_norm` /
 one controller holds ΣAE(V) stable, by continuation in speed) and :func:`reduce_order` with
 :class:`OrderReduction` (the same interval at lower orders, by continuation in the order),
 chained by :func:`design_interval_controller` (:class:`IntervalDesign`); :func:`order_relaxation` with
-:class:`OrderBound` (what order ``k`` can reach at a few frequencies: the rank relaxation).
+:class:`OrderBound` (what order ``k`` can reach at a few frequencies: the rank relaxation,
+minimised locally) and :func:`static_direction_bound` with :class:`StaticDirectionBound` (a
+certified lower bound on γ for every controller with fewer states than controls).
 """
 
 from ._flutter import FlutterDesign, design_flutter_controller, loop_abscissa, with_flap_rate
@@ -17,7 +19,8 @@ from ._interval import (IntervalDesign, IntervalReach, OrderReduction, OrderStep
                         design_interval_controller, full_order_start, reduce_order,
                         stabilize_interval)
 from ._norm import hinf_norm
-from ._orderbound import OrderBound, order_relaxation
+from ._orderbound import (OrderBound, StaticDirectionBound, order_relaxation,
+                          static_direction_bound)
 from ._plant import Partition, exact_hinf_norm, load_compleib, partition
 from ._synthesis import (StartRecord, SynthesisOptions, SynthesisResult, synthesize,
                          verify_closed_loop)
@@ -27,4 +30,5 @@ __all__ = ["synthesize", "SynthesisOptions", "SynthesisResult", "StartRecord",
            "stabilize_interval", "full_order_start", "IntervalReach",
            "reduce_order", "OrderReduction", "OrderStep", "design_interval_controller",
            "IntervalDesign",
-           "order_relaxation", "OrderBound", "load_compleib", "partition", "Partition", "exact_hinf_norm", "hinf_norm", "verify_closed_loop"]
+           "order_relaxation", "OrderBound", "static_direction_bound", "StaticDirectionBound",
+           "load_compleib", "partition", "Partition", "exact_hinf_norm", "hinf_norm", "verify_closed_loop"]

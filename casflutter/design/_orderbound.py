@@ -28,22 +28,28 @@ that the minimiser of the smooth function approaches one of the maximum); the re
 *the best local minimum found*, an estimate of the lower bound, not a certificate: it is a
 lower bound on ``γ_k`` only when it is the global minimum.  The spread of the local minima
 over the starts is returned so that this can be judged.
+
+For one static control direction (or measurement combination) at two frequencies the
+relaxation can be solved globally: :func:`static_direction_bound` eliminates everything but
+``(q, qᵀDk)`` in closed form and certifies the bound with an S-procedure multiplier.
 """
 
 from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
+from fractions import Fraction
 from typing import Sequence
 
 import control
 import numpy as np
-from scipy.optimize import minimize
+from scipy.optimize import minimize, minimize_scalar
 
 from ..errors import ConfigError, DimensionError
+from . import _exact
 from ._plant import Partition, partition
 
-__all__ = ["OrderBound", "order_relaxation"]
+__all__ = ["OrderBound", "order_relaxation", "StaticDirectionBound", "static_direction_bound"]
 
 log = logging.getLogger("casflutter.design")
 
@@ -169,7 +175,6 @@ class _Relaxation:
             c = (s / f) ** (p - 1.0)
             GT = (Us * c[None, :]) @ Vh                   # ∂f/∂T (df = Re tr(GTᴴ dT))
             gK.append(L.conj().T @ GT @ R.conj().T)       # ∂f/∂K through dT = L dK R
-        k = self.k
         g_inf = np.real(gK[0]).copy()
         gU = np.zeros_like(U)
         gV = np.zeros_like(V)
@@ -183,6 +188,15 @@ class _Relaxation:
                       else np.real(Z).ravel())
         g = np.concatenate([g_inf.ravel(), gU.ravel(), gV.ravel()] + gW)
         return float(f), g
+
+
+def _partitioned(plant: control.StateSpace | Partition, nmeas: int, ncon: int) -> Partition:
+    """The plant's blocks, checked against ``nmeas`` and ``ncon``."""
+    P = plant if isinstance(plant, Partition) else partition(plant, nmeas, ncon)
+    if P.dims[2:] != (ncon, nmeas):
+        raise DimensionError(f"plant has (ncon, nmeas) = {P.dims[2:]}, expected "
+                             f"{(ncon, nmeas)}")
+    return P
 
 
 def order_relaxation(plant: control.StateSpace | Partition, nmeas: int, ncon: int, order: int,
@@ -229,10 +243,7 @@ def order_relaxation(plant: control.StateSpace | Partition, nmeas: int, ncon: in
     if not freqs or any(not np.isfinite(w) or w < 0 for w in freqs):
         raise ConfigError(f"frequencies must be finite and >= 0 (at least one), got "
                           f"{list(frequencies)!r}")
-    P = plant if isinstance(plant, Partition) else partition(plant, nmeas, ncon)
-    if P.dims[2:] != (ncon, nmeas):
-        raise DimensionError(f"plant has (ncon, nmeas) = {P.dims[2:]}, expected "
-                             f"{(ncon, nmeas)}")
+    P = _partitioned(plant, nmeas, ncon)
     order = int(order)
     rel = _Relaxation(P, order, freqs)
     rng = np.random.default_rng(seed)
@@ -258,3 +269,328 @@ def order_relaxation(plant: control.StateSpace | Partition, nmeas: int, ncon: in
                       sigma_at_infinity=float(sv[0][0]),
                       sigma_at_frequencies=tuple(float(s[0]) for s in sv[1:]),
                       trivial=bool(trivial))
+
+
+# -- the static-direction certificate -----------------------------------------------------
+
+@dataclass(frozen=True)
+class StaticDirectionBound:
+    """Outcome of :func:`static_direction_bound`: a certified lower bound on γ.
+
+    Attributes
+    ----------
+    value : float
+        Every stabilising controller with a static control direction (``side = "control"``:
+        any order ``k < ncon``) or a static measurement combination (``side =
+        "measurement"``: any ``k < nmeas``) has ``‖T_zw‖∞ >= value``.  Certified by an
+        S-procedure multiplier (below): positive definite in exact arithmetic (``exact``), or
+        with a smallest eigenvalue above ``tolerance``.
+    estimate : float
+        The two-frequency relaxation's global minimum as computed: the largest γ whose best
+        multiplier has a positive smallest eigenvalue, without the rounding margin.  By the
+        S-lemma (two quadratic forms, one of them negative somewhere) the multiplier exists
+        exactly up to the relaxation's minimum, so ``value <= estimate`` and the gap is what
+        the margin costs.
+    upper : float
+        The first γ above ``estimate`` at which the bisection found no multiplier
+        (``inf`` when none failed up to ``1e12`` times the start).
+    side : str
+        ``"control"`` or ``"measurement"``.
+    applies_below_order : int
+        The orders ``k`` the bound holds for are ``k < applies_below_order`` (``ncon`` or
+        ``nmeas``).
+    frequencies : tuple of float
+        The two frequencies (rad/s; ``inf`` is the feed-through) whose gains are bounded.
+    multiplier : tuple of float
+        ``(t1, t2)``, ``t1 + t2 = 1``, with ``t1 Φ1 + t2 Φ2`` positive definite at ``value``
+        (matrices normalised to unit norm); empty when ``value`` is the per-frequency floor.
+    margin : float
+        Smallest eigenvalue of that combination (``nan`` when there is none).
+    tolerance : float
+        The margin required of it in floating point: ``100 · eps · κ``, κ the largest
+        condition number of ``jωI − A`` at the two frequencies (1 at ω = ∞), for the rounding
+        in ``P(jω)`` (not used when ``exact``).
+    exact : bool
+        True when ``value`` was proven in exact rational arithmetic on the plant's numbers
+        (the multiplier's combination positive definite by exact elimination).
+    per_frequency : tuple of float
+        The bound each frequency gives on its own for any controller, ``‖Π⊥ P11(jω)‖`` with
+        Π⊥ the projector off the range of ``P12(jω)``: ``value`` is at least their maximum.
+    """
+
+    value: float
+    estimate: float
+    upper: float
+    side: str
+    applies_below_order: int
+    frequencies: tuple
+    multiplier: tuple
+    margin: float
+    tolerance: float
+    exact: bool
+    per_frequency: tuple
+
+
+def _transposed(P: Partition) -> Partition:
+    """The dual plant: ``T_zw`` of ``(P, K)`` is the transpose of ``T`` of ``(Pᵀ, Kᵀ)``."""
+    return Partition(P.A.T, P.C1.T, P.C2.T, P.B1.T, P.B2.T, P.D11.T, P.D21.T, P.D12.T,
+                     P.D22.T)
+
+
+class _StaticDirectionForms:
+    """The quadratic forms of the static-direction relaxation at one frequency.
+
+    A controller with a static control direction ``q`` (``qᵀ K(s) = rᵀ`` at every ``s``) has,
+    with ``Q = K (I − P22 K)⁻¹`` and ``T = P11 + P12 Q P21``,
+    ``aᵀ Q = rᵀ`` for ``a = q − P22ᵀ r``.  The unit vector ``e = P12 G⁻¹ ā / n``
+    (``G = P12ᴴ P12``, ``n² = aᵀ G⁻¹ ā``) is orthogonal to everything ``Q`` can still move
+    inside the range of ``P12``, so ``eᴴ T = (aᵀ P12⁺ P11 + rᵀ P21) / n =: mᵀ`` whatever the
+    rest of ``Q``; with ``Π⊥`` the projector off that range, ``Π⊥ T = Π⊥ P11 =: A0``.  As
+    ``Π⊥ + e eᴴ`` is an orthogonal projector, ``σ̄ T >= σ̄ [A0; mᵀ]``, and ``σ̄ [A0; mᵀ] < γ``
+    is, for ``γ > σ̄ A0``, the quadratic inequality ``zᵀ Φ(γ) z < 0`` in ``z = (q, r)``.
+    """
+
+    def __init__(self, P: Partition, w: float, side: str = "control"):
+        P11, P12, P21, P22 = _blocks(P, w)
+        nu = P12.shape[1]
+        # rounding in P(jω) grows with the condition of (jωI − A): it sets the certificate's margin
+        self.kappa = (float(np.linalg.cond(1j * w * np.eye(P.nx) - P.A))
+                      if np.isfinite(w) and P.nx else 1.0)
+        sv = np.linalg.svd(P12, compute_uv=False)
+        if sv.size < nu or sv[-1] <= 1e-12 * max(sv[0], 1e-300):
+            what = (("P12", "controls", "control direction does not reach z", "D12")
+                    if side == "control" else
+                    ("P21ᵀ", "measurements", "measurement does not see w", "D21"))
+            raise ConfigError(
+                f"{what[0]} at ω = {w!r} rad/s has rank below the number of {what[1]} ({nu}): "
+                f"some {what[2]} there, and the static-direction certificate on the {side} "
+                f"side needs it to; choose another frequency (a finite one when {what[3]} is "
+                "rank-deficient) or the other side")
+        G = P12.conj().T @ P12
+        P12p = np.linalg.solve(G, P12.conj().T)
+        self.A0 = P11 - P12 @ (P12p @ P11)
+        self.W = np.vstack([P12p @ P11, P21 - P22 @ P12p @ P11])
+        L = np.hstack([np.eye(nu), -P22.T])
+        self.N = np.real(L.T @ np.linalg.solve(G, L.conj()))
+        self.floor = float(np.linalg.norm(self.A0, 2))
+        self.nw = P11.shape[1]
+
+    def phi(self, gamma: float) -> np.ndarray:
+        """``Φ(γ)``: ``zᵀ Φ z < 0`` exactly when ``σ̄ [A0; m(z)ᵀ] < γ`` (``γ > σ̄ A0``)."""
+        R = np.linalg.inv(gamma ** 2 * np.eye(self.nw) - self.A0.conj().T @ self.A0)
+        F = np.real(self.W @ R @ self.W.conj().T) - self.N
+        return 0.5 * (F + F.T)
+
+
+def _multiplier(phis: list[np.ndarray]) -> tuple[float, float, tuple[float, float]]:
+    """``max over t ∈ [0, 1]`` of ``λmin((1 − t) Φ̂1 + t Φ̂2)`` (unit-norm ``Φ̂``; concave in t):
+    ``(t, λmin, (w1, w2))`` with ``w1 Φ1 + w2 Φ2`` that combination."""
+    norms = [float(np.linalg.norm(p, 2)) for p in phis]
+    a, b = (p / n for p, n in zip(phis, norms))
+
+    def neg(t):
+        return -float(np.linalg.eigvalsh((1.0 - t) * a + t * b)[0])
+
+    grid = np.linspace(0.0, 1.0, 201)
+    # the optimum can sit very close to an end (forms of very different scale): look there too
+    grid = np.unique(np.concatenate([grid, np.logspace(-12, -2, 41), 1.0 - np.logspace(-12, -2, 41)]))
+    vals = [neg(t) for t in grid]
+    i = int(np.argmin(vals))
+    lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+    res = minimize_scalar(neg, bounds=(lo, hi), method="bounded", options={"xatol": 1e-15})
+    t, v = (res.x, -res.fun) if -res.fun > -vals[i] else (grid[i], -vals[i])
+    return float(t), float(v), ((1.0 - t) / norms[0], t / norms[1])
+
+
+class _ExactStaticDirectionForms:
+    """:class:`_StaticDirectionForms` in exact rational arithmetic (ω = 0 or ∞, where
+    ``P(jω)`` is real): the plant's floats taken as the rationals they are."""
+
+    def __init__(self, P: Partition, w: float):
+        D = [_exact.fractions(M) for M in (P.D11, P.D12, P.D21, P.D22)]
+        if np.isinf(w):
+            P11, P12, P21, P22 = D
+        elif w == 0.0:
+            nw = P.B1.shape[1]
+            try:    # (−A)⁻¹ [B1 B2]
+                X = _exact.solve(_exact.fractions(-P.A), _exact.fractions(np.hstack([P.B1, P.B2])))
+            except ZeroDivisionError:
+                raise ConfigError("A is singular: ω = 0 is a pole of the plant; exact=True "
+                                  "needs ω = 0 and ∞") from None
+            X1, X2 = [r[:nw] for r in X], [r[nw:] for r in X]
+            C1, C2 = _exact.fractions(P.C1), _exact.fractions(P.C2)
+            one = Fraction(1)
+            P11 = _exact.combine([(one, _exact.matmul(C1, X1)), (one, D[0])])
+            P12 = _exact.combine([(one, _exact.matmul(C1, X2)), (one, D[1])])
+            P21 = _exact.combine([(one, _exact.matmul(C2, X1)), (one, D[2])])
+            P22 = _exact.combine([(one, _exact.matmul(C2, X2)), (one, D[3])])
+        else:
+            raise ConfigError(f"exact=True works at ω = 0 and ∞ only (real responses), got "
+                              f"{w!r}")
+        one = Fraction(1)
+        P12t = _exact.transpose(P12)
+        G = _exact.matmul(P12t, P12)
+        H = _exact.solve(G, _exact.matmul(P12t, P11))                  # P12⁺ P11
+        A0 = _exact.combine([(one, P11), (-one, _exact.matmul(P12, H))])
+        self.W = H + _exact.combine([(one, P21), (-one, _exact.matmul(P22, H))])
+        nu = len(P12t)
+        L = [row + [-x for x in trow] for row, trow in zip(_exact.identity(nu),
+                                                             _exact.transpose(P22))]
+        self.N = _exact.matmul(_exact.transpose(L), _exact.solve(G, L))
+        self.AtA = _exact.matmul(_exact.transpose(A0), A0)
+        self.nw = len(self.AtA)
+
+    def phi(self, gamma: Fraction):
+        """``Φ(γ)`` exactly (a list of rows of ``Fraction``)."""
+        R = _exact.solve(_exact.combine([(gamma * gamma, _exact.identity(self.nw)),
+                                         (Fraction(-1), self.AtA)]), _exact.identity(self.nw))
+        one = Fraction(1)
+        return _exact.combine([(one, _exact.matmul(_exact.matmul(self.W, R),
+                                                   _exact.transpose(self.W))), (-one, self.N)])
+
+
+def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, ncon: int, *,
+                           side: str = "control",
+                           frequencies: Sequence[float] = (0.0, np.inf),
+                           rtol: float = 1e-6, exact: bool = False) -> StaticDirectionBound:
+    """Certified lower bound on the γ of every controller with fewer states than controls.
+
+    A controller of order ``k`` has ``K(s) = Dk + Ck (sI − Ak)⁻¹ Bk`` with ``Ck`` of size
+    ``ncon × k``.  When ``k < ncon`` some real unit ``q`` has ``qᵀ Ck = 0``, so
+    ``qᵀ K(s) = qᵀ Dk =: rᵀ`` at every frequency: one combination of the controls is a
+    static output feedback.  At one frequency this costs nothing (``r`` is free), but the
+    same ``r`` acts at two frequencies, e.g. integral action a low-frequency weight demands
+    (ω = 0) against the control weight at high frequency (ω = ∞).  For each frequency,
+    ``σ̄ T(jω) >= σ̄ [A0; m(q, r)ᵀ]`` with ``m`` a ratio of linear functions of ``(q, r)``
+    (:class:`_StaticDirectionForms`), so ``max_ω σ̄ T(jω) < γ`` at both frequencies asks two
+    quadratic forms to be negative at one ``z = (q, r) ≠ 0``.  A multiplier ``t ∈ [0, 1]``
+    with ``(1 − t) Φ1(γ) + t Φ2(γ) ⪰ 0`` rules that out (S-procedure), so every such
+    controller has ``‖T‖∞ >= γ``; the largest such γ is found by bisection.  For two forms
+    the S-lemma is lossless, so the value is the global minimum of this two-frequency
+    relaxation (``estimate``; ``value`` is below it by the rounding margin), found without
+    local searches.  The relaxation drops the controller's dynamics everywhere except
+    through ``q`` and ``r``, and stability (only used for ``‖T‖∞ >= σ̄ T(jω)``): where it is
+    tight, the order-``k`` optimum is close to it.
+
+    With ``side = "measurement"`` the same is done on the dual plant: a controller with
+    ``k < nmeas`` has a static measurement combination ``K(s) p = Dk p``.
+
+    Parameters
+    ----------
+    plant : control.StateSpace or Partition
+        Generalised plant (``hinfsyn`` convention, ``u = K y``).
+    nmeas, ncon : int
+        Number of measurements and controls.
+    side : {"control", "measurement"}
+        Which static direction to use.
+    frequencies : pair of float
+        Two distinct frequencies in ``[0, inf]`` (rad/s); ``inf`` is the feed-through.
+        ``P12(jω)`` (``P21(jω)ᵀ`` for the measurement side) must have full column rank at both,
+        and a finite one must not be a pole of the plant.
+    rtol : float
+        Relative accuracy of the bisections.
+    exact : bool
+        Accept a multiplier only when the combination is positive definite in exact
+        rational arithmetic on the plant's own numbers (``fractions.Fraction``; frequencies
+        0 and ∞ only): ``value`` is then proven, not computed with a rounding margin.  The
+        cost grows quickly with the number of states (about 0.1 s per check at 20 states).
+
+    Returns
+    -------
+    StaticDirectionBound
+
+    Raises
+    ------
+    ConfigError
+        If ``side``, ``frequencies`` or ``rtol`` are invalid, or the plant's ``P12`` lacks
+        rank at a frequency (the message says which), or ``exact`` is asked at another
+        frequency than 0 and ∞.
+    DimensionError
+        If the plant does not fit ``nmeas``, ``ncon``.
+
+    Notes
+    -----
+    At ω = 0 an integrator of the controller leaves ``K(0)`` undefined but not ``Q(0)``,
+    a closed-loop map of a stabilising controller, and ``aᵀ Q = rᵀ`` holds there by
+    continuity; the bound stands.  Rounding: without ``exact`` a multiplier is accepted only
+    when the smallest eigenvalue of the unit-norm combination exceeds ``100 · eps · κ``, with
+    κ the largest condition number of ``jωI − A`` at the two frequencies (1 at ω = ∞); with
+    ``exact`` the multiplier found in floating point is re-checked on exact rationals.
+    """
+    if side not in ("control", "measurement"):
+        raise ConfigError(f"side must be 'control' or 'measurement', got {side!r}")
+    freqs = tuple(float(w) for w in frequencies)
+    if (len(freqs) != 2 or freqs[0] == freqs[1] or any(np.isnan(w) or w < 0 for w in freqs)):
+        raise ConfigError(f"frequencies must be two distinct values in [0, inf] (rad/s), "
+                          f"got {list(frequencies)!r}")
+    if not (0.0 < rtol < 0.1):
+        raise ConfigError(f"rtol must be in (0, 0.1), got {rtol!r}")
+    P = _partitioned(plant, nmeas, ncon)
+    Pd = P if side == "control" else _transposed(P)
+    forms = [_StaticDirectionForms(Pd, w, side) for w in freqs]
+    exact_forms = [_ExactStaticDirectionForms(Pd, w) for w in freqs] if exact else None
+    tol = 100.0 * np.finfo(float).eps * max(f.kappa for f in forms)
+
+    def multiplier(g):
+        """Best ``(t, λmin, weights)`` at γ = g (λmin = -inf where rounding overwhelms)."""
+        try:
+            with np.errstate(over="ignore", invalid="ignore"):
+                phis = [f.phi(g) for f in forms]
+            if not all(np.all(np.isfinite(p)) for p in phis):
+                return 0.0, -np.inf, None
+            return _multiplier(phis)
+        except np.linalg.LinAlgError:
+            return 0.0, -np.inf, None
+
+    def certified(g, t, lam, weights):
+        """The multiplier at γ = g proves the bound: in exact arithmetic, or past rounding."""
+        if not exact:
+            return lam > tol
+        if not lam > 0:
+            return False
+        gf = Fraction(g)
+        try:
+            phis = [f.phi(gf) for f in exact_forms]
+        except ZeroDivisionError:           # γ² is an eigenvalue of A0ᵀA0: not certified
+            return False
+        return _exact.is_positive_definite(
+            _exact.combine([(Fraction(w), ph) for w, ph in zip(weights, phis)]))
+
+    floor = max(f.floor for f in forms)     # any controller: γ >= σ̄ A0(jω) at each ω
+    scale = max(float(np.linalg.norm(f.W, 2)) for f in forms)
+
+    def largest(accept):
+        """Bisection for the largest γ whose best multiplier is accepted:
+        ``(γ, first γ that failed, t, λmin)``; γ = floor (t None) when none is."""
+        lo, hi, t_lo, lam_lo = floor, np.inf, None, np.nan
+        g = max(1.01 * floor, 1e-6 * scale, 1e-300)
+        cap = 1e12 * g
+        while g < cap:      # double until the multiplier fails
+            t, lam, wts = multiplier(g)
+            if not accept(g, t, lam, wts):
+                hi = g
+                break
+            lo, t_lo, lam_lo = g, t, lam
+            g *= 2.0
+        while np.isfinite(hi) and hi - lo > rtol * hi and hi > 1e-12 * scale:
+            mid = 0.5 * (lo + hi)
+            t, lam, wts = multiplier(mid)
+            if accept(mid, t, lam, wts):
+                lo, t_lo, lam_lo = mid, t, lam
+            else:
+                hi = mid
+        return lo, hi, t_lo, lam_lo
+
+    value, _, t_val, lam_val = largest(certified)
+    estimate, upper, _, _ = largest(lambda g, t, lam, w: lam > 0)
+    log.info("static-direction bound (%s side, ω = %s): γ >= %.8g certified%s; the "
+             "relaxation's minimum %.8g", side, freqs, value, " exactly" if exact else "",
+             estimate)
+    return StaticDirectionBound(value=float(value), estimate=float(estimate),
+                                upper=float(upper), side=side,
+                                applies_below_order=ncon if side == "control" else nmeas,
+                                frequencies=freqs,
+                                multiplier=() if t_val is None else (1.0 - t_val, t_val),
+                                margin=float(lam_val), tolerance=float(tol),
+                                exact=bool(exact and t_val is not None),
+                                per_frequency=tuple(f.floor for f in forms))
