@@ -558,7 +558,7 @@ def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, nc
     tol = 100.0 * np.finfo(float).eps * max(f.kappa for f in forms)
 
     def multiplier(g):
-        """Best ``(t, λmin, weights)`` at γ = g (λmin = -inf where rounding overwhelms)."""
+        """Best ``(t, λ_m, weights)`` at γ = g (λ_m = -inf where rounding overwhelms)."""
         try:
             with np.errstate(over="ignore", invalid="ignore"):
                 phis = [f.phi(g) for f in forms]
@@ -588,7 +588,7 @@ def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, nc
 
     def largest(accept):
         """Bisection for the largest γ whose best multiplier is accepted:
-        ``(γ, first γ that failed, t, λmin)``; γ = floor (t None) when none is."""
+        ``(γ, first γ that failed, t, λ_m)``; γ = floor (t None) when none is."""
         lo, hi, t_lo, lam_lo = floor, np.inf, None, np.nan
         g = max(1.01 * floor, 1e-6 * scale, 1e-300)
         cap = 1e12 * g
