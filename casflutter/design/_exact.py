@@ -16,7 +16,7 @@ import numpy as np
 Matrix = list  # list of rows of Fraction
 
 __all__ = ["fractions", "matmul", "transpose", "combine", "identity", "solve",
-           "is_positive_definite"]
+           "negative_eigenvalues", "is_positive_definite"]
 
 
 def fractions(M) -> Matrix:
@@ -66,16 +66,23 @@ def solve(A: Matrix, B: Matrix) -> Matrix:
     return [row[n:] for row in M]
 
 
-def is_positive_definite(S: Matrix) -> bool:
-    """True exactly when the symmetric ``S`` is positive definite (every pivot of its
-    symmetric elimination positive; Sylvester's criterion)."""
+def negative_eigenvalues(S: Matrix) -> int | None:
+    """The number of negative eigenvalues of the symmetric ``S``, from the signs of the pivots
+    of its symmetric elimination ``S = L D Lᵀ`` (Sylvester's law of inertia); ``None`` when a
+    pivot is zero (the elimination, without pivoting, then says nothing)."""
     A = [list(r) for r in S]
-    n = len(A)
+    n, neg = len(A), 0
     for c in range(n):
-        if A[c][c] <= 0:
-            return False
+        if A[c][c] == 0:
+            return None
+        neg += A[c][c] < 0
         for r in range(c + 1, n):
             f = A[r][c] / A[c][c]
             if f != 0:
                 A[r] = [x - f * y for x, y in zip(A[r], A[c])]
-    return True
+    return neg
+
+
+def is_positive_definite(S: Matrix) -> bool:
+    """True exactly when the symmetric ``S`` is positive definite (every pivot positive)."""
+    return negative_eigenvalues(S) == 0

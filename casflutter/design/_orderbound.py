@@ -280,39 +280,41 @@ class StaticDirectionBound:
     Attributes
     ----------
     value : float
-        Every stabilising controller with a static control direction (``side = "control"``:
-        any order ``k < ncon``) or a static measurement combination (``side =
-        "measurement"``: any ``k < nmeas``) has ``‖T_zw‖∞ >= value``.  Certified by an
+        Every stabilising controller of order at most ``order`` (so with ``directions``
+        static control directions, or measurement combinations on the measurement side) has
+        ``‖T_zw‖∞ >= value``.  Certified by an
         S-procedure multiplier (below): positive definite in exact arithmetic (``exact``), or
         with a smallest eigenvalue above ``tolerance``.
     estimate : float
-        The two-frequency relaxation's global minimum as computed: the largest γ whose best
-        multiplier has a positive smallest eigenvalue, without the rounding margin.  By the
-        S-lemma (two quadratic forms, one of them negative somewhere) the multiplier exists
-        exactly up to the relaxation's minimum, so ``value <= estimate`` and the gap is what
-        the margin costs.
+        The largest γ whose best multiplier has a positive ``m``-th eigenvalue, without the
+        rounding margin (``value <= estimate``).  With one direction it is the two-frequency
+        relaxation's global minimum: by the S-lemma (two quadratic forms, one of them negative
+        somewhere) the multiplier exists exactly up to it.
     upper : float
         The first γ above ``estimate`` at which the bisection found no multiplier
         (``inf`` when none failed up to ``1e12`` times the start).
     side : str
         ``"control"`` or ``"measurement"``.
-    applies_below_order : int
-        The orders ``k`` the bound holds for are ``k < applies_below_order`` (``ncon`` or
-        ``nmeas``).
+    order : int
+        The bound holds for every controller of order up to ``order``.
+    directions : int
+        The number ``m`` of static directions such a controller has (``ncon − order``, or
+        ``nmeas − order`` on the measurement side).
     frequencies : tuple of float
         The two frequencies (rad/s; ``inf`` is the feed-through) whose gains are bounded.
     multiplier : tuple of float
-        ``(t1, t2)``, ``t1 + t2 = 1``, with ``t1 Φ1 + t2 Φ2`` positive definite at ``value``
-        (matrices normalised to unit norm); empty when ``value`` is the per-frequency floor.
+        ``(t1, t2)``, ``t1 + t2 = 1``, with ``t1 Φ1 + t2 Φ2`` having fewer than ``m`` negative
+        eigenvalues at ``value`` (positive definite for ``m = 1``; matrices normalised to unit
+        norm); empty when ``value`` is the per-frequency floor.
     margin : float
-        Smallest eigenvalue of that combination (``nan`` when there is none).
+        The ``m``-th smallest eigenvalue of that combination (``nan`` when there is none).
     tolerance : float
         The margin required of it in floating point: ``100 · eps · κ``, κ the largest
         condition number of ``jωI − A`` at the two frequencies (1 at ω = ∞), for the rounding
         in ``P(jω)`` (not used when ``exact``).
     exact : bool
         True when ``value`` was proven in exact rational arithmetic on the plant's numbers
-        (the multiplier's combination positive definite by exact elimination).
+        (the multiplier's combination's inertia by exact elimination).
     per_frequency : tuple of float
         The bound each frequency gives on its own for any controller, ``‖Π⊥ P11(jω)‖`` with
         Π⊥ the projector off the range of ``P12(jω)``: ``value`` is at least their maximum.
@@ -322,7 +324,8 @@ class StaticDirectionBound:
     estimate: float
     upper: float
     side: str
-    applies_below_order: int
+    order: int
+    directions: int
     frequencies: tuple
     multiplier: tuple
     margin: float
@@ -382,14 +385,15 @@ class _StaticDirectionForms:
         return 0.5 * (F + F.T)
 
 
-def _multiplier(phis: list[np.ndarray]) -> tuple[float, float, tuple[float, float]]:
-    """``max over t ∈ [0, 1]`` of ``λmin((1 − t) Φ̂1 + t Φ̂2)`` (unit-norm ``Φ̂``; concave in t):
-    ``(t, λmin, (w1, w2))`` with ``w1 Φ1 + w2 Φ2`` that combination."""
+def _multiplier(phis: list[np.ndarray], m: int = 1) -> tuple[float, float, tuple[float, float]]:
+    """``max over t ∈ [0, 1]`` of the ``m``-th smallest eigenvalue ``λ_m((1 − t) Φ̂1 + t Φ̂2)``
+    (unit-norm ``Φ̂``; concave in t for ``m = 1``, searched on a grid and refined otherwise):
+    ``(t, λ_m, (w1, w2))`` with ``w1 Φ1 + w2 Φ2`` that combination."""
     norms = [float(np.linalg.norm(p, 2)) for p in phis]
     a, b = (p / n for p, n in zip(phis, norms))
 
     def neg(t):
-        return -float(np.linalg.eigvalsh((1.0 - t) * a + t * b)[0])
+        return -float(np.linalg.eigvalsh((1.0 - t) * a + t * b)[m - 1])
 
     grid = np.linspace(0.0, 1.0, 201)
     # the optimum can sit very close to an end (forms of very different scale): look there too
@@ -450,7 +454,7 @@ class _ExactStaticDirectionForms:
 
 
 def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, ncon: int, *,
-                           side: str = "control",
+                           order: int | None = None, side: str = "control",
                            frequencies: Sequence[float] = (0.0, np.inf),
                            rtol: float = 1e-6, exact: bool = False) -> StaticDirectionBound:
     """Certified lower bound on the γ of every controller with fewer states than controls.
@@ -472,8 +476,16 @@ def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, nc
     through ``q`` and ``r``, and stability (only used for ``‖T‖∞ >= σ̄ T(jω)``): where it is
     tight, the order-``k`` optimum is close to it.
 
+    An order ``k`` lower by ``m − 1`` leaves ``m = ncon − k`` static directions, the columns
+    of an orthonormal ``Q_s`` with ``Q_sᵀ K(s) = Rᵀ``; the same algebra gives an ``m × m``
+    matrix inequality ``Zᵀ Φ(γ) Z ≺ 0`` in ``Z = [Q_s; R]`` at each frequency, and a
+    combination ``(1 − t) Φ1 + t Φ2`` with fewer than ``m`` negative eigenvalues rules it out
+    (no ``m``-dimensional subspace on which it is negative definite).  For ``m > 1`` this is
+    sufficient only: ``estimate`` is then what the certificate reaches, not necessarily the
+    relaxation's minimum.
+
     With ``side = "measurement"`` the same is done on the dual plant: a controller with
-    ``k < nmeas`` has a static measurement combination ``K(s) p = Dk p``.
+    ``k < nmeas`` has ``nmeas − k`` static measurement combinations ``K(s) p = Dk p``.
 
     Parameters
     ----------
@@ -481,8 +493,12 @@ def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, nc
         Generalised plant (``hinfsyn`` convention, ``u = K y``).
     nmeas, ncon : int
         Number of measurements and controls.
+    order : int, optional
+        The controller order ``k`` to bound (the bound holds for every order up to ``k``);
+        ``0 <= k < ncon`` (``< nmeas`` on the measurement side).  Default: one less than
+        ``ncon`` (``nmeas``), one static direction.
     side : {"control", "measurement"}
-        Which static direction to use.
+        Which static directions to use.
     frequencies : pair of float
         Two distinct frequencies in ``[0, inf]`` (rad/s); ``inf`` is the feed-through.
         ``P12(jω)`` (``P21(jω)ᵀ`` for the measurement side) must have full column rank at both,
@@ -490,9 +506,10 @@ def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, nc
     rtol : float
         Relative accuracy of the bisections.
     exact : bool
-        Accept a multiplier only when the combination is positive definite in exact
-        rational arithmetic on the plant's own numbers (``fractions.Fraction``; frequencies
-        0 and ∞ only): ``value`` is then proven, not computed with a rounding margin.  The
+        Accept a multiplier only when the combination's inertia (fewer than ``m`` negative
+        eigenvalues) holds in exact rational arithmetic on the plant's own numbers
+        (``fractions.Fraction``; frequencies 0 and ∞ only): ``value`` is then proven, not
+        computed with a rounding margin.  The
         cost grows quickly with the number of states (about 0.1 s per check at 20 states).
 
     Returns
@@ -502,7 +519,7 @@ def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, nc
     Raises
     ------
     ConfigError
-        If ``side``, ``frequencies`` or ``rtol`` are invalid, or the plant's ``P12`` lacks
+        If ``order``, ``side``, ``frequencies`` or ``rtol`` are invalid, or the plant's ``P12`` lacks
         rank at a frequency (the message says which), or ``exact`` is asked at another
         frequency than 0 and ∞.
     DimensionError
@@ -513,7 +530,7 @@ def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, nc
     At ω = 0 an integrator of the controller leaves ``K(0)`` undefined but not ``Q(0)``,
     a closed-loop map of a stabilising controller, and ``aᵀ Q = rᵀ`` holds there by
     continuity; the bound stands.  Rounding: without ``exact`` a multiplier is accepted only
-    when the smallest eigenvalue of the unit-norm combination exceeds ``100 · eps · κ``, with
+    when the ``m``-th smallest eigenvalue of the unit-norm combination exceeds ``100 · eps · κ``, with
     κ the largest condition number of ``jωI − A`` at the two frequencies (1 at ω = ∞); with
     ``exact`` the multiplier found in floating point is re-checked on exact rationals.
     """
@@ -526,19 +543,28 @@ def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, nc
     if not (0.0 < rtol < 0.1):
         raise ConfigError(f"rtol must be in (0, 0.1), got {rtol!r}")
     P = _partitioned(plant, nmeas, ncon)
+    n_dir = ncon if side == "control" else nmeas
+    k = n_dir - 1 if order is None else order
+    if int(k) != k or not 0 <= k < n_dir:
+        raise ConfigError(f"order must be an integer in [0, {n_dir - 1}] on the {side} side "
+                          f"({n_dir} {'controls' if side == 'control' else 'measurements'}: "
+                          f"a controller of order >= {n_dir} has no static direction), "
+                          f"got {order!r}")
+    k = int(k)
+    m = n_dir - k
     Pd = P if side == "control" else _transposed(P)
     forms = [_StaticDirectionForms(Pd, w, side) for w in freqs]
     exact_forms = [_ExactStaticDirectionForms(Pd, w) for w in freqs] if exact else None
     tol = 100.0 * np.finfo(float).eps * max(f.kappa for f in forms)
 
     def multiplier(g):
-        """Best ``(t, λmin, weights)`` at γ = g (λmin = -inf where rounding overwhelms)."""
+        """Best ``(t, λ_m, weights)`` at γ = g (λ_m = -inf where rounding overwhelms)."""
         try:
             with np.errstate(over="ignore", invalid="ignore"):
                 phis = [f.phi(g) for f in forms]
             if not all(np.all(np.isfinite(p)) for p in phis):
                 return 0.0, -np.inf, None
-            return _multiplier(phis)
+            return _multiplier(phis, m)
         except np.linalg.LinAlgError:
             return 0.0, -np.inf, None
 
@@ -553,15 +579,16 @@ def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, nc
             phis = [f.phi(gf) for f in exact_forms]
         except ZeroDivisionError:           # γ² is an eigenvalue of A0ᵀA0: not certified
             return False
-        return _exact.is_positive_definite(
+        neg = _exact.negative_eigenvalues(
             _exact.combine([(Fraction(w), ph) for w, ph in zip(weights, phis)]))
+        return neg is not None and neg < m
 
     floor = max(f.floor for f in forms)     # any controller: γ >= σ̄ A0(jω) at each ω
     scale = max(float(np.linalg.norm(f.W, 2)) for f in forms)
 
     def largest(accept):
         """Bisection for the largest γ whose best multiplier is accepted:
-        ``(γ, first γ that failed, t, λmin)``; γ = floor (t None) when none is."""
+        ``(γ, first γ that failed, t, λ_m)``; γ = floor (t None) when none is."""
         lo, hi, t_lo, lam_lo = floor, np.inf, None, np.nan
         g = max(1.01 * floor, 1e-6 * scale, 1e-300)
         cap = 1e12 * g
@@ -583,12 +610,11 @@ def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, nc
 
     value, _, t_val, lam_val = largest(certified)
     estimate, upper, _, _ = largest(lambda g, t, lam, w: lam > 0)
-    log.info("static-direction bound (%s side, ω = %s): γ >= %.8g certified%s; the "
-             "relaxation's minimum %.8g", side, freqs, value, " exactly" if exact else "",
+    log.info("static-direction bound (%s side, order <= %d, ω = %s): γ >= %.8g certified%s "
+             "(without margin %.8g)", side, k, freqs, value, " exactly" if exact else "",
              estimate)
     return StaticDirectionBound(value=float(value), estimate=float(estimate),
-                                upper=float(upper), side=side,
-                                applies_below_order=ncon if side == "control" else nmeas,
+                                upper=float(upper), side=side, order=k, directions=m,
                                 frequencies=freqs,
                                 multiplier=() if t_val is None else (1.0 - t_val, t_val),
                                 margin=float(lam_val), tolerance=float(tol),
