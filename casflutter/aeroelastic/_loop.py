@@ -169,14 +169,38 @@ class AeroelasticLoop:
         nk = Ak.shape[0] if Ak.size else 0
         if nk == 0:
             Ak, Bk, Ck = np.zeros((0, 0)), np.zeros((0, m)), np.zeros((1, 0))
-        s = 1.0 - float((Dk @ self.D22)[0])
-        if abs(s) < 1e-12:
+        if abs(1.0 - float((Dk @ self.D22)[0])) < 1e-12:
             raise DimensionError("the loop v = K zm is algebraically singular (1 - Dk D22 = 0)")
+        return self.closed_loop_parts(Ak, Bk, Ck, Dk)[0]
+
+    def closed_loop_parts(self, Ak: np.ndarray, Bk: np.ndarray, Ck: np.ndarray,
+                          Dk: np.ndarray) -> tuple[np.ndarray, float, np.ndarray, np.ndarray]:
+        """The closed loop of :meth:`closed_loop_state_matrix` from the controller's matrices,
+        unchecked, with the pieces a gradient with respect to them needs.
+
+        Parameters
+        ----------
+        Ak, Bk, Ck, Dk : ndarray
+            The controller's matrices (``Ck`` of one row, ``Dk`` of shape ``(1, n_sensors)``).
+
+        Returns
+        -------
+        A_cl : ndarray
+            The state matrix of ``(x, x_K)``.
+        s : float
+            ``1 − Dk D22``, the algebraic loop's factor.
+        vx : ndarray
+            ``Dk C2 / s``: the flap's dependence on the loop's state.
+        zx : ndarray
+            ``C2 + D22 vx``: the sensors' dependence on the loop's state.
+        """
+        s = 1.0 - float((Dk @ self.D22)[0])
         # v = (Ck xk + Dk C2 x) / s
-        vx, vk = (Dk @ self.C2) / s, Ck / s
-        B2 = self.B2[:, None]
-        zx, zk = self.C2 + self.D22[:, None] @ vx, self.D22[:, None] @ vk
-        return np.block([[self.A + B2 @ vx, B2 @ vk], [Bk @ zx, Ak + Bk @ zk]])
+        vx = (Dk @ self.C2) / s
+        B2, D22 = self.B2[:, None], self.D22[:, None]
+        zx = self.C2 + D22 @ vx
+        A_cl = np.block([[self.A + B2 @ vx, (B2 / s) @ Ck], [Bk @ zx, Ak + Bk @ D22 @ Ck / s]])
+        return A_cl, s, vx, zx
 
     def with_servo(self, omega: float, zeta: float = 0.7) -> "AeroelasticLoop":
         """This loop with the flap behind a second-order servo, ``v̈ = ω² (c − v) − 2ζω v̇``.

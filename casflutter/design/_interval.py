@@ -145,29 +145,19 @@ class _ClosedLoopsAtSpeeds:
         self.loops = [lp for V in speeds for lp in models.loops(V)]
         self.m = models.n_sensors
 
-    def _closed_loop(self, lp, Ak, Bk, Ck, Dk):
-        """A_cl of one loop and the pieces its gradient needs."""
-        s = 1.0 - float((Dk @ lp.D22)[0])
-        B2 = lp.B2[:, None] / s
-        vx = (Dk @ lp.C2) / s
-        zx = lp.C2 + lp.D22[:, None] @ vx
-        D22 = lp.D22[:, None]
-        Acl = np.block([[lp.A + lp.B2[:, None] @ vx, B2 @ Ck],
-                        [Bk @ zx, Ak + Bk @ D22 @ Ck / s]])
-        return Acl, (s, B2, vx, zx, D22)
-
     def abscissae(self, p: np.ndarray) -> np.ndarray:
         """The closed loop's spectral abscissa at every speed (eigenvalues only)."""
         Ak, Bk, Ck, Dk = _unpack(p, self.order, self.m, self.Dk)
         return np.array([float(np.max(np.linalg.eigvals(
-            self._closed_loop(lp, Ak, Bk, Ck, Dk)[0]).real)) for lp in self.loops])
+            lp.closed_loop_parts(Ak, Bk, Ck, Dk)[0]).real)) for lp in self.loops])
 
     def gradient(self, p: np.ndarray, j: int) -> tuple[float, np.ndarray]:
         """The rightmost eigenvalue's real part of loop ``j`` and its gradient."""
         Ak, Bk, Ck, Dk = _unpack(p, self.order, self.m, self.Dk)
         free_d = p.size > self.order * (self.order + self.m + 1)    # Dk among the parameters
         lp = self.loops[j]
-        Acl, (s, B2, vx, zx, D22) = self._closed_loop(lp, Ak, Bk, Ck, Dk)
+        Acl, s, vx, zx = lp.closed_loop_parts(Ak, Bk, Ck, Dk)
+        B2, D22 = lp.B2[:, None] / s, lp.D22[:, None]
         lam, VL, VR = scipy.linalg.eig(Acl, left=True, right=True)
         i = int(np.argmax(lam.real))
         u, v = VL[:, i].conj(), VR[:, i]
