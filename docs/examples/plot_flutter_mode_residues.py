@@ -72,20 +72,23 @@ fig.tight_layout()
 #
 # On the wing the dip lies near V = 1.46, where the mode grows at only 1.3 rad/s; on the
 # frozen ROM loop it lies near V = 1.93, where the mode already grows at 6.6 rad/s, with a
-# grip almost four times weaker than at its flutter speed.  The interval designs stall exactly
-# there (``casflutter bench interval``, :func:`casflutter.design.stabilize_interval`):
+# grip almost four times weaker than at its flutter speed.  The interval designs
+# (:func:`casflutter.design.stabilize_interval`, ``casflutter bench interval``) meet it:
 #
-# * on the wing, order-3 controllers continued up from V = 0.05 reach 2.24-2.27, and order-3
-#   controllers that stabilise V = 2.4 continued down stall at 1.48-1.53: each side of the
-#   dip is held at order 3, not both; an order-4 controller holds (0, 2.41) (the witnesses in
-#   ``problems/seed_wing/``);
-# * on the frozen ROM loop, every route stalls between 1.9 and 2.05, whatever the order:
-#   the wing's order-4, order-8 and full-order witnesses continued from below, the paper's
-#   order-3 design continued from below, and full-order LQG controllers continued down from
-#   2.4.
+# * on the frozen ROM loop every route stalls around the dip, whatever the order: continued
+#   up from V = 0.05, the paper's order-3 design reaches 1.88 and the wing's own order-3,
+#   order-4, order-8 and full-order (32) controllers 1.87, 1.83, 1.97 and 2.01; continued
+#   down from 2.4, full-order LQG controllers stop between 1.79 and 2.05 (with or without
+#   the servo);
+# * on the wing, order-3 controllers continued up from V = 0.05 reach 2.24-2.27, and
+#   order-3 controllers that stabilise V = 2.4 continued down stop either just above the dip
+#   (1.48-1.53) or, with a resonator at 68-76 rad/s, cross it and stop at 1.03-1.23, where the
+#   resonator destabilises the lightly damped lateral mode (63 rad/s, 0.5 %).  Two order-3
+#   controllers hold (0, 2.26) and (1.03, 2.40) (``problems/seed_wing/``, certified in the
+#   tests); one order-4 controller holds (0, 2.41).
 #
 # The frozen ROM puts the flutter mode's control reversal half a speed unit too high, where
-# the mode is four times as unstable.  That is a property of the model (eq. 8 keeps the
+# the mode is five times as unstable.  That is a property of the model (eq. 8 keeps the
 # aerodynamic time scale of V0; *Which ROM predicts a controller on the wing?* shows the ROM
 # whose lags scale with V following the wing), and it is why the default run's design,
-# made on that loop, cannot be certified over the paper's interval.
+# made on that loop, is not certified over the paper's interval.
