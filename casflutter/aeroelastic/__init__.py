@@ -8,6 +8,8 @@
   :class:`LoopFamily` — the interface they share (a loop at every speed index).
 - :func:`track_eigenvalues`, :func:`find_flutter` — branch tracking by eigenvector
   continuity, V–g / V–f data, flutter (Hopf) and divergence speeds.
+- :func:`mode_residues` — a mode's residues in the flap-to-sensor loop along V: the flap's
+  grip on the flutter mode and the phase a controller needs to damp it.
 - :func:`simulate_loop` — the nonlinear discrete ROM in feedback with Σs (paper Fig. 9).
 - :func:`build_lft` — the uncertainty LFT of eq. 10-15 (Lemmas 1-2).
 - :class:`RFASystem` — ΣAE(U) in the airspeed from a rational-function approximation of
@@ -19,6 +21,7 @@ from ._lft import AeroelasticLFT, build_lft
 from ._loop import (AeroelasticLoop, AeroelasticSystem, LoopFamily, ParametricSystem,
                     ServoSystem, aeroelastic_loop, split_sigma_f)
 from ._pk import PKResult, pk_flutter
+from ._residues import ModeResidues, mode_residues
 from ._rfa_system import RFASystem
 from ._simulate import LoopSimulation, simulate_loop
 from ._tracking import EigenTracking, eig_sorted_by_reference, track_eigenvalues
@@ -31,5 +34,5 @@ __all__ = [
     "EigenTracking", "track_eigenvalues", "eig_sorted_by_reference",
     "Crossing", "FlutterResult", "find_flutter", "origin_modes",
     "AeroelasticLFT", "build_lft", "RFASystem", "PKResult", "pk_flutter",
-    "LoopSimulation", "simulate_loop", "TruthLoop",
+    "LoopSimulation", "simulate_loop", "TruthLoop", "ModeResidues", "mode_residues",
 ]

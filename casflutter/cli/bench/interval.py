@@ -12,6 +12,13 @@ the paper's interval V ∈ (0.05, 2.4)?  Two continuations bracket the answer
 Every controller's exact stable interval is then certified by the independent verification
 layer (:func:`casflutter.verify.verify_controller`, guardian map on the LFT at Vf).
 
+``--start FILE`` (repeatable) continues a saved controller (a verification-layer JSON,
+``v = K zm``) from the low end as well: whether a controller that holds one model, e.g. the
+wing, can be carried over the interval on another.  ``--servo W`` puts the ROM loop's flap
+behind the servo (:class:`casflutter.aeroelastic.ServoSystem`) for the continuations and their
+certificates, as on the wing; the paper's design at Vf stays the LFT's (eq. 14-16), and the
+loop with the servo is certified by :func:`casflutter.verify.speed_family_interval`.
+
 With ``--model truth`` the same question is asked of the wing itself: the truth's own
 full-order linearisation with the flap behind a servo (:class:`casflutter.aeroelastic.TruthLoop`),
 continued from the high end by a full-order LQG start and from the low end by ``--orders``
@@ -136,6 +143,25 @@ def _from_high_end(family, lo: float, hi: float):
     return stabilize_interval(family, K0, (lo, hi), anchor="high")
 
 
+def _start_runs(family, lo: float, hi: float, starts, verify, doc, write) -> None:
+    """Each saved controller of ``starts`` (path, controller) continued from the low end."""
+    from ...design import stabilize_interval  # noqa: PLC0415
+    from ...errors import ConfigError  # noqa: PLC0415
+
+    for path, K in starts:
+        t0 = time.perf_counter()
+        try:
+            reach = stabilize_interval(family, K, (lo, hi), anchor="low")
+        except ConfigError as exc:     # it does not hold this model's low end
+            _log.warning("start %s: %s", path, exc)
+            doc["runs"].append({"start": f"file {path}", "order": K.nstates, "anchor": "low",
+                                "reached": None, "met": False, "error": str(exc)})
+            write()
+            continue
+        _add_run(doc, write, f"{path}, order {K.nstates} from the low end", f"file {path}",
+                 K.nstates, reach, verify(0.5 * sum(reach.reached), reach.controller), t0)
+
+
 def _truth_runs(family, lo: float, hi: float, orders, doc, write) -> None:
     """Full order from the high end, then ``orders`` from the low end, on the truth loop."""
     import control  # noqa: PLC0415
@@ -178,6 +204,7 @@ def _handler(args: argparse.Namespace) -> int:
     from ...errors import CasflutterError, ConfigError  # noqa: PLC0415
     from ...pipeline import load_config  # noqa: PLC0415
     from ...truth import AeroelasticTruth  # noqa: PLC0415
+    from ...verify import load_controller  # noqa: PLC0415
     from ..._outputs import check_output_path  # noqa: PLC0415
     from ..._settings import settings_as  # noqa: PLC0415
 
@@ -194,6 +221,7 @@ def _handler(args: argparse.Namespace) -> int:
     try:    # everything checked before any design work; nothing is written until a result
         out = check_output_path(args.out, what="--out", suffixes=(".json",))
         cfg = load_config(args.config)
+        starts = [(path, load_controller(path)) for path in args.start]
         if args.model == "truth":
             truth = cfg.problem.load()
             if not isinstance(truth, AeroelasticTruth):
@@ -203,12 +231,20 @@ def _handler(args: argparse.Namespace) -> int:
                                             if args.servo is None else args.servo))
         else:
             system, Vf = load_rom_loop(Path(args.rom))
+            family = system if args.servo is None else system.with_servo(float(args.servo))
+        sensors = family.loop(hi).C2.shape[0]
+        for path, K in starts:
+            if K.ninputs != sensors or K.noutputs != 1:
+                raise ConfigError(f"--start {path}: a controller with {K.ninputs} inputs and "
+                                  f"{K.noutputs} outputs; this loop needs v = K zm, {sensors} "
+                                  "sensors in and the flap command out")
     except (OSError, CasflutterError) as exc:
         print(f"casflutter bench interval: {exc}", file=sys.stderr)
         return 2
     c = cfg.controller
     options = replace(settings_as(c, SynthesisOptions), ipopt={**cfg.solver.ipopt, **c.ipopt})
-    doc: dict[str, Any] = ({"model": "rom", "rom": str(args.rom), "Vf": Vf}
+    doc: dict[str, Any] = ({"model": "rom", "rom": str(args.rom), "Vf": Vf,
+                            "servo_omega": args.servo}
                            if args.model == "rom" else
                            {"model": "truth", "problem": cfg.problem.name,
                             "servo_omega": family.servo_omega, "servo_zeta": family.servo_zeta})
@@ -232,6 +268,13 @@ def _handler(args: argparse.Namespace) -> int:
         tmp.write_text(json.dumps(doc, indent=1, default=float))
         tmp.replace(out)
 
+    if args.model == "truth" or args.servo is not None:
+        def verify(nominal, K):
+            return _verified_family(family, nominal, K)
+    else:
+        def verify(nominal, K):
+            return _verified(system, nominal, K)
+    _start_runs(family, lo, hi, starts, verify, doc, write)
     if args.model == "truth":
         _truth_runs(family, lo, hi, orders, doc, write)
         doc["rhp_zero_crossings"] = _rhp_zero_crossings(family, lo, hi, tuple(args.zero_band))
@@ -243,18 +286,18 @@ def _handler(args: argparse.Namespace) -> int:
         design = design_flutter_controller(
             system, Vf, order, starts=c.starts, seed=args.seed, options=options,
             flap_rate_weight=c.flap_rate_weight, flap_rate_bandwidth=c.flap_rate_bandwidth)
-        reach = stabilize_interval(system, design.controller, (lo, hi), anchor="low")
+        reach = stabilize_interval(family, design.controller, (lo, hi), anchor="low")
         _add_run(doc, write, f"order {order} from the low end",
                  f"paper design at Vf (seed {args.seed})", order, reach,
-                 _verified(system, Vf, reach.controller), t0,
+                 verify(Vf, reach.controller), t0,
                  verified_start=_verified(system, Vf, design.controller))   # γ at Vf
     if args.full_order:
         t0 = time.perf_counter()
-        reach = _from_high_end(system, lo, hi)
+        reach = _from_high_end(family, lo, hi)
         n = reach.controller.nstates
         _add_run(doc, write, f"full order {n} from the high end", f"LQG at V = {hi:g}", n,
-                 reach, _verified(system, hi, reach.controller), t0)
-    doc["rhp_zero_crossings"] = _rhp_zero_crossings(system, lo, hi, tuple(args.zero_band))
+                 reach, verify(hi, reach.controller), t0)
+    doc["rhp_zero_crossings"] = _rhp_zero_crossings(family, lo, hi, tuple(args.zero_band))
     write()
     print(f"wrote {out}", file=sys.stderr)
     return 0
@@ -270,8 +313,9 @@ def register(subparsers) -> None:
                    help="the ROM loop (default) or the truth's own linearisation with the "
                         "flap behind a servo")
     p.add_argument("--servo", type=float, default=None,
-                   help="--model truth: servo natural frequency [rad/s] (default: the run "
-                        "configuration's controller.flap_rate_bandwidth)")
+                   help="servo natural frequency [rad/s] of the flap: --model truth (default: "
+                        "the run configuration's controller.flap_rate_bandwidth), or the ROM "
+                        "loop with the flap behind a servo (default: no servo)")
     p.add_argument("--rom", default=str(DEFAULT_ROM),
                    help="ROM loop .npz (default: the seed wing's, seed 0)")
     p.add_argument("--config", default=None,
@@ -279,6 +323,9 @@ def register(subparsers) -> None:
                         "wing's run.toml)")
     p.add_argument("--interval", default="0.05,2.4", help="target speed-index interval LO,HI")
     p.add_argument("--orders", default="3", help="orders of the low-end continuations")
+    p.add_argument("--start", action="append", default=[], metavar="FILE",
+                   help="a saved controller (verification JSON, v = K zm) to continue from "
+                        "the low end as well; repeatable")
     p.add_argument("--full-order", action=argparse.BooleanOptionalAction, default=True,
                    help="also the full-order continuation from the high end")
     p.add_argument("--zero-band", type=float, nargs=2, default=(20.0, 80.0),

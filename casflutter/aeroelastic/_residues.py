@@ -1,0 +1,176 @@
+"""The flap's grip on one aeroelastic mode along the speed: its residue in ΣAE(V) (eq. 8-9).
+
+A controller ``v = K(s) zm`` (the flap command from the sensors) moves an open-loop eigenvalue
+``λ`` of ΣAE(V), to first order in the controller, by
+
+.. math:: \\delta\\lambda = K(\\lambda)\\, r, \\qquad
+          r_j = \\frac{(w^H B_2)\\,(C_2 v)_j}{w^H v},
+
+with ``v`` and ``w`` the right and left eigenvectors of ``A(V)`` at ``λ`` (the first-order
+eigenvalue perturbation of ``A + B_2 K C_2``).  The residue ``r`` is what a controller has to
+work with: its size is the flap's authority over the mode (times the sensors' view of it), its
+phase says which phase ``K(jω)`` must have near the mode's frequency to damp it
+(``Re(K r) < 0``).  Where ``r`` turns through 180° along V while the mode's frequency hardly
+moves, a controller that damps the mode on one side of the turn pushes it the wrong way on
+the other, to first order; only a controller whose phase changes fast enough in frequency, or
+a large enough gain to move the mode far, holds both sides.  The turn comes with a dip in
+``|r|``: near it the flap hardly reaches the mode (the mode's own control reversal).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ConfigError
+
+__all__ = ["ModeResidues", "mode_residues"]
+
+
+@dataclass(frozen=True)
+class ModeResidues:
+    """Outcome of :func:`mode_residues`: one mode of ΣAE(V) and its residues along V.
+
+    Attributes
+    ----------
+    V : ndarray, shape (nV,)
+        Speed indices (the requested ones plus the tracking's refinement points), increasing.
+    eigenvalue : ndarray, shape (nV,)
+        The mode's open-loop eigenvalue (upper half-plane) at each speed.
+    residues : ndarray, shape (nV, n_sensors)
+        ``r_j``: the eigenvalue's first-order shift per unit static gain from sensor ``j`` to
+        the flap command (``v = K zm``); for a dynamic controller ``δλ = K(λ) r``.
+    """
+
+    V: np.ndarray
+    eigenvalue: np.ndarray
+    residues: np.ndarray
+
+    @property
+    def authority(self) -> np.ndarray:
+        """``|r_j|`` per speed and sensor [rad/s per unit gain]."""
+        return np.abs(self.residues)
+
+    @property
+    def phase_deg(self) -> np.ndarray:
+        """``arg r_j`` per speed and sensor [deg], unwrapped along V (continuous)."""
+        return np.degrees(np.unwrap(np.angle(self.residues), axis=0))
+
+    @property
+    def phase_swing_deg(self) -> np.ndarray:
+        """How far each sensor's residue turns over the speeds: ``max − min`` of
+        :attr:`phase_deg` [deg], per sensor."""
+        p = self.phase_deg
+        return p.max(axis=0) - p.min(axis=0)
+
+    @property
+    def weakest_V(self) -> float:
+        """The speed at which the flap's grip on the mode is weakest (smallest ``‖r‖``)."""
+        return float(self.V[int(np.argmin(np.linalg.norm(self.residues, axis=1)))])
+
+
+def _eig_at(family, V: float):
+    """Eigenvalues, unit right eigenvectors and the loop at V."""
+    lp = family.loop(float(V))
+    lam, R = np.linalg.eig(lp.A)
+    return lam, R / np.linalg.norm(R, axis=0), lp
+
+
+def _follow(prev, cand, min_score: float):
+    """The eigenpair of ``cand`` (upper half-plane) whose right eigenvector is most parallel
+    to the previous one, and that overlap."""
+    lam, R, _ = cand
+    upper = np.flatnonzero(lam.imag > 0)
+    overlap = np.abs(prev.conj() @ R[:, upper])
+    k = int(np.argmax(overlap))
+    return int(upper[k]), float(overlap[k])
+
+
+def mode_residues(family, speeds, *, mode: complex | None = None, min_score: float = 0.9,
+                  max_refine: int = 8) -> ModeResidues:
+    """The residues of one mode of ΣAE(V) in the flap-to-sensor loop along the speed.
+
+    Parameters
+    ----------
+    family : LoopFamily
+        ΣAE(V) at any speed index (an :class:`AeroelasticSystem`, a :class:`ServoSystem`, a
+        :class:`TruthLoop`, ...): ``family.loop(V)`` gives ``A``, ``B2`` (the flap or the servo
+        command) and ``C2`` (the sensors).
+    speeds : array_like
+        Increasing, finite speed indices (at least 2).  The mode is followed along them by
+        the continuity of its right eigenvector (the most parallel one of the next speed);
+        a step whose overlap is below ``min_score`` is bisected, up to ``max_refine`` times.
+    mode : complex, optional
+        The mode: the upper-half-plane eigenvalue nearest to ``mode`` at the first speed,
+        followed upwards.  Default: the flutter mode, the upper-half-plane eigenvalue with the
+        largest real part at the last speed, followed downwards.
+    min_score : float
+        Smallest accepted eigenvector overlap between neighbouring speeds, in (0, 1).
+    max_refine : int
+        Bisections per step at most.
+
+    Returns
+    -------
+    ModeResidues
+
+    Raises
+    ------
+    ConfigError
+        A family without ``loop(V)``, speeds that are not increasing and finite, a
+        ``min_score`` outside (0, 1), or a loop without a complex mode.
+
+    Notes
+    -----
+    With ``w`` the row of ``R⁻¹`` that belongs to the mode (so that ``w v = 1``),
+    ``r_j = (w B_2) (C_2 v)_j``.  The feed-through ``D22`` of accelerometers enters
+    ``A + B_2 K (I − D_22 K)⁻¹ C_2`` only at second order in ``K``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from casflutter.aeroelastic import TruthLoop, mode_residues
+    >>> from casflutter.truth import SeedWing
+    >>> res = mode_residues(TruthLoop(SeedWing(), 251.3), np.linspace(1.1, 2.4, 27))
+    >>> bool(res.phase_swing_deg.min() > 150)        # the flap's grip turns round
+    True
+    """
+    if not callable(getattr(family, "loop", None)):
+        raise ConfigError(f"family must be a loop family with loop(V); got "
+                          f"{type(family).__name__}")
+    grid = np.asarray(speeds, dtype=float).ravel()
+    if grid.size < 2 or not np.all(np.isfinite(grid)) or np.any(np.diff(grid) <= 0):
+        raise ConfigError("speeds must hold at least 2 finite, strictly increasing speed "
+                          "indices")
+    if not 0.0 < min_score < 1.0:
+        raise ConfigError(f"min_score must be in (0, 1), got {min_score}")
+    order = grid if mode is not None else grid[::-1]
+    first = _eig_at(family, order[0])
+    lam0 = first[0]
+    upper = np.flatnonzero(lam0.imag > 0)
+    if upper.size == 0:
+        raise ConfigError(f"ΣAE(V = {order[0]:g}) has no complex mode to follow")
+    k = int(upper[np.argmin(np.abs(lam0[upper] - complex(mode)))] if mode is not None
+            else upper[np.argmax(lam0[upper].real)])
+    points = [(float(order[0]), first, k)]
+    for V in order[1:]:
+        pending = [(float(V), 0)]
+        while pending:
+            Vb, depth = pending[-1]
+            Va, cand_a, ka = points[-1]
+            cand = _eig_at(family, Vb)
+            kb, score = _follow(cand_a[1][:, ka], cand, min_score)
+            if score < min_score and depth < max_refine:
+                pending[-1] = (Vb, depth + 1)
+                pending.append((0.5 * (Va + Vb), depth + 1))
+                continue
+            pending.pop()
+            points.append((Vb, cand, kb))
+    if mode is None:
+        points.reverse()
+    res = []
+    for _, (lam, R, lp), b in points:
+        w = np.linalg.solve(R.T, np.eye(R.shape[0])[b])     # row b of R⁻¹: w v = 1
+        res.append((w @ lp.B2) * (lp.C2 @ R[:, b]))
+    return ModeResidues(np.array([p[0] for p in points]),
+                        np.array([p[1][0][p[2]] for p in points]), np.array(res))
