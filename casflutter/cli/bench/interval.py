@@ -14,7 +14,8 @@ layer (:func:`casflutter.verify.verify_controller`, guardian map on the LFT at V
 
 ``--start FILE`` (repeatable) continues a saved controller (a verification-layer JSON,
 ``v = K zm``) from the low end as well: whether a controller that holds one model, e.g. the
-wing, can be carried over the interval on another.  ``--servo W`` puts the ROM loop's flap
+wing, can be carried over the interval on another (a start that does not hold this model's
+low end is recorded with the reason).  ``--servo W`` puts the ROM loop's flap
 behind the servo (:class:`casflutter.aeroelastic.ServoSystem`) for the continuations and their
 certificates, as on the wing; the paper's design at Vf stays the LFT's (eq. 14-16), and the
 loop with the servo is certified by :func:`casflutter.verify.speed_family_interval`.
@@ -234,6 +235,9 @@ def _handler(args: argparse.Namespace) -> int:
             family = system if args.servo is None else system.with_servo(float(args.servo))
         sensors = family.loop(hi).C2.shape[0]
         for path, K in starts:
+            if K.nstates == 0:
+                raise ConfigError(f"--start {path}: a static gain; the continuation moves a "
+                                  "dynamic controller's (A, B, C), so give one of order >= 1")
             if K.ninputs != sensors or K.noutputs != 1:
                 raise ConfigError(f"--start {path}: a controller with {K.ninputs} inputs and "
                                   f"{K.noutputs} outputs; this loop needs v = K zm, {sensors} "
@@ -251,8 +255,9 @@ def _handler(args: argparse.Namespace) -> int:
     doc.update({"target": [lo, hi], "runs": []})
 
     def write():
-        reached_low = [r["reached"][1] for r in doc["runs"] if r["anchor"] == "low"]
-        reached_high = [r["reached"][0] for r in doc["runs"] if r["anchor"] == "high"]
+        runs = [r for r in doc["runs"] if r["reached"] is not None]    # not: a start refused
+        reached_low = [r["reached"][1] for r in runs if r["anchor"] == "low"]
+        reached_high = [r["reached"][0] for r in runs if r["anchor"] == "high"]
         doc["summary"] = {
             "highest_upper_end_from_low": max(reached_low, default=None),
             "lowest_lower_end_from_high": min(reached_high, default=None),
@@ -260,7 +265,7 @@ def _handler(args: argparse.Namespace) -> int:
             "target_certified_by_any": any(
                 r["verified_exact_interval"] is not None
                 and r["verified_exact_interval"][0] <= lo
-                and r["verified_exact_interval"][1] >= hi for r in doc["runs"]),
+                and r["verified_exact_interval"][1] >= hi for r in runs),
             "machine": {"cpus": os.cpu_count(), "load_average": list(os.getloadavg())
                         if hasattr(os, "getloadavg") else None}}
         out.parent.mkdir(parents=True, exist_ok=True)
