@@ -115,3 +115,16 @@ def test_a_saved_controller_is_continued_on_the_rom_loop_with_the_servo(tmp_path
     lo, hi = run["verified_exact_interval"]
     assert lo <= 0.05 and hi >= 1.0                    # the certificate covers the claim
     assert doc["summary"]["target_certified_by_any"]
+    # below the ROM loop's flutter speed (1.2) the flutter mode is stable: no dip to report
+    grip = doc["flutter_mode_grip"]
+    assert "weakest_unstable_V" not in grip and grip["worst_overlap"] >= 0.9
+    assert 55 < grip["eigenvalue_at_hi"][1] < 65
+
+
+def test_the_flutter_mode_grip_record_finds_the_frozen_rom_loops_dip():
+    from casflutter.cli.bench.interval import _flutter_mode_grip, load_rom_loop
+    rom, Vf = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
+    rec = _flutter_mode_grip(rom.with_servo(251.3), 0.05, 2.4)
+    assert 1.85 < rec["weakest_unstable_V"] < 2.05 and rec["growth_rate_there"] > 6
+    assert rec["grip_there"] < rec["grip_at_onset"] / 3       # almost four times weaker
+    assert min(rec["phase_swing_deg"]) > 180
