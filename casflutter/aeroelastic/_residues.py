@@ -41,11 +41,16 @@ class ModeResidues:
     residues : ndarray, shape (nV, n_sensors)
         ``r_j``: the eigenvalue's first-order shift per unit static gain from sensor ``j`` to
         the flap command (``v = K zm``); for a dynamic controller ``δλ = K(λ) r``.
+    worst_overlap : float
+        The smallest eigenvector overlap accepted between neighbouring speeds (1: the mode
+        was followed without doubt; below the call's ``min_score``: a step still ambiguous
+        after ``max_refine`` bisections, e.g. where two modes veer).
     """
 
     V: np.ndarray
     eigenvalue: np.ndarray
     residues: np.ndarray
+    worst_overlap: float
 
     @property
     def authority(self) -> np.ndarray:
@@ -153,6 +158,7 @@ def mode_residues(family, speeds, *, mode: complex | None = None, min_score: flo
     k = int(upper[np.argmin(np.abs(lam0[upper] - complex(mode)))] if mode is not None
             else upper[np.argmax(lam0[upper].real)])
     points = [(float(order[0]), first, k)]
+    worst = 1.0
     for V in order[1:]:
         pending = [(float(V), 0)]
         while pending:
@@ -166,6 +172,7 @@ def mode_residues(family, speeds, *, mode: complex | None = None, min_score: flo
                 continue
             pending.pop()
             points.append((Vb, cand, kb))
+            worst = min(worst, score)
     if mode is None:
         points.reverse()
     res = []
@@ -173,4 +180,4 @@ def mode_residues(family, speeds, *, mode: complex | None = None, min_score: flo
         w = np.linalg.solve(R.T, np.eye(R.shape[0])[b])     # row b of R⁻¹: w v = 1
         res.append((w @ lp.B2) * (lp.C2 @ R[:, b]))
     return ModeResidues(np.array([p[0] for p in points]),
-                        np.array([p[1][0][p[2]] for p in points]), np.array(res))
+                        np.array([p[1][0][p[2]] for p in points]), np.array(res), worst)

@@ -82,8 +82,10 @@ fig.tight_layout()
 #   the servo);
 # * on the wing, order-3 controllers continued up from V = 0.05 reach 2.24-2.27, and
 #   order-3 controllers that stabilise V = 2.4 continued down stop either just above the dip
-#   (1.48-1.53) or, with a resonator at 68-76 rad/s, cross it and stop at 1.03-1.23, where the
-#   resonator destabilises the lightly damped lateral mode (63 rad/s, 0.5 %).  Two order-3
+#   (1.48-1.53) or, with a resonator at 68-76 rad/s, cross it and stop at 1.03-1.23, where they
+#   destabilise the same mode below its flutter speed (the flutter mode grows out of the
+#   lateral mode, 63 rad/s at rest and damped 0.5 %, and there its residue points the other
+#   way).  Two order-3
 #   controllers hold (0, 2.26) and (1.03, 2.40) (``problems/seed_wing/``, certified in the
 #   tests); one order-4 controller holds (0, 2.41).
 #

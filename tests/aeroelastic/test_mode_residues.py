@@ -57,6 +57,7 @@ def test_the_flutter_mode_is_followed_from_either_end(wing):
     down = mode_residues(wing, SPEEDS)                    # from the most unstable mode at 2.4
     up = mode_residues(wing, SPEEDS, mode=down.eigenvalue[0])
     assert np.allclose(up.eigenvalue, down.eigenvalue, rtol=1e-12)
+    assert down.worst_overlap >= 0.9 and up.worst_overlap >= 0.9
     assert down.eigenvalue[-1].real > 8 and 45 < down.eigenvalue[-1].imag < 60
     # the mode's frequency moves little: 59 -> 48 rad/s
     assert np.ptp(down.eigenvalue.imag) < 12

@@ -56,7 +56,8 @@ def test_truth_model_refuses_a_bad_servo_before_any_work(tmp_path, capsys):
 
 def test_a_start_controller_of_the_wrong_shape_is_refused_before_any_work(tmp_path, capsys):
     bad = tmp_path / "k.json"
-    bad.write_text('{"D": [[1.0, 2.0, 3.0]]}')          # three sensors; the loop has two
+    bad.write_text('{"A": [[-1.0]], "B": [[1.0, 1.0, 1.0]], "C": [[1.0]], '
+                   '"D": [[0.0, 0.0, 0.0]]}')          # three sensors; the loop has two
     t0 = time.perf_counter()
     assert main(["bench", "interval", "--start", str(bad), "--out",
                  str(tmp_path / "b.json")]) == 2
@@ -64,6 +65,28 @@ def test_a_start_controller_of_the_wrong_shape_is_refused_before_any_work(tmp_pa
     err = capsys.readouterr().err
     assert "k.json" in err and "3 inputs" in err and "2 sensors" in err
     assert not (tmp_path / "b.json").exists()
+
+
+def test_a_static_start_is_refused_before_any_work(tmp_path, capsys):
+    gain = tmp_path / "k.json"
+    gain.write_text('{"D": [[1.0, 2.0]]}')
+    assert main(["bench", "interval", "--start", str(gain), "--out",
+                 str(tmp_path / "b.json")]) == 2
+    assert "static gain" in capsys.readouterr().err
+    assert not (tmp_path / "b.json").exists()
+
+
+def test_a_start_that_does_not_hold_the_low_end_is_recorded_with_the_reason(tmp_path):
+    bad = tmp_path / "unstable.json"          # its own pole at +1 stays in the closed loop
+    bad.write_text('{"A": [[1.0]], "B": [[1e-6, 1e-6]], "C": [[1e-6]], "D": [[0.0, 0.0]]}')
+    out = tmp_path / "b.json"
+    assert main(["bench", "interval", "--start", str(bad), "--orders", "", "--no-full-order",
+                 "--interval", "0.05,1.0", "--out", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    (run,) = doc["runs"]
+    assert run["reached"] is None and not run["met"] and "anchor" in run["error"]
+    assert doc["summary"]["highest_upper_end_from_low"] is None
+    assert not doc["summary"]["target_certified_by_any"]
 
 
 def test_a_missing_start_file_and_a_bad_rom_servo_are_named(tmp_path, capsys):
@@ -92,3 +115,16 @@ def test_a_saved_controller_is_continued_on_the_rom_loop_with_the_servo(tmp_path
     lo, hi = run["verified_exact_interval"]
     assert lo <= 0.05 and hi >= 1.0                    # the certificate covers the claim
     assert doc["summary"]["target_certified_by_any"]
+    # below the ROM loop's flutter speed (1.2) the flutter mode is stable: no dip to report
+    grip = doc["flutter_mode_grip"]
+    assert "weakest_unstable_V" not in grip and grip["worst_overlap"] >= 0.9
+    assert 55 < grip["eigenvalue_at_hi"][1] < 65
+
+
+def test_the_flutter_mode_grip_record_finds_the_frozen_rom_loops_dip():
+    from casflutter.cli.bench.interval import _flutter_mode_grip, load_rom_loop
+    rom, Vf = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
+    rec = _flutter_mode_grip(rom.with_servo(251.3), 0.05, 2.4)
+    assert 1.85 < rec["weakest_unstable_V"] < 2.05 and rec["growth_rate_there"] > 6
+    assert rec["grip_there"] < rec["grip_at_onset"] / 3       # almost four times weaker
+    assert min(rec["phase_swing_deg"]) > 180

@@ -14,7 +14,8 @@ layer (:func:`casflutter.verify.verify_controller`, guardian map on the LFT at V
 
 ``--start FILE`` (repeatable) continues a saved controller (a verification-layer JSON,
 ``v = K zm``) from the low end as well: whether a controller that holds one model, e.g. the
-wing, can be carried over the interval on another.  ``--servo W`` puts the ROM loop's flap
+wing, can be carried over the interval on another (a start that does not hold this model's
+low end is recorded with the reason).  ``--servo W`` puts the ROM loop's flap
 behind the servo (:class:`casflutter.aeroelastic.ServoSystem`) for the continuations and their
 certificates, as on the wing; the paper's design at Vf stays the LFT's (eq. 14-16), and the
 loop with the servo is certified by :func:`casflutter.verify.speed_family_interval`.
@@ -25,8 +26,10 @@ continued from the high end by a full-order LQG start and from the low end by ``
 controllers (balanced truncations of the high-end result), each certified on the truth by
 :func:`casflutter.verify.speed_family_interval` (guardian map of the loop, quadratic in V).  The JSON
 also lists, per accelerometer channel, the speeds at which a complex zero pair of
-``v → zm_j`` crosses into the right half-plane near the flutter frequency: the plant property
-the two continuations stall at.
+``v → zm_j`` crosses into the right half-plane near the flutter frequency, and the flutter
+mode's grip (``flutter_mode_grip``: how far its residues in the flap-to-sensor loop turn over
+the interval and, where the mode is unstable, the speed of the flap's weakest grip): the plant
+properties the continuations stall at.
 """
 
 from __future__ import annotations
@@ -98,6 +101,27 @@ def _rhp_zero_crossings(system, lo: float, hi: float, band: tuple[float, float],
                                                                  float(zz.imag)]})
             prev = inband.size
     return out
+
+
+def _flutter_mode_grip(family, lo: float, hi: float, n: int = 120) -> dict[str, Any]:
+    """The flutter mode's residues over ``[lo, hi]`` (:func:`casflutter.aeroelastic.mode_residues`):
+    how far they turn and, where the mode is unstable, the speed of the flap's weakest grip."""
+    from ...aeroelastic import mode_residues  # noqa: PLC0415
+
+    res = mode_residues(family, np.linspace(lo, hi, n))
+    grip = np.linalg.norm(res.residues, axis=1)
+    rec: dict[str, Any] = {"phase_swing_deg": res.phase_swing_deg.tolist(),
+                           "worst_overlap": res.worst_overlap,
+                           "eigenvalue_at_hi": [float(res.eigenvalue[-1].real),
+                                                float(res.eigenvalue[-1].imag)]}
+    unstable = np.flatnonzero(res.eigenvalue.real > 0)
+    if unstable.size:
+        k = int(unstable[np.argmin(grip[unstable])])
+        rec.update({"weakest_unstable_V": float(res.V[k]),
+                    "growth_rate_there": float(res.eigenvalue[k].real),
+                    "frequency_there": float(res.eigenvalue[k].imag),
+                    "grip_there": float(grip[k]), "grip_at_onset": float(grip[unstable[0]])})
+    return rec
 
 
 def _verified(system, nominal: float, K) -> dict[str, Any]:
@@ -234,6 +258,9 @@ def _handler(args: argparse.Namespace) -> int:
             family = system if args.servo is None else system.with_servo(float(args.servo))
         sensors = family.loop(hi).C2.shape[0]
         for path, K in starts:
+            if K.nstates == 0:
+                raise ConfigError(f"--start {path}: a static gain; the continuation moves a "
+                                  "dynamic controller's (A, B, C), so give one of order >= 1")
             if K.ninputs != sensors or K.noutputs != 1:
                 raise ConfigError(f"--start {path}: a controller with {K.ninputs} inputs and "
                                   f"{K.noutputs} outputs; this loop needs v = K zm, {sensors} "
@@ -251,8 +278,9 @@ def _handler(args: argparse.Namespace) -> int:
     doc.update({"target": [lo, hi], "runs": []})
 
     def write():
-        reached_low = [r["reached"][1] for r in doc["runs"] if r["anchor"] == "low"]
-        reached_high = [r["reached"][0] for r in doc["runs"] if r["anchor"] == "high"]
+        runs = [r for r in doc["runs"] if r["reached"] is not None]    # not: a start refused
+        reached_low = [r["reached"][1] for r in runs if r["anchor"] == "low"]
+        reached_high = [r["reached"][0] for r in runs if r["anchor"] == "high"]
         doc["summary"] = {
             "highest_upper_end_from_low": max(reached_low, default=None),
             "lowest_lower_end_from_high": min(reached_high, default=None),
@@ -260,7 +288,7 @@ def _handler(args: argparse.Namespace) -> int:
             "target_certified_by_any": any(
                 r["verified_exact_interval"] is not None
                 and r["verified_exact_interval"][0] <= lo
-                and r["verified_exact_interval"][1] >= hi for r in doc["runs"]),
+                and r["verified_exact_interval"][1] >= hi for r in runs),
             "machine": {"cpus": os.cpu_count(), "load_average": list(os.getloadavg())
                         if hasattr(os, "getloadavg") else None}}
         out.parent.mkdir(parents=True, exist_ok=True)
@@ -278,6 +306,7 @@ def _handler(args: argparse.Namespace) -> int:
     if args.model == "truth":
         _truth_runs(family, lo, hi, orders, doc, write)
         doc["rhp_zero_crossings"] = _rhp_zero_crossings(family, lo, hi, tuple(args.zero_band))
+        doc["flutter_mode_grip"] = _flutter_mode_grip(family, lo, hi)
         write()
         print(f"wrote {out}", file=sys.stderr)
         return 0
@@ -298,6 +327,7 @@ def _handler(args: argparse.Namespace) -> int:
         _add_run(doc, write, f"full order {n} from the high end", f"LQG at V = {hi:g}", n,
                  reach, verify(hi, reach.controller), t0)
     doc["rhp_zero_crossings"] = _rhp_zero_crossings(family, lo, hi, tuple(args.zero_band))
+    doc["flutter_mode_grip"] = _flutter_mode_grip(family, lo, hi)
     write()
     print(f"wrote {out}", file=sys.stderr)
     return 0
