@@ -5,7 +5,8 @@
   :class:`ParametricSystem` — the same with Σf interpolated in V; :class:`TruthLoop` — the
   truth's own linearisation as the same loop (flap behind a servo), what the ROM stands in for;
   :class:`ServoSystem` (``AeroelasticSystem.with_servo``) — a ROM family behind the same servo;
-  :class:`LoopFamily` — the interface they share (a loop at every speed index).
+  :class:`LoopFamily` — the interface they share (a loop at every speed index);
+  :func:`load_rom_loop` — a ROM loop kept in an ``.npz`` file.
 - :func:`track_eigenvalues`, :func:`find_flutter` — branch tracking by eigenvector
   continuity, V–g / V–f data, flutter (Hopf) and divergence speeds.
 - :func:`mode_residues` — a mode's residues in the flap-to-sensor loop along V: the flap's
@@ -23,6 +24,7 @@ from ._loop import (AeroelasticLoop, AeroelasticSystem, LoopFamily, ParametricSy
 from ._pk import PKResult, pk_flutter
 from ._residues import ModeResidues, mode_residues
 from ._rfa_system import RFASystem
+from ._rom_loop_file import load_rom_loop
 from ._simulate import LoopSimulation, simulate_loop
 from ._tracking import EigenTracking, eig_sorted_by_reference, track_eigenvalues
 from ._truth_loop import TruthLoop
@@ -35,4 +37,5 @@ __all__ = [
     "Crossing", "FlutterResult", "find_flutter", "origin_modes",
     "AeroelasticLFT", "build_lft", "RFASystem", "PKResult", "pk_flutter",
     "LoopSimulation", "simulate_loop", "TruthLoop", "ModeResidues", "mode_residues",
+    "load_rom_loop",
 ]

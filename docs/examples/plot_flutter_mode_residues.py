@@ -21,8 +21,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from casflutter._resources import problems_dir
-from casflutter.aeroelastic import TruthLoop, mode_residues
-from casflutter.cli.bench.interval import load_rom_loop
+from casflutter.aeroelastic import TruthLoop, load_rom_loop, mode_residues
 from casflutter.truth import SeedWing
 
 SERVO = 251.3                            # rad/s: the wind-tunnel servo, 40 Hz

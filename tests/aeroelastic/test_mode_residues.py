@@ -13,8 +13,7 @@ import numpy as np
 import pytest
 
 from casflutter._resources import problems_dir
-from casflutter.aeroelastic import TruthLoop, mode_residues
-from casflutter.cli.bench.interval import load_rom_loop
+from casflutter.aeroelastic import TruthLoop, load_rom_loop, mode_residues
 from casflutter.errors import ConfigError
 from casflutter.truth import SeedWing
 

@@ -27,8 +27,7 @@ import pytest
 
 from casflutter._resources import problems_dir
 from casflutter.aeroelastic import (AeroelasticSystem, ParametricSystem, TruthLoop, build_lft,
-                                   find_flutter)
-from casflutter.cli.bench.interval import DEFAULT_ROM, load_rom_loop
+                                   find_flutter, load_rom_loop)
 from casflutter.errors import ConfigError
 from casflutter.ident import identify_common_denominator
 from casflutter.realize import ParametricROM, speed_nodes
@@ -72,7 +71,7 @@ def test_the_parametric_rom_predicts_the_closed_loop_on_the_wing(models):
 
 def test_the_frozen_rom_does_not(models):
     _, _, K = models
-    frozen, Vf = load_rom_loop(DEFAULT_ROM)
+    frozen, Vf = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
     worst = max(_rightmost(frozen.loop(V).with_servo(SERVO).closed_loop_state_matrix(K)).real
                 for V in SPEEDS[SPEEDS < Vf])
     assert worst > 1.0      # unstable below its own flutter speed (1.2)

@@ -10,18 +10,17 @@ import control
 import numpy as np
 import pytest
 
-from casflutter.aeroelastic import ServoSystem
-from casflutter.cli.bench.interval import DEFAULT_ROM, load_rom_loop
+from casflutter._resources import problems_dir
+from casflutter.aeroelastic import ServoSystem, load_rom_loop
 from casflutter.errors import ConfigError
 from casflutter.verify import load_controller
-from casflutter._resources import problems_dir
 
 OMEGA, ZETA = 251.3, 0.7
 
 
 @pytest.fixture(scope="module")
 def system():
-    return load_rom_loop(DEFAULT_ROM)[0]
+    return load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")[0]
 
 
 def test_every_speed_has_the_servo_in_front_of_the_flap(system):

@@ -122,7 +122,8 @@ def test_a_saved_controller_is_continued_on_the_rom_loop_with_the_servo(tmp_path
 
 
 def test_the_flutter_mode_grip_record_finds_the_frozen_rom_loops_dip():
-    from casflutter.cli.bench.interval import _flutter_mode_grip, load_rom_loop
+    from casflutter.aeroelastic import load_rom_loop
+    from casflutter.cli.bench.interval import _flutter_mode_grip
     rom, Vf = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
     rec = _flutter_mode_grip(rom.with_servo(251.3), 0.05, 2.4)
     assert 1.85 < rec["weakest_unstable_V"] < 2.05 and rec["growth_rate_there"] > 6

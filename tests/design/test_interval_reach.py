@@ -11,16 +11,15 @@ import control
 import numpy as np
 import pytest
 
-from casflutter.aeroelastic import build_lft
+from casflutter._resources import problems_dir
+from casflutter.aeroelastic import build_lft, load_rom_loop
 from casflutter.design import full_order_start, loop_abscissa, stabilize_interval
 from casflutter.errors import ConfigError
 from casflutter.verify import verify_controller
 
-from casflutter.cli.bench.interval import DEFAULT_ROM, load_rom_loop
-
 
 def seed_wing_loop():
-    return load_rom_loop(DEFAULT_ROM)
+    return load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
 
 
 def _exact(system, nominal, K):

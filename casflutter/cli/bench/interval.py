@@ -47,33 +47,9 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
-__all__ = ["register", "load_rom_loop"]
+__all__ = ["register"]
 
 _log = logging.getLogger(__name__)
-_ROOT = Path(__file__).resolve().parents[3]
-DEFAULT_ROM = _ROOT / "problems" / "seed_wing" / "rom_loop_seed0.npz"
-
-
-def load_rom_loop(path: Path):
-    """ΣAE and Vf from an ``.npz`` with Σf (``Af, Bf, bf, Cf, Df, df``), the structure
-    (``omega, zeta, alpha, Hs, sensor``) and ``Vf``."""
-    from ...aeroelastic import AeroelasticSystem  # noqa: PLC0415
-    from ...errors import DataError  # noqa: PLC0415
-    from ...structure import ModalStructure  # noqa: PLC0415
-
-    keys = ("Af", "Bf", "bf", "Cf", "Df", "df", "omega", "zeta", "alpha", "Hs", "sensor", "Vf")
-    try:
-        d = np.load(path)
-    except (OSError, ValueError) as exc:
-        raise DataError(f"{path}: not a readable .npz ROM-loop file ({exc})") from None
-    missing = [k for k in keys if k not in d]
-    if missing:
-        raise DataError(f"{path}: missing {missing}; the file needs {list(keys)} "
-                        "(see problems/seed_wing/rom_loop_seed0.npz)")
-    s = ModalStructure(omega=d["omega"], zeta=d["zeta"], alpha=float(d["alpha"]), Hs=d["Hs"],
-                       sensor=str(d["sensor"]))
-    return (AeroelasticSystem(s, d["Af"], d["Bf"], d["bf"], d["Cf"], d["Df"], d["df"]),
-            float(d["Vf"]))
 
 
 def _rhp_zero_crossings(system, lo: float, hi: float, band: tuple[float, float],
@@ -224,7 +200,8 @@ def _reach_record(kind: str, order: int, reach, verified: dict, wall: float) -> 
 def _handler(args: argparse.Namespace) -> int:
     from ...design import (SynthesisOptions, design_flutter_controller,  # noqa: PLC0415
                            stabilize_interval)
-    from ...aeroelastic import TruthLoop  # noqa: PLC0415
+    from ...aeroelastic import TruthLoop, load_rom_loop  # noqa: PLC0415
+    from ..._resources import problems_dir  # noqa: PLC0415
     from ...errors import CasflutterError, ConfigError  # noqa: PLC0415
     from ...pipeline import load_config  # noqa: PLC0415
     from ...truth import AeroelasticTruth  # noqa: PLC0415
@@ -254,7 +231,9 @@ def _handler(args: argparse.Namespace) -> int:
             family = TruthLoop(truth, float(cfg.controller.flap_rate_bandwidth
                                             if args.servo is None else args.servo))
         else:
-            system, Vf = load_rom_loop(Path(args.rom))
+            rom = (problems_dir() / "seed_wing" / "rom_loop_seed0.npz" if args.rom is None
+                   else Path(args.rom))
+            system, Vf = load_rom_loop(rom)
             family = system if args.servo is None else system.with_servo(float(args.servo))
         sensors = family.loop(hi).C2.shape[0]
         for path, K in starts:
@@ -270,7 +249,7 @@ def _handler(args: argparse.Namespace) -> int:
         return 2
     c = cfg.controller
     options = replace(settings_as(c, SynthesisOptions), ipopt={**cfg.solver.ipopt, **c.ipopt})
-    doc: dict[str, Any] = ({"model": "rom", "rom": str(args.rom), "Vf": Vf,
+    doc: dict[str, Any] = ({"model": "rom", "rom": str(rom), "Vf": Vf,
                             "servo_omega": args.servo}
                            if args.model == "rom" else
                            {"model": "truth", "problem": cfg.problem.name,
@@ -346,8 +325,9 @@ def register(subparsers) -> None:
                    help="servo natural frequency [rad/s] of the flap: --model truth (default: "
                         "the run configuration's controller.flap_rate_bandwidth), or the ROM "
                         "loop with the flap behind a servo (default: no servo)")
-    p.add_argument("--rom", default=str(DEFAULT_ROM),
-                   help="ROM loop .npz (default: the seed wing's, seed 0)")
+    p.add_argument("--rom", default=None,
+                   help="ROM loop .npz (default: the seed wing's default run, seed 0: "
+                        "problems/seed_wing/rom_loop_seed0.npz)")
     p.add_argument("--config", default=None,
                    help="run configuration for the controller settings (default: the seed "
                         "wing's run.toml)")
