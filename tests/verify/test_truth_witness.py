@@ -9,7 +9,7 @@ of ``problems/seed_wing/interval.toml`` (designed on the scaled ROM loop) contin
 (see each file's ``about``).  Whether they hold the wing is not taken from the optimiser: the
 verification layer certifies the exact stable interval (polynomial guardian map, the loop
 closed by python-control), and a dense eigenvalue scan computed here agrees.  At the paper's
-order 3 two controllers hold the two parts of the interval, (0, 2.26) and (1.04, 2.4); no
+order 3 two controllers hold the two parts of the interval, (0, 2.26) and (1.03, 2.40); no
 single one was found.
 """
 
@@ -69,8 +69,9 @@ def test_the_best_order_3_controller_found_holds_the_wing_to_2_26(plant):
 
 def test_an_order_3_controller_holds_the_upper_part_through_the_grip_dip(plant):
     """The other order-3 figure the documentation quotes: a controller that holds the wing from
-    V = 1.04 to 2.4, across the dip of the flap's grip on the flutter mode (V ≈ 1.46), and
-    loses it lower down to the lateral mode its resonator destabilises; a dense scan agrees."""
+    V = 1.03 to 2.40, across the dip of the flap's grip on the flutter mode (V ≈ 1.46), and
+    loses it lower down, where its resonator destabilises the same mode's low-speed branch
+    (the lateral mode); a dense scan agrees."""
     K = load_controller(problems_dir() / "seed_wing" / "truth_order3_upper_controller.json")
     assert K.nstates == 3
     cert = speed_family_interval(plant, K, 2.0)
