@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ConfigError
+from ._tracking import _eig
 
 __all__ = ["ModeResidues", "mode_residues"]
 
@@ -58,6 +59,11 @@ class ModeResidues:
         return np.abs(self.residues)
 
     @property
+    def grip(self) -> np.ndarray:
+        """``‖r‖`` over the sensors, per speed: the flap's grip on the mode."""
+        return np.linalg.norm(self.residues, axis=1)
+
+    @property
     def phase_deg(self) -> np.ndarray:
         """``arg r_j`` per speed and sensor [deg], unwrapped along V (continuous)."""
         return np.degrees(np.unwrap(np.angle(self.residues), axis=0))
@@ -71,18 +77,17 @@ class ModeResidues:
 
     @property
     def weakest_V(self) -> float:
-        """The speed at which the flap's grip on the mode is weakest (smallest ``‖r‖``)."""
-        return float(self.V[int(np.argmin(np.linalg.norm(self.residues, axis=1)))])
+        """The speed at which the flap's grip on the mode is weakest (smallest :attr:`grip`)."""
+        return float(self.V[int(np.argmin(self.grip))])
 
 
 def _eig_at(family, V: float):
     """Eigenvalues, unit right eigenvectors and the loop at V."""
     lp = family.loop(float(V))
-    lam, R = np.linalg.eig(lp.A)
-    return lam, R / np.linalg.norm(R, axis=0), lp
+    return (*_eig(lp.A), lp)
 
 
-def _follow(prev, cand, min_score: float):
+def _follow(prev, cand):
     """The eigenpair of ``cand`` (upper half-plane) whose right eigenvector is most parallel
     to the previous one, and that overlap."""
     lam, R, _ = cand
@@ -165,7 +170,7 @@ def mode_residues(family, speeds, *, mode: complex | None = None, min_score: flo
             Vb, depth = pending[-1]
             Va, cand_a, ka = points[-1]
             cand = _eig_at(family, Vb)
-            kb, score = _follow(cand_a[1][:, ka], cand, min_score)
+            kb, score = _follow(cand_a[1][:, ka], cand)
             if score < min_score and depth < max_refine:
                 pending[-1] = (Vb, depth + 1)
                 pending.append((0.5 * (Va + Vb), depth + 1))

@@ -44,7 +44,7 @@ for name, res in models.items():
 fig, axes = plt.subplots(3, 1, figsize=(7.5, 8.0), sharex=True)
 for (name, res), color in zip(models.items(), ("k", "C3")):
     axes[0].plot(res.V, res.eigenvalue.real, color=color, label=name)
-    axes[1].semilogy(res.V, np.linalg.norm(res.residues, axis=1), color=color)
+    axes[1].semilogy(res.V, res.grip, color=color)
     for j, style in enumerate(("-", "--")):
         axes[2].plot(res.V, res.phase_deg[:, j], style, color=color,
                      label=f"{name.split(' (')[0]}, Acc{j + 1}")

@@ -85,7 +85,7 @@ def _flutter_mode_grip(family, lo: float, hi: float, n: int = 120) -> dict[str, 
     from ...aeroelastic import mode_residues  # noqa: PLC0415
 
     res = mode_residues(family, np.linspace(lo, hi, n))
-    grip = np.linalg.norm(res.residues, axis=1)
+    grip = res.grip
     rec: dict[str, Any] = {"phase_swing_deg": res.phase_swing_deg.tolist(),
                            "worst_overlap": res.worst_overlap,
                            "eigenvalue_at_hi": [float(res.eigenvalue[-1].real),
