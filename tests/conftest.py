@@ -25,3 +25,15 @@ def seed_wing_sigma_f():
     records = RecordSettings(amplitude=0.002, coupling_delay=0)
     rom = identify_common_denominator(truth_records(SeedWing(), records, V0=0.69), 2, 6)
     return realize(rom.model).sigma_f
+
+
+@pytest.fixture
+def numpy_global_seed():
+    """Seed numpy's global random state for the test and restore it afterwards: python-control's
+    ``rss``/``drss`` draw from it, so a test that uses them is otherwise different on every run."""
+    import numpy as np
+
+    state = np.random.get_state()
+    np.random.seed(0)
+    yield
+    np.random.set_state(state)

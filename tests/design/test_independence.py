@@ -50,7 +50,7 @@ def test_synthesis_gamma_agrees_with_verification_layer(name):
     np.testing.assert_allclose(g, ref.gamma, rtol=1e-6)
 
 
-def test_design_norm_on_hard_systems():
+def test_design_norm_on_hard_systems(numpy_global_seed):
     """Lightly damped (ζ = 1e-7), a peak at ω = 0 and a feed-through that nearly equals the
     peak: the cases where a Hamiltonian test on the axis is fragile."""
     rng = np.random.default_rng(3)
