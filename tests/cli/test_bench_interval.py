@@ -15,7 +15,9 @@ import numpy as np
 import pytest
 
 from casflutter._resources import problems_dir
+from casflutter.aeroelastic import load_rom_loop
 from casflutter.cli import main
+from casflutter.verify import controller_from_json
 
 
 @pytest.mark.parametrize("args, words", [
@@ -139,11 +141,17 @@ def test_random_order3_starts_from_the_high_end_are_recorded_and_certified(tmp_p
     assert run["met"] and run["reached"] == [2.2, 2.4]
     lo, hi = run["verified_exact_interval"]
     assert lo <= 2.2 and hi >= 2.4
+    # the recorded controller is the one certified: its closed loop decays on (2.2, 2.4)
+    K = controller_from_json(run["controller"])
+    family = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")[0]
+    family = family.with_servo(251.3)
+    assert K.nstates == 3 and all(
+        np.max(np.linalg.eigvals(family.closed_loop_state_matrix(V, K)).real) < 0
+        for V in np.linspace(2.2, 2.4, 11))
     assert doc["summary"]["lowest_lower_end_from_high"] == 2.2
 
 
 def test_the_flutter_mode_grip_record_finds_the_frozen_rom_loops_dip():
-    from casflutter.aeroelastic import load_rom_loop
     from casflutter.cli.bench.interval import _flutter_mode_grip
     rom, Vf = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
     rec = _flutter_mode_grip(rom.with_servo(251.3), 0.05, 2.4)

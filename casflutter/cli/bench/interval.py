@@ -14,7 +14,9 @@ the paper's interval V ∈ (0.05, 2.4)?  Two continuations bracket the answer
   low-end continuations this brackets what one controller of that order holds.
 
 Every controller's exact stable interval is then certified by the independent verification
-layer (:func:`casflutter.verify.verify_controller`, guardian map on the LFT at Vf).
+layer (:func:`casflutter.verify.verify_controller`, guardian map on the LFT at Vf).  Every
+run's record holds its controller (:func:`casflutter.verify.controller_from_json` reads
+``runs[i]["controller"]``).
 
 ``--start FILE`` (repeatable) continues a saved controller (a verification-layer JSON,
 ``v = K zm``) from the low end as well: whether a controller that holds one model, e.g. the
@@ -222,8 +224,12 @@ def _truth_runs(family, lo: float, hi: float, orders, doc, write) -> None:
 
 
 def _reach_record(kind: str, order: int, reach, verified: dict, wall: float) -> dict:
+    """One continuation's record, with its controller (``controller_from_json`` reads it)."""
+    from ...verify import controller_to_json  # noqa: PLC0415
+
     return {"start": kind, "order": order, "anchor": reach.anchor,
             "reached": list(reach.reached), "met": reach.met,
+            "controller": controller_to_json(reach.controller),
             "worst_abscissa": reach.worst_abscissa, **{f"verified_{k}": v
                                                         for k, v in verified.items()},
             "history": [list(h) for h in reach.history], "wall_time_s": wall}
