@@ -145,6 +145,8 @@ def test_random_order3_starts_from_the_high_end_are_recorded_and_certified(tmp_p
     K = controller_from_json(run["controller"])
     family = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")[0]
     family = family.with_servo(251.3)
+    assert run["controller_spectral_abscissa"] == pytest.approx(
+        np.max(np.linalg.eigvals(K.A).real), abs=1e-9)
     assert K.nstates == 3 and all(
         np.max(np.linalg.eigvals(family.closed_loop_state_matrix(V, K)).real) < 0
         for V in np.linspace(2.2, 2.4, 11))

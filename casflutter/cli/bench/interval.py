@@ -230,6 +230,8 @@ def _reach_record(kind: str, order: int, reach, verified: dict, wall: float) -> 
     return {"start": kind, "order": order, "anchor": reach.anchor,
             "reached": list(reach.reached), "met": reach.met,
             "controller": controller_to_json(reach.controller),
+            # > 0: the controller itself is unstable (the loop then needs the plant to hold)
+            "controller_spectral_abscissa": float(np.max(np.real(reach.controller.poles()))),
             "worst_abscissa": reach.worst_abscissa, **{f"verified_{k}": v
                                                         for k, v in verified.items()},
             "history": [list(h) for h in reach.history], "wall_time_s": wall}
