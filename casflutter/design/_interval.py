@@ -86,6 +86,17 @@ class IntervalReach:
     met: bool
 
 
+def _speed_interval(interval) -> tuple[float, float]:
+    """``(lo, hi)`` of a target speed interval, checked: ``0 <= lo < hi``, both finite."""
+    try:
+        lo, hi = (float(x) for x in interval)
+    except (TypeError, ValueError):
+        raise ConfigError(f"interval = {interval!r}: need two numbers (lo, hi)") from None
+    if not (0 <= lo < hi and math.isfinite(hi)):
+        raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
+    return lo, hi
+
+
 def _unpack(p: np.ndarray, n: int, m: int, Dk: np.ndarray):
     """``(Ak, Bk, Ck, Dk)`` of an order-``n`` controller on ``m`` sensors from its parameters;
     ``Dk`` is the last ``m`` of them when they are there (a free feed-through), the given one
@@ -328,9 +339,7 @@ def stabilize_interval(system, controller, interval, *,
     design_flutter_controller : H∞ design at Vf with stability over an interval.
     casflutter.verify.verify_controller : the independent exact stable interval.
     """
-    lo, hi = (float(x) for x in interval)
-    if not (0 <= lo < hi and math.isfinite(hi)):
-        raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
+    lo, hi = _speed_interval(interval)
     if anchor not in ("low", "high"):
         raise ConfigError(f"anchor = {anchor!r}: 'low' or 'high'")
     if not (decay >= 0 and n_speeds >= 2 and 0 < min_step <= first_step and max_iter >= 1):
@@ -551,9 +560,7 @@ def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
     --------
     stabilize_interval : continuation in speed at a fixed order.
     """
-    lo, hi = (float(x) for x in interval)
-    if not (0 <= lo < hi and math.isfinite(hi)):
-        raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
+    lo, hi = _speed_interval(interval)
     K = control.ss(controller)
     seq = [int(n) for n in orders]
     if (not seq or any(n < 1 for n in seq) or any(a <= b for a, b in zip(seq, seq[1:]))
@@ -684,9 +691,7 @@ def design_interval_controller(system, interval, order: int, *,
     --------
     design_flutter_controller : the paper's design at Vf, with an interval continuation.
     """
-    lo, hi = (float(x) for x in interval)
-    if not (0 <= lo < hi and math.isfinite(hi)):
-        raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
+    lo, hi = _speed_interval(interval)
     if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order < 1:
         raise ConfigError(f"order = {order!r}: an integer >= 1 (a dynamic controller)")
     models = _Models.of(system)

@@ -23,7 +23,7 @@ import numpy as np
 
 from .._threads import single_threaded
 from ..errors import ConfigError
-from ._interval import IntervalReach, _Models, _polish, stabilize_interval
+from ._interval import IntervalReach, _Models, _polish, _speed_interval, stabilize_interval
 
 __all__ = ["HighEndSearch", "search_from_high_end"]
 
@@ -153,9 +153,7 @@ def search_from_high_end(system, interval, order: int, *, starts: int = 20, seed
     stabilize_interval : the continuation of one start.
     full_order_start : the deterministic full-order start at the top.
     """
-    lo, hi = (float(x) for x in interval)
-    if not (0 <= lo < hi and math.isfinite(hi)):
-        raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
+    lo, hi = _speed_interval(interval)
     if not (isinstance(order, (int, np.integer)) and order >= 1):
         raise ConfigError(f"order = {order!r}: an integer >= 1 (a dynamic controller)")
     if not (isinstance(starts, (int, np.integer)) and starts >= 1):
