@@ -137,7 +137,8 @@ def search_from_high_end(system, interval, order: int, *, starts: int = 20, seed
         BFGS iterations per temperature, on the top band and in the continuation.
     **continuation
         Further settings of :func:`stabilize_interval` (``n_speeds``, ``first_step``,
-        ``min_step``, ``max_rounds``, ``free_feedthrough``).
+        ``min_step``, ``max_rounds``, ``free_feedthrough``, ``stable_controller``); the last
+        two apply on the top band as well.
 
     Returns
     -------
@@ -162,7 +163,7 @@ def search_from_high_end(system, interval, order: int, *, starts: int = 20, seed
         raise ConfigError(f"need top_width > 0, decay >= 0, max_iter >= 1; got "
                           f"top_width={top_width!r}, decay={decay!r}, max_iter={max_iter!r}")
     unknown = set(continuation) - {"n_speeds", "first_step", "min_step", "max_rounds",
-                                   "free_feedthrough"}
+                                   "free_feedthrough", "stable_controller"}
     if unknown:
         raise ConfigError(f"unknown continuation settings {sorted(unknown)}; see "
                           "stabilize_interval")
@@ -179,12 +180,13 @@ def search_from_high_end(system, interval, order: int, *, starts: int = 20, seed
             raise ConfigError(f"frequency_band = {frequency_band!r}: need 0 < low <= high")
     top = [max(lo, hi - top_width), hi]
     free = bool(continuation.get("free_feedthrough", False))
+    stable = bool(continuation.get("stable_controller", False))
     reaches, indices = [], []
     with single_threaded():
         for i in range(int(starts)):
             rng = np.random.default_rng([int(seed), i])
             K = _random_start(rng, int(order), models.n_sensors, band)
-            K, worst = _polish(models, K, top, max_iter, -2 * decay, free)
+            K, worst = _polish(models, K, top, max_iter, -2 * decay, free, stable)
             if not worst < -decay:
                 log.info("high-end start %d: the top band does not decay (worst %.4g)", i, worst)
                 continue

@@ -127,16 +127,17 @@ def test_a_saved_controller_is_continued_on_the_rom_loop_with_the_servo(tmp_path
 
 
 def test_random_order3_starts_from_the_high_end_are_recorded_and_certified(tmp_path):
-    """Four seeded order-3 starts at the top of the frozen ROM loop with the servo: the one
-    that held (2.2, 2.4) is recorded with the count of starts that held the top, and the
-    verification layer's exact interval covers its claim."""
+    """Four seeded order-3 starts at the top of the frozen ROM loop with the servo, kept
+    stable themselves: the one that held (2.2, 2.4) is recorded with the count of starts that
+    held the top, and the verification layer's exact interval covers its claim."""
     out = tmp_path / "b.json"
-    assert main(["bench", "interval", "--high-orders", "3", "--high-starts", "4",
+    assert main(["bench", "interval", "--high-orders", "3", "--high-starts", "4", "--high-stable",
                  "--orders", "", "--no-full-order", "--servo", "251.3",
                  "--interval", "2.2,2.4", "--out", str(out)]) == 0
     doc = json.loads(out.read_text())
     (run,) = doc["runs"]
     assert run["anchor"] == "high" and run["order"] == 3 and run["random_starts"] == 4
+    assert run["stable_controller"] and run["controller_spectral_abscissa"] <= -0.05 + 1e-9
     assert 1 <= run["held_the_top"] <= 4 and len(run["lower_ends"]) == run["held_the_top"]
     assert run["met"] and run["reached"] == [2.2, 2.4]
     lo, hi = run["verified_exact_interval"]

@@ -9,12 +9,14 @@ loop) and eigenvalues of the closed loop formed here with numpy.
 
 from __future__ import annotations
 
+import control
 import numpy as np
 import pytest
 
 from casflutter._resources import problems_dir
 from casflutter.aeroelastic import load_rom_loop
-from casflutter.design import search_from_high_end
+from casflutter.design import search_from_high_end, stabilize_interval
+from casflutter.design._interval import _ClosedLoopsAtSpeeds, _pack
 from casflutter.design._interval_search import _random_start
 from casflutter.errors import ConfigError
 from casflutter.verify import speed_family_interval
@@ -94,3 +96,43 @@ def test_bad_requests_are_refused_before_any_work(kwargs, words):
     with pytest.raises(ConfigError, match=words.replace("[", r"\[").replace("]", r"\]")):
         search_from_high_end(frozen_loop_with_servo(), args.pop("interval"), args.pop("order"),
                              **args)
+
+
+def test_the_controllers_own_abscissa_and_its_gradient_join_the_objective():
+    """``stable_controller``: one more entry, the largest real part of ``eig(Ak)`` computed
+    here, with a gradient (``Ak`` only) equal to central differences."""
+    family = frozen_loop_with_servo()
+    rng = np.random.default_rng(5)
+    K = control.ss(rng.normal(size=(3, 3)), rng.normal(size=(3, 2)), rng.normal(size=(1, 3)),
+                   0.05 * rng.normal(size=(1, 2)))
+    loops = _ClosedLoopsAtSpeeds(family, [1.0, 2.0], 3, np.asarray(K.D), stable_controller=True)
+    p = _pack(K, True)
+    values, grads = loops.rightmost(p)
+    assert len(values) == 3 and np.array_equal(values, loops.abscissae(p))
+    assert values[-1] == pytest.approx(np.max(np.linalg.eigvals(K.A).real), abs=1e-12)
+    h = 1e-6
+    fd = np.array([(loops.abscissae(p + h * e)[-1] - loops.abscissae(p - h * e)[-1]) / (2 * h)
+                   for e in np.eye(len(p))])
+    assert np.max(np.abs(fd - grads[-1])) < 1e-6 * np.max(np.abs(fd))
+    assert np.all(fd[9:] == 0) and np.all(grads[-1][9:] == 0)     # B, C, D do not move it
+
+
+def test_a_stable_controller_search_keeps_the_controller_stable_and_is_certified():
+    family = frozen_loop_with_servo()
+    search = search_from_high_end(family, (2.2, 2.4), 3, starts=8, seed=0,
+                                  stable_controller=True)
+    assert search.reaches
+    for reach in search.reaches:
+        assert np.max(reach.controller.poles().real) <= -0.05 + 1e-9
+    best = search.best
+    cert = speed_family_interval(lambda V: family.loop(V).flap_to_sensors(), best.controller,
+                                 0.5 * sum(best.reached))
+    assert cert.lower <= best.reached[0] and cert.upper >= best.reached[1]
+
+
+def test_an_unstable_start_is_refused_when_the_controller_must_stay_stable():
+    K = control.ss(np.diag([0.5, -1.0, -2.0]), np.ones((3, 2)), np.ones((1, 3)),
+                   np.zeros((1, 2)))
+    with pytest.raises(ConfigError, match=r"itself is unstable \(a pole with real part 0.5"):
+        stabilize_interval(frozen_loop_with_servo(), K, (2.2, 2.4), anchor="high",
+                           stable_controller=True)

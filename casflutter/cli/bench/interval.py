@@ -10,8 +10,9 @@ the paper's interval V ∈ (0.05, 2.4)?  Two continuations bracket the answer
   the target's upper end, its lower end pushed down;
 * from the high end at a low order (``--high-orders``): ``--high-starts`` seeded random
   controllers of each order at the top (:func:`casflutter.design.search_from_high_end`), the
-  one that reaches lowest recorded with the lower ends of all that held the top.  With the
-  low-end continuations this brackets what one controller of that order holds.
+  one that reaches lowest recorded with the lower ends of all that held the top
+  (``--high-stable``: controllers that are stable themselves).  With the low-end
+  continuations this brackets what one controller of that order holds.
 
 Every controller's exact stable interval is then certified by the independent verification
 layer (:func:`casflutter.verify.verify_controller`, guardian map on the LFT at Vf).  Every
@@ -168,17 +169,19 @@ def _start_runs(family, lo: float, hi: float, starts, verify, doc, write) -> Non
                  K.nstates, reach, verify(0.5 * sum(reach.reached), reach.controller), t0)
 
 
-def _high_end_runs(family, lo: float, hi: float, orders, starts: int, seed: int, verify,
-                   doc, write) -> None:
+def _high_end_runs(family, lo: float, hi: float, orders, starts: int, seed: int,
+                   stable: bool, verify, doc, write) -> None:
     """For each of ``orders``, ``starts`` seeded random controllers at ``hi`` continued down
-    (:func:`casflutter.design.search_from_high_end`); the one that reached lowest is
-    certified and recorded with the lower ends of all of them."""
+    (:func:`casflutter.design.search_from_high_end`, kept stable themselves when ``stable``);
+    the one that reached lowest is certified and recorded with the lower ends of all."""
     from ...design import search_from_high_end  # noqa: PLC0415
 
     for order in orders:
         t0 = time.perf_counter()
-        search = search_from_high_end(family, (lo, hi), order, starts=starts, seed=seed)
-        extra = {"random_starts": starts, "held_the_top": len(search.reaches),
+        search = search_from_high_end(family, (lo, hi), order, starts=starts, seed=seed,
+                                      stable_controller=stable)
+        extra = {"random_starts": starts, "stable_controller": stable,
+                 "held_the_top": len(search.reaches),
                  "lower_ends": [r.reached[0] for r in search.reaches],
                  "frequency_band": list(search.frequency_band)}
         best = search.best
@@ -324,7 +327,8 @@ def _handler(args: argparse.Namespace) -> int:
         def verify(nominal, K):
             return _verified(system, nominal, K)
     _start_runs(family, lo, hi, starts, verify, doc, write)
-    _high_end_runs(family, lo, hi, high_orders, args.high_starts, args.seed, verify, doc, write)
+    _high_end_runs(family, lo, hi, high_orders, args.high_starts, args.seed, args.high_stable,
+                   verify, doc, write)
     if args.model == "truth":
         _truth_runs(family, lo, hi, orders, doc, write)
         doc["rhp_zero_crossings"] = _rhp_zero_crossings(family, lo, hi, tuple(args.zero_band))
@@ -383,6 +387,9 @@ def register(subparsers) -> None:
                    help="orders of random starts continued from the high end (default none)")
     p.add_argument("--high-starts", type=int, default=20,
                    help="random starts per --high-orders order (seeded by --seed)")
+    p.add_argument("--high-stable", action="store_true",
+                   help="keep the --high-orders controllers stable themselves (their poles "
+                        "join the objective)")
     p.add_argument("--full-order", action=argparse.BooleanOptionalAction, default=True,
                    help="also the full-order continuation from the high end")
     p.add_argument("--zero-band", type=float, nargs=2, default=(20.0, 80.0),
