@@ -169,7 +169,8 @@ class _ClosedLoopsAtSpeeds:
             a.append(float(np.max(np.linalg.eigvals(Ak).real)))
         return np.array(a)
 
-    def _rightmost_gradient(self, M: np.ndarray) -> tuple[float, np.ndarray]:
+    @staticmethod
+    def _rightmost_gradient(M: np.ndarray) -> tuple[float, np.ndarray]:
         """Real part of the rightmost eigenvalue of ``M`` and its gradient with respect to
         ``M``, the real part of ``∂λ/∂M = u vᵀ / (uᵀ v)`` (left/right eigenvectors)."""
         lam, VL, VR = scipy.linalg.eig(M, left=True, right=True)
@@ -347,9 +348,8 @@ def stabilize_interval(system, controller, interval, *,
     stable_controller : bool
         Keep the controller itself stable as well: its spectral abscissa joins the worst, so
         every step kept leaves its poles decaying at the rate ``decay`` (the start must be
-        stable).  An unstable
-        controller may hold the loop, but only while the plant's feedback holds it: the
-        loop fails if the flap or a sensor does.
+        stable).  An unstable controller may hold the loop, but only while the plant's
+        feedback holds it: the loop fails if the flap or a sensor does.
 
     Returns
     -------
