@@ -86,6 +86,17 @@ class IntervalReach:
     met: bool
 
 
+def _speed_interval(interval) -> tuple[float, float]:
+    """``(lo, hi)`` of a target speed interval, checked: ``0 <= lo < hi``, both finite."""
+    try:
+        lo, hi = (float(x) for x in interval)
+    except (TypeError, ValueError):
+        raise ConfigError(f"interval = {interval!r}: need two numbers (lo, hi)") from None
+    if not (0 <= lo < hi and math.isfinite(hi)):
+        raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
+    return lo, hi
+
+
 def _unpack(p: np.ndarray, n: int, m: int, Dk: np.ndarray):
     """``(Ak, Bk, Ck, Dk)`` of an order-``n`` controller on ``m`` sensors from its parameters;
     ``Dk`` is the last ``m`` of them when they are there (a free feed-through), the given one
@@ -137,31 +148,49 @@ class _Models:
 class _ClosedLoopsAtSpeeds:
     """ΣAE(V_j) at a set of speeds and the closed loop's rightmost eigenvalue and its gradient
     with respect to ``(Ak, Bk, Ck)``, and ``Dk`` when the parameters include it (otherwise
-    ``Dk`` is held at the given value)."""
+    ``Dk`` is held at the given value).  With ``stable_controller`` the controller's own
+    spectral abscissa (of ``Ak``) is one more entry, after the loops': the worst then asks
+    for a stable controller too."""
 
-    def __init__(self, models, speeds, order: int, Dk: np.ndarray):
-        self.order, self.Dk = order, Dk
+    def __init__(self, models, speeds, order: int, Dk: np.ndarray,
+                 stable_controller: bool = False):
+        self.order, self.Dk, self.stable_controller = order, Dk, bool(stable_controller)
         models = _Models.of(models)
         self.loops = [lp for V in speeds for lp in models.loops(V)]
         self.m = models.n_sensors
 
     def abscissae(self, p: np.ndarray) -> np.ndarray:
-        """The closed loop's spectral abscissa at every speed (eigenvalues only)."""
+        """The closed loop's spectral abscissa at every speed (eigenvalues only), then the
+        controller's own when it is asked to be stable."""
         Ak, Bk, Ck, Dk = _unpack(p, self.order, self.m, self.Dk)
-        return np.array([float(np.max(np.linalg.eigvals(
-            lp.closed_loop_parts(Ak, Bk, Ck, Dk)[0]).real)) for lp in self.loops])
+        a = [float(np.max(np.linalg.eigvals(lp.closed_loop_parts(Ak, Bk, Ck, Dk)[0]).real))
+             for lp in self.loops]
+        if self.stable_controller:
+            a.append(float(np.max(np.linalg.eigvals(Ak).real)))
+        return np.array(a)
+
+    @staticmethod
+    def _rightmost_gradient(M: np.ndarray) -> tuple[float, np.ndarray]:
+        """Real part of the rightmost eigenvalue of ``M`` and its gradient with respect to
+        ``M``, the real part of ``∂λ/∂M = u vᵀ / (uᵀ v)`` (left/right eigenvectors)."""
+        lam, VL, VR = scipy.linalg.eig(M, left=True, right=True)
+        i = int(np.argmax(lam.real))
+        u, v = VL[:, i].conj(), VR[:, i]
+        return float(lam[i].real), np.real(np.outer(u, v) / (u @ v))
 
     def gradient(self, p: np.ndarray, j: int) -> tuple[float, np.ndarray]:
-        """The rightmost eigenvalue's real part of loop ``j`` and its gradient."""
+        """The rightmost eigenvalue's real part of loop ``j`` (of the controller itself for
+        ``j = len(loops)``) and its gradient."""
         Ak, Bk, Ck, Dk = _unpack(p, self.order, self.m, self.Dk)
         free_d = p.size > self.order * (self.order + self.m + 1)    # Dk among the parameters
+        if j == len(self.loops):                  # the controller's own abscissa: Ak only
+            a, dAk = self._rightmost_gradient(Ak)
+            rest = p.size - self.order * self.order
+            return a, np.concatenate([dAk.ravel(), np.zeros(rest)])
         lp = self.loops[j]
         Acl, s, vx, zx = lp.closed_loop_parts(Ak, Bk, Ck, Dk)
         B2, D22 = lp.B2[:, None] / s, lp.D22[:, None]
-        lam, VL, VR = scipy.linalg.eig(Acl, left=True, right=True)
-        i = int(np.argmax(lam.real))
-        u, v = VL[:, i].conj(), VR[:, i]
-        G = np.real(np.outer(u, v) / (u @ v))            # ∂λ/∂A_cl, real part
+        alpha, G = self._rightmost_gradient(Acl)         # ∂λ/∂A_cl, real part
         nx = lp.A.shape[0]
         Gxx, Gxk, Gkx, Gkk = G[:nx, :nx], G[:nx, nx:], G[nx:, :nx], G[nx:, nx:]
         dAk = Gkk
@@ -174,11 +203,13 @@ class _ClosedLoopsAtSpeeds:
             a = float(lp.B2 @ Gxk @ Ck[0] + (Bk @ D22)[:, 0] @ Gkk @ Ck[0])  # ∂λ/∂(1/s)
             dvx = lp.C2 / s + np.outer(lp.D22, vx[0]) / s           # row j: ∂vx/∂Dk_j
             parts.append(dvx @ g + a * lp.D22 / s ** 2)
-        return float(lam[i].real), np.concatenate(parts)
+        return alpha, np.concatenate(parts)
 
     def rightmost(self, p: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
-        """The rightmost eigenvalue's real part at every speed and its gradient."""
-        pairs = [self.gradient(p, j) for j in range(len(self.loops))]
+        """The rightmost eigenvalue's real part at every speed (and of the controller) and
+        its gradient."""
+        pairs = [self.gradient(p, j)
+                 for j in range(len(self.loops) + self.stable_controller)]
         return np.array([a for a, _ in pairs]), [g for _, g in pairs]
 
     def smoothed(self, p: np.ndarray, tau: float | None) -> tuple[float, np.ndarray]:
@@ -216,13 +247,15 @@ def _minimise_worst(fam: _ClosedLoopsAtSpeeds, p: np.ndarray, taus, good: float,
 
 
 def _polish(system, K: control.StateSpace, speeds, max_iter: int, good: float,
-            free_feedthrough: bool = False) -> tuple[control.StateSpace, float]:
-    """``K`` re-optimised for the worst spectral abscissa over ``speeds``: BFGS on the
-    log-sum-exp of decreasing temperature, then on the maximum itself; stops early once the
-    worst is below ``good``.  Returns the best controller met and its worst abscissa."""
+            free_feedthrough: bool = False, stable_controller: bool = False
+            ) -> tuple[control.StateSpace, float]:
+    """``K`` re-optimised for the worst spectral abscissa over ``speeds`` (and of ``K``
+    itself with ``stable_controller``): BFGS on the log-sum-exp of decreasing temperature,
+    then on the maximum itself; stops early once the worst is below ``good``.  Returns the
+    best controller met and its worst abscissa."""
     Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (K.A, K.B, K.C, K.D))
     n, m = K.nstates, Dk.shape[1]
-    fam = _ClosedLoopsAtSpeeds(system, speeds, n, Dk)
+    fam = _ClosedLoopsAtSpeeds(system, speeds, n, Dk, stable_controller)
     taus = (1.0, 0.3, 0.1, 0.03, 0.01, None)
     p, best = _minimise_worst(fam, _pack(K, free_feedthrough), taus, good, max_iter)
     return _controller(p, n, m, Dk), float(best)
@@ -277,7 +310,8 @@ def stabilize_interval(system, controller, interval, *,
                        anchor: str = "low", decay: float = 0.05, n_speeds: int = 40,
                        first_step: float = 0.05, min_step: float = 0.0025,
                        max_iter: int = 300, max_rounds: int = 200,
-                       free_feedthrough: bool = False) -> IntervalReach:
+                       free_feedthrough: bool = False,
+                       stable_controller: bool = False) -> IntervalReach:
     """Extend the speed interval over which one controller keeps ΣAE(V) decaying.
 
     Parameters
@@ -311,6 +345,11 @@ def stabilize_interval(system, controller, interval, *,
     free_feedthrough : bool
         Optimise ``D`` with ``(A, B, C)`` (a static path from the sensors to the flap: two
         more parameters at no cost in order).
+    stable_controller : bool
+        Keep the controller itself stable as well: its spectral abscissa joins the worst, so
+        every step kept leaves its poles decaying at the rate ``decay`` (the start must be
+        stable).  An unstable controller may hold the loop, but only while the plant's
+        feedback holds it: the loop fails if the flap or a sensor does.
 
     Returns
     -------
@@ -319,7 +358,8 @@ def stabilize_interval(system, controller, interval, *,
     Raises
     ------
     ConfigError
-        A bad interval, anchor or setting, or a start that does not decay at the anchor end.
+        A bad interval, anchor or setting, a start that does not decay at the anchor end, or
+        an unstable start with ``stable_controller``.
     DimensionError
         A controller that does not map the sensors to the flap.
 
@@ -328,9 +368,7 @@ def stabilize_interval(system, controller, interval, *,
     design_flutter_controller : H∞ design at Vf with stability over an interval.
     casflutter.verify.verify_controller : the independent exact stable interval.
     """
-    lo, hi = (float(x) for x in interval)
-    if not (0 <= lo < hi and math.isfinite(hi)):
-        raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
+    lo, hi = _speed_interval(interval)
     if anchor not in ("low", "high"):
         raise ConfigError(f"anchor = {anchor!r}: 'low' or 'high'")
     if not (decay >= 0 and n_speeds >= 2 and 0 < min_step <= first_step and max_iter >= 1):
@@ -349,6 +387,10 @@ def stabilize_interval(system, controller, interval, *,
     dense = 8 * n_speeds
     with single_threaded():
         start = hi if anchor == "high" else lo
+        own = float(np.max(np.linalg.eigvals(Ak).real))
+        if stable_controller and not own < 0:
+            raise ConfigError(f"stable_controller: the start controller itself is unstable "
+                              f"(a pole with real part {own:.4g}); start from a stable one")
         if not _dense_worst(system, K, start, start, 1) < 0:
             raise ConfigError(f"the start controller does not stabilise ΣAE at the anchor "
                               f"V = {start:.4g}; start from a controller designed there")
@@ -374,7 +416,7 @@ def stabilize_interval(system, controller, interval, *,
             speeds = np.linspace(*trial, n_speeds)
             q = p
             for _ in range(3):
-                fam = _ClosedLoopsAtSpeeds(system, speeds, order, Dk)
+                fam = _ClosedLoopsAtSpeeds(system, speeds, order, Dk, stable_controller)
                 q, worst = _minimise_worst(fam, q, (0.3, 0.1, 0.03, None), -2 * decay,
                                            max_iter)
                 ok = worst <= -decay
@@ -551,9 +593,7 @@ def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
     --------
     stabilize_interval : continuation in speed at a fixed order.
     """
-    lo, hi = (float(x) for x in interval)
-    if not (0 <= lo < hi and math.isfinite(hi)):
-        raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
+    lo, hi = _speed_interval(interval)
     K = control.ss(controller)
     seq = [int(n) for n in orders]
     if (not seq or any(n < 1 for n in seq) or any(a <= b for a, b in zip(seq, seq[1:]))
@@ -684,9 +724,7 @@ def design_interval_controller(system, interval, order: int, *,
     --------
     design_flutter_controller : the paper's design at Vf, with an interval continuation.
     """
-    lo, hi = (float(x) for x in interval)
-    if not (0 <= lo < hi and math.isfinite(hi)):
-        raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
+    lo, hi = _speed_interval(interval)
     if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order < 1:
         raise ConfigError(f"order = {order!r}: an integer >= 1 (a dynamic controller)")
     models = _Models.of(system)

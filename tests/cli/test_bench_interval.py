@@ -2,8 +2,8 @@
 
 The benchmark itself takes minutes (two continuations and the exact intervals); what it
 computes is tested in ``tests/design/test_interval_reach.py``.  One short run carries a saved
-controller over part of the interval (``--start``) and checks its record against the
-verification layer.
+controller over part of the interval (``--start``), another continues random order-3 starts
+from the top (``--high-orders``); both check their record against the verification layer.
 """
 
 from __future__ import annotations
@@ -15,13 +15,18 @@ import numpy as np
 import pytest
 
 from casflutter._resources import problems_dir
+from casflutter.aeroelastic import load_rom_loop
 from casflutter.cli import main
+from casflutter.verify import controller_from_json
 
 
 @pytest.mark.parametrize("args, words", [
     (["--interval", "2.4,0.05"], "LO < HI"),
     (["--interval", "a,b"], "numbers"),
     (["--orders", "0"], "orders >= 1"),
+    (["--high-orders", "0"], "orders >= 1"),
+    (["--high-orders", "x"], "--high-orders K,K"),
+    (["--high-orders", "3", "--high-starts", "0"], "--high-starts >= 1"),
 ])
 def test_bad_arguments_exit_2_at_once(tmp_path, capsys, args, words):
     t0 = time.perf_counter()
@@ -121,8 +126,35 @@ def test_a_saved_controller_is_continued_on_the_rom_loop_with_the_servo(tmp_path
     assert 55 < grip["eigenvalue_at_hi"][1] < 65
 
 
+def test_random_order3_starts_from_the_high_end_are_recorded_and_certified(tmp_path):
+    """Four seeded order-3 starts at the top of the frozen ROM loop with the servo, kept
+    stable themselves: the one that held (2.2, 2.4) is recorded with the count of starts that
+    held the top, and the verification layer's exact interval covers its claim."""
+    out = tmp_path / "b.json"
+    assert main(["bench", "interval", "--high-orders", "3", "--high-starts", "4", "--high-stable",
+                 "--orders", "", "--no-full-order", "--servo", "251.3",
+                 "--interval", "2.2,2.4", "--out", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    (run,) = doc["runs"]
+    assert run["anchor"] == "high" and run["order"] == 3 and run["random_starts"] == 4
+    assert run["stable_controller"] and run["controller_spectral_abscissa"] <= -0.05 + 1e-9
+    assert 1 <= run["held_the_top"] <= 4 and len(run["lower_ends"]) == run["held_the_top"]
+    assert run["met"] and run["reached"] == [2.2, 2.4]
+    lo, hi = run["verified_exact_interval"]
+    assert lo <= 2.2 and hi >= 2.4
+    # the recorded controller is the one certified: its closed loop decays on (2.2, 2.4)
+    K = controller_from_json(run["controller"])
+    family = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")[0]
+    family = family.with_servo(251.3)
+    assert run["controller_spectral_abscissa"] == pytest.approx(
+        np.max(np.linalg.eigvals(K.A).real), abs=1e-9)
+    assert K.nstates == 3 and all(
+        np.max(np.linalg.eigvals(family.closed_loop_state_matrix(V, K)).real) < 0
+        for V in np.linspace(2.2, 2.4, 11))
+    assert doc["summary"]["lowest_lower_end_from_high"] == 2.2
+
+
 def test_the_flutter_mode_grip_record_finds_the_frozen_rom_loops_dip():
-    from casflutter.aeroelastic import load_rom_loop
     from casflutter.cli.bench.interval import _flutter_mode_grip
     rom, Vf = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
     rec = _flutter_mode_grip(rom.with_servo(251.3), 0.05, 2.4)

@@ -7,10 +7,17 @@ the paper's interval V ∈ (0.05, 2.4)?  Two continuations bracket the answer
 * from the low end: the paper's design at Vf of each ``--orders`` (the run configuration's
   controller settings), its upper end pushed towards the target;
 * from the high end (``--full-order``): an LQG controller of the loop's own order designed at
-  the target's upper end, its lower end pushed down.
+  the target's upper end, its lower end pushed down;
+* from the high end at a low order (``--high-orders``): ``--high-starts`` seeded random
+  controllers of each order at the top (:func:`casflutter.design.search_from_high_end`), the
+  one that reaches lowest recorded with the lower ends of all that held the top
+  (``--high-stable``: controllers that are stable themselves).  With the low-end
+  continuations this brackets what one controller of that order holds.
 
 Every controller's exact stable interval is then certified by the independent verification
-layer (:func:`casflutter.verify.verify_controller`, guardian map on the LFT at Vf).
+layer (:func:`casflutter.verify.verify_controller`, guardian map on the LFT at Vf).  Every
+run's record holds its controller (:func:`casflutter.verify.controller_from_json` reads
+``runs[i]["controller"]``).
 
 ``--start FILE`` (repeatable) continues a saved controller (a verification-layer JSON,
 ``v = K zm``) from the low end as well: whether a controller that holds one model, e.g. the
@@ -162,6 +169,36 @@ def _start_runs(family, lo: float, hi: float, starts, verify, doc, write) -> Non
                  K.nstates, reach, verify(0.5 * sum(reach.reached), reach.controller), t0)
 
 
+def _high_end_runs(family, lo: float, hi: float, orders, starts: int, seed: int,
+                   stable: bool, verify, doc, write) -> None:
+    """For each of ``orders``, ``starts`` seeded random controllers at ``hi`` continued down
+    (:func:`casflutter.design.search_from_high_end`, kept stable themselves when ``stable``);
+    the one that reached lowest is certified and recorded with the lower ends of all."""
+    from ...design import search_from_high_end  # noqa: PLC0415
+
+    for order in orders:
+        t0 = time.perf_counter()
+        search = search_from_high_end(family, (lo, hi), order, starts=starts, seed=seed,
+                                      stable_controller=stable)
+        extra = {"random_starts": starts, "stable_controller": stable,
+                 "held_the_top": len(search.reaches),
+                 "lower_ends": [r.reached[0] for r in search.reaches],
+                 "frequency_band": list(search.frequency_band)}
+        best = search.best
+        kind = f"random order-{order} starts at V = {hi:g} (seed {seed})"
+        if best is None:
+            _log.warning("order %d: none of %d random starts held the top", order, starts)
+            doc["runs"].append({"start": kind, "order": order, "anchor": "high",
+                                "reached": None, "met": False,
+                                "error": "no start decayed at the top", **extra,
+                                "wall_time_s": time.perf_counter() - t0})
+            write()
+            continue
+        _add_run(doc, write, f"order {order} from the high end ({len(search.reaches)} of "
+                             f"{starts} starts held the top)", kind, order, best,
+                 verify(0.5 * sum(best.reached), best.controller), t0, **extra)
+
+
 def _truth_runs(family, lo: float, hi: float, orders, doc, write) -> None:
     """Full order from the high end, then ``orders`` from the low end, on the truth loop."""
     import control  # noqa: PLC0415
@@ -190,8 +227,14 @@ def _truth_runs(family, lo: float, hi: float, orders, doc, write) -> None:
 
 
 def _reach_record(kind: str, order: int, reach, verified: dict, wall: float) -> dict:
+    """One continuation's record, with its controller (``controller_from_json`` reads it)."""
+    from ...verify import controller_to_json  # noqa: PLC0415
+
     return {"start": kind, "order": order, "anchor": reach.anchor,
             "reached": list(reach.reached), "met": reach.met,
+            "controller": controller_to_json(reach.controller),
+            # > 0: the controller itself is unstable (the loop then needs the plant to hold)
+            "controller_spectral_abscissa": float(np.max(np.real(reach.controller.poles()))),
             "worst_abscissa": reach.worst_abscissa, **{f"verified_{k}": v
                                                         for k, v in verified.items()},
             "history": [list(h) for h in reach.history], "wall_time_s": wall}
@@ -212,12 +255,14 @@ def _handler(args: argparse.Namespace) -> int:
     try:
         lo, hi = (float(x) for x in str(args.interval).split(","))
         orders = [int(o) for o in str(args.orders).split(",") if o.strip()]
+        high_orders = [int(o) for o in str(args.high_orders).split(",") if o.strip()]
     except ValueError:
-        print("casflutter bench interval: --interval LO,HI and --orders K,K,... (numbers)",
-              file=sys.stderr)
+        print("casflutter bench interval: --interval LO,HI, --orders K,K,... and "
+              "--high-orders K,K,... (numbers)", file=sys.stderr)
         return 2
-    if not 0 <= lo < hi or any(k < 1 for k in orders):
-        print("casflutter bench interval: need 0 <= LO < HI and orders >= 1", file=sys.stderr)
+    if not 0 <= lo < hi or any(k < 1 for k in orders + high_orders) or args.high_starts < 1:
+        print("casflutter bench interval: need 0 <= LO < HI, orders >= 1 and "
+              "--high-starts >= 1", file=sys.stderr)
         return 2
     try:    # everything checked before any design work; nothing is written until a result
         out = check_output_path(args.out, what="--out", suffixes=(".json",))
@@ -282,6 +327,8 @@ def _handler(args: argparse.Namespace) -> int:
         def verify(nominal, K):
             return _verified(system, nominal, K)
     _start_runs(family, lo, hi, starts, verify, doc, write)
+    _high_end_runs(family, lo, hi, high_orders, args.high_starts, args.seed, args.high_stable,
+                   verify, doc, write)
     if args.model == "truth":
         _truth_runs(family, lo, hi, orders, doc, write)
         doc["rhp_zero_crossings"] = _rhp_zero_crossings(family, lo, hi, tuple(args.zero_band))
@@ -336,11 +383,19 @@ def register(subparsers) -> None:
     p.add_argument("--start", action="append", default=[], metavar="FILE",
                    help="a saved controller (verification JSON, v = K zm) to continue from "
                         "the low end as well; repeatable")
+    p.add_argument("--high-orders", default="",
+                   help="orders of random starts continued from the high end (default none)")
+    p.add_argument("--high-starts", type=int, default=20,
+                   help="random starts per --high-orders order (seeded by --seed)")
+    p.add_argument("--high-stable", action="store_true",
+                   help="keep the --high-orders controllers stable themselves (their poles "
+                        "join the objective)")
     p.add_argument("--full-order", action=argparse.BooleanOptionalAction, default=True,
                    help="also the full-order continuation from the high end")
     p.add_argument("--zero-band", type=float, nargs=2, default=(20.0, 80.0),
                    metavar=("W_LO", "W_HI"),
                    help="frequency band [rad/s] of the zero crossings reported")
-    p.add_argument("--seed", type=int, default=0, help="seed of the paper design's starts")
+    p.add_argument("--seed", type=int, default=0,
+                   help="seed of the paper design's starts and of the high-end random starts")
     p.add_argument("--out", required=True, help="output JSON file")
     p.set_defaults(func=_handler)

@@ -1,0 +1,199 @@
+"""Random fixed-order starts at the top of a speed interval, continued downwards (eq. 8-9).
+
+:func:`~casflutter.design.stabilize_interval` continues one controller; where it stalls
+depends on the start.  From the low end the natural start is the paper's design at Vf; from
+the high end the only deterministic start is the full-order LQG of
+:func:`~casflutter.design.full_order_start`, whose truncations to a low order rarely hold the
+top.  :func:`search_from_high_end` supplies low-order starts there: seeded random controllers
+made of lightly damped resonators near the flutter mode's frequency (and one real pole for an
+odd order), each optimised for the worst spectral abscissa on a short band at the top of the
+interval and, when that band decays, continued down.  Together with the low-end continuations
+this brackets what one controller *of a given order* can hold, the question of the paper's
+order-3 interval (0, 2.4).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+from .._threads import single_threaded
+from ..errors import ConfigError
+from ._interval import IntervalReach, _Models, _polish, _speed_interval, stabilize_interval
+
+__all__ = ["HighEndSearch", "search_from_high_end"]
+
+log = logging.getLogger("casflutter.design")
+
+
+@dataclass(frozen=True)
+class HighEndSearch:
+    """Outcome of :func:`search_from_high_end`.
+
+    Attributes
+    ----------
+    order : int
+        Controller order of every start.
+    starts : int
+        Random starts tried.
+    seed : int
+        Seed of the search (start ``i`` draws from ``numpy.random.default_rng([seed, i])``).
+    reaches : tuple of IntervalReach
+        The continuation of every start that decayed on the top band, in the order tried.
+    start_indices : tuple of int
+        The index ``i`` of each of ``reaches``.
+    frequency_band : tuple of float
+        The band (rad/s) the resonators' frequencies were drawn from.
+    """
+
+    order: int
+    starts: int
+    seed: int
+    reaches: tuple
+    start_indices: tuple
+    frequency_band: tuple
+
+    @property
+    def best(self) -> IntervalReach | None:
+        """The continuation that reached lowest (``None`` when no start held the top)."""
+        return min(self.reaches, key=lambda r: r.reached[0], default=None)
+
+    @property
+    def met(self) -> bool:
+        """True when some start held the whole target interval."""
+        return any(r.met for r in self.reaches)
+
+
+def _rightmost_complex_frequency(models: _Models, V: float) -> float:
+    """|Im λ| of the rightmost eigenvalue with a nonzero imaginary part of the open loops."""
+    lam = np.concatenate([np.linalg.eigvals(lp.A) for lp in models.loops(V)])
+    lam = lam[lam.imag > 1e-6 * max(1.0, float(np.max(np.abs(lam))))]
+    if lam.size == 0:
+        raise ConfigError(f"the open loop at V = {V:.4g} has no oscillatory mode to place "
+                          "the start's resonators at; give frequency_band explicitly")
+    return float(lam[np.argmax(lam.real)].imag)
+
+
+def _random_start(rng: np.random.Generator, order: int, m: int, band) -> control.StateSpace:
+    """An order-``order`` controller (``m`` sensors, one flap): ``order // 2`` resonators
+    with frequencies uniform in ``band`` and damping 0.5-10 %, one real pole at
+    ``-10^U(-1.5, 0.5)`` for an odd order, and Gaussian ``B``, ``C`` of log-uniform scale."""
+    blocks = []
+    if order % 2:
+        blocks.append(np.array([[-10.0 ** rng.uniform(-1.5, 0.5)]]))
+    for _ in range(order // 2):
+        w, z = rng.uniform(*band), rng.uniform(0.005, 0.1)
+        wd = w * math.sqrt(1 - z * z)
+        blocks.append(np.array([[-z * w, wd], [-wd, -z * w]]))
+    A = np.zeros((order, order))
+    k = 0
+    for blk in blocks:
+        s = blk.shape[0]
+        A[k:k + s, k:k + s] = blk
+        k += s
+    B = rng.standard_normal((order, m)) * 10.0 ** rng.uniform(-1, 1)
+    C = rng.standard_normal((1, order)) * 10.0 ** rng.uniform(-1, 1)
+    return control.ss(A, B, C, np.zeros((1, m)))
+
+
+def search_from_high_end(system, interval, order: int, *, starts: int = 20, seed: int = 0,
+                         frequency_band: tuple[float, float] | None = None,
+                         top_width: float = 0.1, decay: float = 0.05,
+                         max_iter: int = 300, **continuation) -> HighEndSearch:
+    """Seeded random order-``order`` controllers at the top of ``interval``, continued down.
+
+    Start ``i`` (``numpy.random.default_rng([seed, i])``) is optimised for the worst
+    closed-loop spectral abscissa at the two speeds ``hi - top_width`` and ``hi``; when it
+    decays there at the rate ``decay``, :func:`stabilize_interval` pushes its lower end
+    towards ``lo`` (anchor ``"high"``).  The same seed gives the same starts and the same
+    continuations whatever the thread count (the work runs single-threaded).
+
+    Parameters
+    ----------
+    system : LoopFamily or sequence of LoopFamily
+        ΣAE(V) of eq. 8-9, as for :func:`stabilize_interval`.
+    interval : (lo, hi)
+        Target speed-index interval, ``0 <= lo < hi``.
+    order : int
+        Controller order (>= 1).
+    starts : int
+        Random starts (>= 1).
+    seed : int
+        Seed of the starts.
+    frequency_band : (float, float), optional
+        Band (rad/s) of the resonators' frequencies; default 0.8-1.6 times the frequency of
+        the open loop's rightmost oscillatory mode at ``hi`` (the flutter mode): the
+        controllers that held the seed wing's top settled between 53 and 76 rad/s, about
+        1.1-1.6 times its 48 rad/s.
+    top_width : float
+        Width of the band at the top where a start must decay before it is continued.
+    decay : float
+        Decay rate (rad/s) required on the top band and by the continuation.
+    max_iter : int
+        BFGS iterations per temperature, on the top band and in the continuation.
+    **continuation
+        Further settings of :func:`stabilize_interval` (``n_speeds``, ``first_step``,
+        ``min_step``, ``max_rounds``, ``free_feedthrough``, ``stable_controller``); the last
+        two apply on the top band as well.
+
+    Returns
+    -------
+    HighEndSearch
+
+    Raises
+    ------
+    ConfigError
+        A bad interval, order, count, band or setting (before any optimisation).
+
+    See Also
+    --------
+    stabilize_interval : the continuation of one start.
+    full_order_start : the deterministic full-order start at the top.
+    """
+    lo, hi = _speed_interval(interval)
+    if not (isinstance(order, (int, np.integer)) and order >= 1):
+        raise ConfigError(f"order = {order!r}: an integer >= 1 (a dynamic controller)")
+    if not (isinstance(starts, (int, np.integer)) and starts >= 1):
+        raise ConfigError(f"starts = {starts!r}: an integer >= 1")
+    if not (0 < top_width and decay >= 0 and max_iter >= 1):
+        raise ConfigError(f"need top_width > 0, decay >= 0, max_iter >= 1; got "
+                          f"top_width={top_width!r}, decay={decay!r}, max_iter={max_iter!r}")
+    unknown = set(continuation) - {"n_speeds", "first_step", "min_step", "max_rounds",
+                                   "free_feedthrough", "stable_controller"}
+    if unknown:
+        raise ConfigError(f"unknown continuation settings {sorted(unknown)}; see "
+                          "stabilize_interval")
+    models = _Models.of(system)
+    if frequency_band is None:
+        w = _rightmost_complex_frequency(models, hi)
+        band = (0.8 * w, 1.6 * w)
+    else:
+        try:
+            band = tuple(float(x) for x in frequency_band)
+        except (TypeError, ValueError):
+            band = ()
+        if not (len(band) == 2 and 0 < band[0] <= band[1] and math.isfinite(band[1])):
+            raise ConfigError(f"frequency_band = {frequency_band!r}: need 0 < low <= high")
+    top = [max(lo, hi - top_width), hi]
+    free = bool(continuation.get("free_feedthrough", False))
+    stable = bool(continuation.get("stable_controller", False))
+    reaches, indices = [], []
+    with single_threaded():
+        for i in range(int(starts)):
+            rng = np.random.default_rng([int(seed), i])
+            K = _random_start(rng, int(order), models.n_sensors, band)
+            K, worst = _polish(models, K, top, max_iter, -2 * decay, free, stable)
+            if not worst < -decay:
+                log.info("high-end start %d: the top band does not decay (worst %.4g)", i, worst)
+                continue
+            reach = stabilize_interval(models, K, (lo, hi), anchor="high", decay=decay,
+                                       max_iter=max_iter, **continuation)
+            log.info("high-end start %d: reached [%.4g, %.4g]", i, *reach.reached)
+            reaches.append(reach)
+            indices.append(i)
+    return HighEndSearch(int(order), int(starts), int(seed), tuple(reaches), tuple(indices),
+                         band)

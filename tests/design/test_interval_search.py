@@ -1,0 +1,138 @@
+"""Seeded random low-order starts at the top of a speed interval, continued down.
+
+Fixture: ``problems/seed_wing/rom_loop_seed0.npz`` (Σf and Σs of the default run, seed 0),
+with the flap behind the 40 Hz servo, the loop the bench's ``--servo 251.3`` closes.
+Truth used: the verification layer's exact stable interval
+(:func:`casflutter.verify.speed_family_interval`, guardian map, python-control closing the
+loop) and eigenvalues of the closed loop formed here with numpy.
+"""
+
+from __future__ import annotations
+
+import control
+import numpy as np
+import pytest
+
+from casflutter._resources import problems_dir
+from casflutter.aeroelastic import load_rom_loop
+from casflutter.design import search_from_high_end, stabilize_interval
+from casflutter.design._interval import _ClosedLoopsAtSpeeds, _pack
+from casflutter.design._interval_search import _random_start
+from casflutter.errors import ConfigError
+from casflutter.verify import speed_family_interval
+
+
+def frozen_loop_with_servo():
+    rom, _ = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
+    return rom.with_servo(251.3)
+
+
+def _abscissa_here(family, K, V):
+    """Closed loop of ``v = K zm`` on ``family.loop(V)``'s flap-to-sensor map, formed here."""
+    G = family.loop(V).flap_to_sensors()
+    Ag, Bg, Cg, Dg = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (G.A, G.B, G.C, G.D))
+    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (K.A, K.B, K.C, K.D))
+    s = 1.0 - (Dk @ Dg).item()                     # v = Ck xk + Dk (Cg x + Dg v)
+    A = np.block([[Ag + Bg @ Dk @ Cg / s, Bg @ Ck / s],
+                  [Bk @ (Cg + Dg @ Dk @ Cg / s), Ak + Bk @ Dg @ Ck / s]])
+    return float(np.max(np.linalg.eigvals(A).real))
+
+
+def test_a_random_order3_start_holds_the_top_and_the_certificate_covers_its_claim():
+    family = frozen_loop_with_servo()
+    search = search_from_high_end(family, (2.2, 2.4), 3, starts=4, seed=0)
+    # the band is drawn around the flutter mode's frequency at the top (51.5 rad/s)
+    assert search.frequency_band == pytest.approx((0.8 * 51.48, 1.6 * 51.48), rel=1e-3)
+    assert search.reaches and search.met
+    best = search.best
+    assert best.reached == (2.2, 2.4) and best.controller.nstates == 3
+    cert = speed_family_interval(lambda V: family.loop(V).flap_to_sensors(), best.controller,
+                                 2.3)
+    assert cert.lower <= 2.2 and cert.upper >= 2.4        # the certificate covers the claim
+    for V in np.linspace(2.2, 2.4, 9):                    # and eigenvalues formed here agree
+        assert _abscissa_here(family, best.controller, V) < -0.04
+
+
+@pytest.mark.slow
+def test_order3_starts_from_the_top_of_the_frozen_rom_loop_stall_above_its_dip():
+    """The frozen ROM loop's flutter mode is gripped most weakly near V = 1.93 (growth
+    6.6 rad/s): order-3 continuations from the top stop above it, 2.03-2.06 with these
+    settings, while the paper's order-3 design from below stops at 1.88."""
+    family = frozen_loop_with_servo()
+    search = search_from_high_end(family, (0.05, 2.4), 3, starts=4, seed=0)
+    assert search.start_indices == (3,)
+    (reach,) = search.reaches
+    assert not reach.met and 1.93 < reach.reached[0] < 2.1
+    cert = speed_family_interval(lambda V: family.loop(V).flap_to_sensors(),
+                                 reach.controller, 2.3)
+    assert cert.lower <= reach.reached[0] and cert.upper >= 2.4
+    assert cert.lower > 1.9                # the certified interval, too, stops above the dip
+
+
+def test_the_starts_depend_on_the_seed_and_the_index_only():
+    a = _random_start(np.random.default_rng([7, 2]), 3, 2, (40.0, 80.0))
+    b = _random_start(np.random.default_rng([7, 2]), 3, 2, (40.0, 80.0))
+    c = _random_start(np.random.default_rng([7, 3]), 3, 2, (40.0, 80.0))
+    assert np.array_equal(a.A, b.A) and np.array_equal(a.B, b.B) and np.array_equal(a.C, b.C)
+    assert not np.array_equal(a.B, c.B)
+    # one real pole and one resonator in the band, all stable
+    poles = a.poles()
+    assert np.sum(np.abs(poles.imag) > 0) == 2 and np.all(poles.real < 0)
+    assert 40 <= np.max(np.abs(poles)) <= 80
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    (dict(interval=(2.4, 2.2)), "0 <= lo < hi"),
+    (dict(order=0), "order = 0"),
+    (dict(starts=0), "starts = 0"),
+    (dict(frequency_band=(80.0, 40.0)), "frequency_band"),
+    (dict(frequency_band=5.0), "frequency_band"),
+    (dict(top_width=0.0), "top_width"),
+    (dict(anchor="low"), "unknown continuation settings ['anchor']"),
+])
+def test_bad_requests_are_refused_before_any_work(kwargs, words):
+    args = dict(interval=(2.2, 2.4), order=3)
+    args.update(kwargs)
+    with pytest.raises(ConfigError, match=words.replace("[", r"\[").replace("]", r"\]")):
+        search_from_high_end(frozen_loop_with_servo(), args.pop("interval"), args.pop("order"),
+                             **args)
+
+
+def test_the_controllers_own_abscissa_and_its_gradient_join_the_objective():
+    """``stable_controller``: one more entry, the largest real part of ``eig(Ak)`` computed
+    here, with a gradient (``Ak`` only) equal to central differences."""
+    family = frozen_loop_with_servo()
+    rng = np.random.default_rng(5)
+    K = control.ss(rng.normal(size=(3, 3)), rng.normal(size=(3, 2)), rng.normal(size=(1, 3)),
+                   0.05 * rng.normal(size=(1, 2)))
+    loops = _ClosedLoopsAtSpeeds(family, [1.0, 2.0], 3, np.asarray(K.D), stable_controller=True)
+    p = _pack(K, True)
+    values, grads = loops.rightmost(p)
+    assert len(values) == 3 and np.array_equal(values, loops.abscissae(p))
+    assert values[-1] == pytest.approx(np.max(np.linalg.eigvals(K.A).real), abs=1e-12)
+    h = 1e-6
+    fd = np.array([(loops.abscissae(p + h * e)[-1] - loops.abscissae(p - h * e)[-1]) / (2 * h)
+                   for e in np.eye(len(p))])
+    assert np.max(np.abs(fd - grads[-1])) < 1e-6 * np.max(np.abs(fd))
+    assert np.all(fd[9:] == 0) and np.all(grads[-1][9:] == 0)     # B, C, D do not move it
+
+
+def test_a_stable_controller_search_keeps_the_controller_stable_and_is_certified():
+    family = frozen_loop_with_servo()
+    search = search_from_high_end(family, (2.2, 2.4), 3, starts=8, seed=0,
+                                  stable_controller=True)
+    assert search.reaches
+    for reach in search.reaches:
+        assert np.max(reach.controller.poles().real) <= -0.05 + 1e-9
+    best = search.best
+    cert = speed_family_interval(lambda V: family.loop(V).flap_to_sensors(), best.controller,
+                                 0.5 * sum(best.reached))
+    assert cert.lower <= best.reached[0] and cert.upper >= best.reached[1]
+
+
+def test_an_unstable_start_is_refused_when_the_controller_must_stay_stable():
+    K = control.ss(np.diag([0.5, -1.0, -2.0]), np.ones((3, 2)), np.ones((1, 3)),
+                   np.zeros((1, 2)))
+    with pytest.raises(ConfigError, match=r"itself is unstable \(a pole with real part 0.5"):
+        stabilize_interval(frozen_loop_with_servo(), K, (2.2, 2.4), anchor="high",
+                           stable_controller=True)
