@@ -97,13 +97,13 @@ def _flutter_mode_grip(family, lo: float, hi: float, n: int = 120) -> dict[str, 
                            "worst_overlap": res.worst_overlap,
                            "eigenvalue_at_hi": [float(res.eigenvalue[-1].real),
                                                 float(res.eigenvalue[-1].imag)]}
-    unstable = np.flatnonzero(res.eigenvalue.real > 0)
-    if unstable.size:
-        k = int(unstable[np.argmin(grip[unstable])])
+    k = res.weakest_index(unstable_only=True)
+    if k is not None:
+        onset = int(np.flatnonzero(res.eigenvalue.real > 0)[0])
         rec.update({"weakest_unstable_V": float(res.V[k]),
                     "growth_rate_there": float(res.eigenvalue[k].real),
                     "frequency_there": float(res.eigenvalue[k].imag),
-                    "grip_there": float(grip[k]), "grip_at_onset": float(grip[unstable[0]])})
+                    "grip_there": float(grip[k]), "grip_at_onset": float(grip[onset])})
     return rec
 
 
