@@ -123,12 +123,12 @@ def search_from_high_end(system, interval, order: int, *, starts: int = 20, seed
     starts : int
         Random starts (>= 1).
     seed : int
-        Seed of the starts.
+        Seed of the starts (>= 0).
     frequency_band : (float, float), optional
         Band (rad/s) of the resonators' frequencies; default 0.8-1.6 times the frequency of
-        the open loop's rightmost oscillatory mode at ``hi`` (the flutter mode): the
-        controllers that held the seed wing's top settled between 53 and 76 rad/s, about
-        1.1-1.6 times its 48 rad/s.
+        the open loop's rightmost oscillatory mode at ``hi`` (the flutter mode): on the seed
+        wing and its frozen ROM loop, the order-3 controllers that held V = 2.4 settled
+        between 53 and 76 rad/s, 1.0-1.6 times the flutter mode's 48-52 rad/s there.
     top_width : float
         Width of the band at the top where a start must decay before it is continued.
     decay : float
@@ -159,6 +159,8 @@ def search_from_high_end(system, interval, order: int, *, starts: int = 20, seed
         raise ConfigError(f"order = {order!r}: an integer >= 1 (a dynamic controller)")
     if not (isinstance(starts, (int, np.integer)) and starts >= 1):
         raise ConfigError(f"starts = {starts!r}: an integer >= 1")
+    if not (isinstance(seed, (int, np.integer)) and seed >= 0):
+        raise ConfigError(f"seed = {seed!r}: an integer >= 0")
     if not (0 < top_width and decay >= 0 and max_iter >= 1):
         raise ConfigError(f"need top_width > 0, decay >= 0, max_iter >= 1; got "
                           f"top_width={top_width!r}, decay={decay!r}, max_iter={max_iter!r}")

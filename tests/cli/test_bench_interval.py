@@ -27,6 +27,7 @@ from casflutter.verify import controller_from_json
     (["--high-orders", "0"], "orders >= 1"),
     (["--high-orders", "x"], "--high-orders K,K"),
     (["--high-orders", "3", "--high-starts", "0"], "--high-starts >= 1"),
+    (["--high-orders", "3", "--seed", "-2"], "--seed >= 0"),
 ])
 def test_bad_arguments_exit_2_at_once(tmp_path, capsys, args, words):
     t0 = time.perf_counter()

@@ -85,6 +85,7 @@ def test_the_starts_depend_on_the_seed_and_the_index_only():
     (dict(interval=(2.4, 2.2)), "0 <= lo < hi"),
     (dict(order=0), "order = 0"),
     (dict(starts=0), "starts = 0"),
+    (dict(seed=-1), "seed = -1"),
     (dict(frequency_band=(80.0, 40.0)), "frequency_band"),
     (dict(frequency_band=5.0), "frequency_band"),
     (dict(top_width=0.0), "top_width"),

@@ -260,9 +260,10 @@ def _handler(args: argparse.Namespace) -> int:
         print("casflutter bench interval: --interval LO,HI, --orders K,K,... and "
               "--high-orders K,K,... (numbers)", file=sys.stderr)
         return 2
-    if not 0 <= lo < hi or any(k < 1 for k in orders + high_orders) or args.high_starts < 1:
-        print("casflutter bench interval: need 0 <= LO < HI, orders >= 1 and "
-              "--high-starts >= 1", file=sys.stderr)
+    if (not 0 <= lo < hi or any(k < 1 for k in orders + high_orders) or args.high_starts < 1
+            or args.seed < 0):
+        print("casflutter bench interval: need 0 <= LO < HI, orders >= 1, --high-starts >= 1 "
+              "and --seed >= 0", file=sys.stderr)
         return 2
     try:    # everything checked before any design work; nothing is written until a result
         out = check_output_path(args.out, what="--out", suffixes=(".json",))
