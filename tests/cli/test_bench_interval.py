@@ -153,6 +153,8 @@ def test_random_order3_starts_from_the_high_end_are_recorded_and_certified(tmp_p
         np.max(np.linalg.eigvals(family.closed_loop_state_matrix(V, K)).real) < 0
         for V in np.linspace(2.2, 2.4, 11))
     assert doc["summary"]["lowest_lower_end_from_high"] == 2.2
+    assert doc["summary"]["by_order"] == {"3": {"highest_upper_end_from_low": None,
+                                                "lowest_lower_end_from_high": 2.2}}
 
 
 def test_the_flutter_mode_grip_record_finds_the_frozen_rom_loops_dip():

@@ -309,6 +309,15 @@ def _handler(args: argparse.Namespace) -> int:
         doc["summary"] = {
             "highest_upper_end_from_low": max(reached_low, default=None),
             "lowest_lower_end_from_high": min(reached_high, default=None),
+            # per controller order (JSON keys are strings): the bracket of each order
+            "by_order": {str(k): {
+                "highest_upper_end_from_low": max((r["reached"][1] for r in runs
+                                                   if r["anchor"] == "low" and r["order"] == k),
+                                                  default=None),
+                "lowest_lower_end_from_high": min((r["reached"][0] for r in runs
+                                                   if r["anchor"] == "high" and r["order"] == k),
+                                                  default=None)}
+                for k in sorted({r["order"] for r in runs})},
             "met_by_any": any(r["met"] for r in doc["runs"]),
             "target_certified_by_any": any(
                 r["verified_exact_interval"] is not None
