@@ -75,10 +75,34 @@ class ModeResidues:
         p = self.phase_deg
         return p.max(axis=0) - p.min(axis=0)
 
+    def weakest_index(self, *, unstable_only: bool = False) -> int | None:
+        """Index of the speed at which the flap's grip on the mode is weakest (smallest
+        :attr:`grip`).
+
+        Parameters
+        ----------
+        unstable_only : bool
+            Look only where the mode is unstable (``Re λ > 0``): the dip that matters to a
+            controller, rather than the lowest speeds, where the flap's aerodynamic force
+            vanishes with the dynamic pressure.
+
+        Returns
+        -------
+        int or None
+            ``None`` when ``unstable_only`` and the mode is stable at every speed.
+        """
+        grip = self.grip
+        candidates = (np.flatnonzero(self.eigenvalue.real > 0) if unstable_only
+                      else np.arange(len(self.V)))
+        if candidates.size == 0:
+            return None
+        return int(candidates[np.argmin(grip[candidates])])
+
     @property
     def weakest_V(self) -> float:
-        """The speed at which the flap's grip on the mode is weakest (smallest :attr:`grip`)."""
-        return float(self.V[int(np.argmin(self.grip))])
+        """The speed at which the flap's grip on the mode is weakest (smallest :attr:`grip`)
+        over all the speeds; see :meth:`weakest_index` for the unstable ones alone."""
+        return float(self.V[self.weakest_index()])
 
 
 def _eig_at(family, V: float):

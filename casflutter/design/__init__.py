@@ -6,8 +6,8 @@ LFT at Vf plus stability of ΣAE(V) over an interval, eq. 8-16); :func:`load_com
 the benchmark plants; :func:`partition`, :class:`Partition`; :func:`hinf_norm` /
 :func:`exact_hinf_norm` (the synthesis' own Hamiltonian norm) and :func:`verify_closed_loop`;
 :func:`stabilize_interval` with :func:`full_order_start` and :class:`IntervalReach` (how far
-one controller holds ΣAE(V) stable, by continuation in speed), :func:`search_from_high_end`
-with :class:`HighEndSearch` (seeded random low-order starts at the top, continued down) and :func:`reduce_order` with
+one controller holds ΣAE(V) stable, by continuation in speed), :func:`search_random_starts`
+with :class:`RandomStartSearch` (seeded random low-order starts at one end, continued) and :func:`reduce_order` with
 :class:`OrderReduction` (the same interval at lower orders, by continuation in the order),
 chained by :func:`design_interval_controller` (:class:`IntervalDesign`); :func:`order_relaxation` with
 :class:`OrderBound` (what order ``k`` can reach at a few frequencies: the rank relaxation,
@@ -19,7 +19,7 @@ from ._flutter import FlutterDesign, design_flutter_controller, loop_abscissa, w
 from ._interval import (IntervalDesign, IntervalReach, OrderReduction, OrderStep,
                         design_interval_controller, full_order_start, reduce_order,
                         stabilize_interval)
-from ._interval_search import HighEndSearch, search_from_high_end
+from ._interval_search import RandomStartSearch, search_random_starts
 from ._norm import hinf_norm
 from ._orderbound import (OrderBound, StaticDirectionBound, order_relaxation,
                           static_direction_bound)
@@ -31,6 +31,6 @@ __all__ = ["synthesize", "SynthesisOptions", "SynthesisResult", "StartRecord",
            "design_flutter_controller", "with_flap_rate", "FlutterDesign", "loop_abscissa",
            "stabilize_interval", "full_order_start", "IntervalReach",
            "reduce_order", "OrderReduction", "OrderStep", "design_interval_controller",
-           "IntervalDesign", "search_from_high_end", "HighEndSearch",
+           "IntervalDesign", "search_random_starts", "RandomStartSearch",
            "order_relaxation", "OrderBound", "static_direction_bound", "StaticDirectionBound",
            "load_compleib", "partition", "Partition", "exact_hinf_norm", "hinf_norm", "verify_closed_loop"]

@@ -1,15 +1,15 @@
-"""Random fixed-order starts at the top of a speed interval, continued downwards (eq. 8-9).
+"""Random fixed-order starts at one end of a speed interval, continued to the other (eq. 8-9).
 
 :func:`~casflutter.design.stabilize_interval` continues one controller; where it stalls
 depends on the start.  From the low end the natural start is the paper's design at Vf; from
 the high end the only deterministic start is the full-order LQG of
 :func:`~casflutter.design.full_order_start`, whose truncations to a low order rarely hold the
-top.  :func:`search_from_high_end` supplies low-order starts there: seeded random controllers
-made of lightly damped resonators near the flutter mode's frequency (and one real pole for an
-odd order), each optimised for the worst spectral abscissa on a short band at the top of the
-interval and, when that band decays, continued down.  Together with the low-end continuations
-this brackets what one controller *of a given order* can hold, the question of the paper's
-order-3 interval (0, 2.4).
+top.  :func:`search_random_starts` supplies low-order starts at either end: seeded random
+controllers made of lightly damped resonators near the flutter mode's frequency (and one real
+pole for an odd order), each optimised for the worst spectral abscissa on a short band at the
+anchor end and, when that band decays, continued towards the other end.  From both ends it
+brackets what one controller *of a given order* can hold, and whether two of that order, one
+from each end, overlap: the question of the paper's order-3 interval (0, 2.4).
 """
 
 from __future__ import annotations
@@ -25,17 +25,19 @@ from .._threads import single_threaded
 from ..errors import ConfigError
 from ._interval import IntervalReach, _Models, _polish, _speed_interval, stabilize_interval
 
-__all__ = ["HighEndSearch", "search_from_high_end"]
+__all__ = ["RandomStartSearch", "search_random_starts"]
 
 log = logging.getLogger("casflutter.design")
 
 
 @dataclass(frozen=True)
-class HighEndSearch:
-    """Outcome of :func:`search_from_high_end`.
+class RandomStartSearch:
+    """Outcome of :func:`search_random_starts`.
 
     Attributes
     ----------
+    anchor : str
+        ``"low"`` or ``"high"``: the end the starts were made at.
     order : int
         Controller order of every start.
     starts : int
@@ -43,13 +45,14 @@ class HighEndSearch:
     seed : int
         Seed of the search (start ``i`` draws from ``numpy.random.default_rng([seed, i])``).
     reaches : tuple of IntervalReach
-        The continuation of every start that decayed on the top band, in the order tried.
+        The continuation of every start that decayed on the anchor band, in the order tried.
     start_indices : tuple of int
         The index ``i`` of each of ``reaches``.
     frequency_band : tuple of float
         The band (rad/s) the resonators' frequencies were drawn from.
     """
 
+    anchor: str
     order: int
     starts: int
     seed: int
@@ -59,8 +62,11 @@ class HighEndSearch:
 
     @property
     def best(self) -> IntervalReach | None:
-        """The continuation that reached lowest (``None`` when no start held the top)."""
-        return min(self.reaches, key=lambda r: r.reached[0], default=None)
+        """The continuation that reached farthest from the anchor (``None`` when no start
+        held the anchor band)."""
+        if self.anchor == "high":
+            return min(self.reaches, key=lambda r: r.reached[0], default=None)
+        return max(self.reaches, key=lambda r: r.reached[1], default=None)
 
     @property
     def met(self) -> bool:
@@ -100,17 +106,19 @@ def _random_start(rng: np.random.Generator, order: int, m: int, band) -> control
     return control.ss(A, B, C, np.zeros((1, m)))
 
 
-def search_from_high_end(system, interval, order: int, *, starts: int = 20, seed: int = 0,
+def search_random_starts(system, interval, order: int, *, anchor: str = "high",
+                         starts: int = 20, seed: int = 0,
                          frequency_band: tuple[float, float] | None = None,
-                         top_width: float = 0.1, decay: float = 0.05,
-                         max_iter: int = 300, **continuation) -> HighEndSearch:
-    """Seeded random order-``order`` controllers at the top of ``interval``, continued down.
+                         anchor_width: float = 0.1, decay: float = 0.05,
+                         max_iter: int = 300, **continuation) -> RandomStartSearch:
+    """Seeded random order-``order`` controllers at one end of ``interval``, continued.
 
     Start ``i`` (``numpy.random.default_rng([seed, i])``) is optimised for the worst
-    closed-loop spectral abscissa at the two speeds ``hi - top_width`` and ``hi``; when it
-    decays there at the rate ``decay``, :func:`stabilize_interval` pushes its lower end
-    towards ``lo`` (anchor ``"high"``).  The same seed gives the same starts and the same
-    continuations whatever the thread count (the work runs single-threaded).
+    closed-loop spectral abscissa at the two speeds of the anchor band (``hi - anchor_width``
+    and ``hi``, or ``lo`` and ``lo + anchor_width``); when it decays there at the rate
+    ``decay``, :func:`stabilize_interval` pushes the other end of its interval towards the
+    target's.  The same seed gives the same starts and the same continuations whatever the
+    thread count (the work runs single-threaded).
 
     Parameters
     ----------
@@ -120,34 +128,37 @@ def search_from_high_end(system, interval, order: int, *, starts: int = 20, seed
         Target speed-index interval, ``0 <= lo < hi``.
     order : int
         Controller order (>= 1).
+    anchor : {"high", "low"}
+        The end the starts are made at.
     starts : int
         Random starts (>= 1).
     seed : int
-        Seed of the starts.
+        Seed of the starts (>= 0).
     frequency_band : (float, float), optional
         Band (rad/s) of the resonators' frequencies; default 0.8-1.6 times the frequency of
-        the open loop's rightmost oscillatory mode at ``hi`` (the flutter mode): the
-        controllers that held the seed wing's top settled between 53 and 76 rad/s, about
-        1.1-1.6 times its 48 rad/s.
-    top_width : float
-        Width of the band at the top where a start must decay before it is continued.
+        the open loop's rightmost oscillatory mode at ``hi`` (the flutter mode): on the seed
+        wing and its frozen ROM loop, the order-3 controllers that held V = 2.4 settled
+        between 53 and 76 rad/s, 1.0-1.6 times the flutter mode's 48-52 rad/s there.
+    anchor_width : float
+        Width of the band at the anchor end where a start must decay before it is continued.
     decay : float
-        Decay rate (rad/s) required on the top band and by the continuation.
+        Decay rate (rad/s) required on the anchor band and by the continuation.
     max_iter : int
-        BFGS iterations per temperature, on the top band and in the continuation.
+        BFGS iterations per temperature, on the anchor band and in the continuation.
     **continuation
         Further settings of :func:`stabilize_interval` (``n_speeds``, ``first_step``,
         ``min_step``, ``max_rounds``, ``free_feedthrough``, ``stable_controller``); the last
-        two apply on the top band as well.
+        two apply on the anchor band as well.
 
     Returns
     -------
-    HighEndSearch
+    RandomStartSearch
 
     Raises
     ------
     ConfigError
-        A bad interval, order, count, band or setting (before any optimisation).
+        A bad interval, anchor, order, count, seed, band or setting (before any
+        optimisation).
 
     See Also
     --------
@@ -155,13 +166,18 @@ def search_from_high_end(system, interval, order: int, *, starts: int = 20, seed
     full_order_start : the deterministic full-order start at the top.
     """
     lo, hi = _speed_interval(interval)
+    if anchor not in ("low", "high"):
+        raise ConfigError(f"anchor = {anchor!r}: 'low' or 'high'")
     if not (isinstance(order, (int, np.integer)) and order >= 1):
         raise ConfigError(f"order = {order!r}: an integer >= 1 (a dynamic controller)")
     if not (isinstance(starts, (int, np.integer)) and starts >= 1):
         raise ConfigError(f"starts = {starts!r}: an integer >= 1")
-    if not (0 < top_width and decay >= 0 and max_iter >= 1):
-        raise ConfigError(f"need top_width > 0, decay >= 0, max_iter >= 1; got "
-                          f"top_width={top_width!r}, decay={decay!r}, max_iter={max_iter!r}")
+    if not (isinstance(seed, (int, np.integer)) and seed >= 0):
+        raise ConfigError(f"seed = {seed!r}: an integer >= 0")
+    if not (0 < anchor_width and decay >= 0 and max_iter >= 1):
+        raise ConfigError(f"need anchor_width > 0, decay >= 0, max_iter >= 1; got "
+                          f"anchor_width={anchor_width!r}, decay={decay!r}, "
+                          f"max_iter={max_iter!r}")
     unknown = set(continuation) - {"n_speeds", "first_step", "min_step", "max_rounds",
                                    "free_feedthrough", "stable_controller"}
     if unknown:
@@ -178,7 +194,8 @@ def search_from_high_end(system, interval, order: int, *, starts: int = 20, seed
             band = ()
         if not (len(band) == 2 and 0 < band[0] <= band[1] and math.isfinite(band[1])):
             raise ConfigError(f"frequency_band = {frequency_band!r}: need 0 < low <= high")
-    top = [max(lo, hi - top_width), hi]
+    band_speeds = ([max(lo, hi - anchor_width), hi] if anchor == "high"
+                   else [lo, min(hi, lo + anchor_width)])
     free = bool(continuation.get("free_feedthrough", False))
     stable = bool(continuation.get("stable_controller", False))
     reaches, indices = [], []
@@ -186,14 +203,15 @@ def search_from_high_end(system, interval, order: int, *, starts: int = 20, seed
         for i in range(int(starts)):
             rng = np.random.default_rng([int(seed), i])
             K = _random_start(rng, int(order), models.n_sensors, band)
-            K, worst = _polish(models, K, top, max_iter, -2 * decay, free, stable)
+            K, worst = _polish(models, K, band_speeds, max_iter, -2 * decay, free, stable)
             if not worst < -decay:
-                log.info("high-end start %d: the top band does not decay (worst %.4g)", i, worst)
+                log.info("%s-end start %d: the anchor band does not decay (worst %.4g)",
+                         anchor, i, worst)
                 continue
-            reach = stabilize_interval(models, K, (lo, hi), anchor="high", decay=decay,
+            reach = stabilize_interval(models, K, (lo, hi), anchor=anchor, decay=decay,
                                        max_iter=max_iter, **continuation)
-            log.info("high-end start %d: reached [%.4g, %.4g]", i, *reach.reached)
+            log.info("%s-end start %d: reached [%.4g, %.4g]", anchor, i, *reach.reached)
             reaches.append(reach)
             indices.append(i)
-    return HighEndSearch(int(order), int(starts), int(seed), tuple(reaches), tuple(indices),
-                         band)
+    return RandomStartSearch(anchor, int(order), int(starts), int(seed), tuple(reaches),
+                             tuple(indices), band)

@@ -33,7 +33,7 @@ models = {"wing (truth linearisation)": mode_residues(wing, speeds),
           "default ROM loop (frozen, eq. 8)": mode_residues(rom.with_servo(SERVO), speeds)}
 
 for name, res in models.items():
-    k = int(np.argmin(np.abs(res.V - res.weakest_V)))
+    k = res.weakest_index()
     print(f"{name:34s} residues turn by {np.round(res.phase_swing_deg).astype(int)} deg; "
           f"weakest grip at V = {res.weakest_V:.2f}, where the mode grows at "
           f"{res.eigenvalue[k].real:.2f} rad/s ({res.eigenvalue[k].imag:.1f} rad/s)")

@@ -76,6 +76,25 @@ def test_the_flaps_grip_on_the_flutter_mode_turns_round(wing, rom):
     assert r.eigenvalue[r.V == r.weakest_V][0].real > 6
 
 
+def test_the_weakest_grip_where_the_mode_is_unstable(wing, rom):
+    """Over the paper's whole interval the weakest grip is at the lowest speed, where the
+    flap's force vanishes with the dynamic pressure; among the unstable speeds it is the dip
+    (wing near 1.46, frozen ROM loop near 1.93), and there is none below flutter."""
+    speeds = np.linspace(0.05, 2.4, 48)
+    w = mode_residues(wing, speeds)
+    assert w.weakest_V == pytest.approx(0.05)
+    k = w.weakest_index(unstable_only=True)
+    assert w.eigenvalue[k].real > 0 and 1.3 < w.V[k] < 1.6
+    unstable = w.eigenvalue.real > 0
+    assert w.grip[k] == pytest.approx(np.min(w.grip[unstable]))     # computed here
+    r = mode_residues(rom.with_servo(SERVO), speeds)
+    assert 1.85 < r.V[r.weakest_index(unstable_only=True)] < 2.05
+    below = mode_residues(wing, np.linspace(0.05, 1.0, 12))
+    assert np.all(below.eigenvalue.real < 0)
+    assert below.weakest_index(unstable_only=True) is None
+    assert below.weakest_index() == int(np.argmin(below.grip))
+
+
 @pytest.mark.parametrize("speeds, kwargs, words", [
     ([2.0, 1.0], {}, "increasing"),
     ([1.0], {}, "at least 2"),

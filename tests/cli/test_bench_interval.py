@@ -3,7 +3,7 @@
 The benchmark itself takes minutes (two continuations and the exact intervals); what it
 computes is tested in ``tests/design/test_interval_reach.py``.  One short run carries a saved
 controller over part of the interval (``--start``), another continues random order-3 starts
-from the top (``--high-orders``); both check their record against the verification layer.
+from the top (``--random-orders``); both check their record against the verification layer.
 """
 
 from __future__ import annotations
@@ -24,9 +24,10 @@ from casflutter.verify import controller_from_json
     (["--interval", "2.4,0.05"], "LO < HI"),
     (["--interval", "a,b"], "numbers"),
     (["--orders", "0"], "orders >= 1"),
-    (["--high-orders", "0"], "orders >= 1"),
-    (["--high-orders", "x"], "--high-orders K,K"),
-    (["--high-orders", "3", "--high-starts", "0"], "--high-starts >= 1"),
+    (["--random-orders", "0"], "orders >= 1"),
+    (["--random-orders", "x"], "--random-orders K,K"),
+    (["--random-orders", "3", "--random-starts", "0"], "--random-starts >= 1"),
+    (["--random-orders", "3", "--seed", "-2"], "--seed >= 0"),
 ])
 def test_bad_arguments_exit_2_at_once(tmp_path, capsys, args, words):
     t0 = time.perf_counter()
@@ -131,14 +132,15 @@ def test_random_order3_starts_from_the_high_end_are_recorded_and_certified(tmp_p
     stable themselves: the one that held (2.2, 2.4) is recorded with the count of starts that
     held the top, and the verification layer's exact interval covers its claim."""
     out = tmp_path / "b.json"
-    assert main(["bench", "interval", "--high-orders", "3", "--high-starts", "4", "--high-stable",
+    assert main(["bench", "interval", "--random-orders", "3", "--random-ends", "high",
+                 "--random-starts", "4", "--random-stable",
                  "--orders", "", "--no-full-order", "--servo", "251.3",
                  "--interval", "2.2,2.4", "--out", str(out)]) == 0
     doc = json.loads(out.read_text())
     (run,) = doc["runs"]
     assert run["anchor"] == "high" and run["order"] == 3 and run["random_starts"] == 4
     assert run["stable_controller"] and run["controller_spectral_abscissa"] <= -0.05 + 1e-9
-    assert 1 <= run["held_the_top"] <= 4 and len(run["lower_ends"]) == run["held_the_top"]
+    assert 1 <= run["held_the_anchor"] <= 4 and len(run["far_ends"]) == run["held_the_anchor"]
     assert run["met"] and run["reached"] == [2.2, 2.4]
     lo, hi = run["verified_exact_interval"]
     assert lo <= 2.2 and hi >= 2.4
@@ -152,6 +154,8 @@ def test_random_order3_starts_from_the_high_end_are_recorded_and_certified(tmp_p
         np.max(np.linalg.eigvals(family.closed_loop_state_matrix(V, K)).real) < 0
         for V in np.linspace(2.2, 2.4, 11))
     assert doc["summary"]["lowest_lower_end_from_high"] == 2.2
+    assert doc["summary"]["by_order"] == {"3": {"highest_upper_end_from_low": None,
+                                                "lowest_lower_end_from_high": 2.2}}
 
 
 def test_the_flutter_mode_grip_record_finds_the_frozen_rom_loops_dip():

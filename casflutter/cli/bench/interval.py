@@ -8,11 +8,12 @@ the paper's interval V ∈ (0.05, 2.4)?  Two continuations bracket the answer
   controller settings), its upper end pushed towards the target;
 * from the high end (``--full-order``): an LQG controller of the loop's own order designed at
   the target's upper end, its lower end pushed down;
-* from the high end at a low order (``--high-orders``): ``--high-starts`` seeded random
-  controllers of each order at the top (:func:`casflutter.design.search_from_high_end`), the
-  one that reaches lowest recorded with the lower ends of all that held the top
-  (``--high-stable``: controllers that are stable themselves).  With the low-end
-  continuations this brackets what one controller of that order holds.
+* random starts of a given order (``--random-orders``): ``--random-starts`` seeded random
+  controllers of each order at each end of ``--random-ends``
+  (:func:`casflutter.design.search_random_starts`), the one that reaches farthest recorded
+  with the far ends of all that held their anchor (``--random-stable``: controllers that are
+  stable themselves).  From both ends this brackets what one controller of that order
+  holds, and whether two, one from each end, overlap (the summary's ``by_order``).
 
 Every controller's exact stable interval is then certified by the independent verification
 layer (:func:`casflutter.verify.verify_controller`, guardian map on the LFT at Vf).  Every
@@ -97,13 +98,13 @@ def _flutter_mode_grip(family, lo: float, hi: float, n: int = 120) -> dict[str, 
                            "worst_overlap": res.worst_overlap,
                            "eigenvalue_at_hi": [float(res.eigenvalue[-1].real),
                                                 float(res.eigenvalue[-1].imag)]}
-    unstable = np.flatnonzero(res.eigenvalue.real > 0)
-    if unstable.size:
-        k = int(unstable[np.argmin(grip[unstable])])
+    k = res.weakest_index(unstable_only=True)
+    if k is not None:
+        onset = int(np.flatnonzero(res.eigenvalue.real > 0)[0])
         rec.update({"weakest_unstable_V": float(res.V[k]),
                     "growth_rate_there": float(res.eigenvalue[k].real),
                     "frequency_there": float(res.eigenvalue[k].imag),
-                    "grip_there": float(grip[k]), "grip_at_onset": float(grip[unstable[0]])})
+                    "grip_there": float(grip[k]), "grip_at_onset": float(grip[onset])})
     return rec
 
 
@@ -169,34 +170,39 @@ def _start_runs(family, lo: float, hi: float, starts, verify, doc, write) -> Non
                  K.nstates, reach, verify(0.5 * sum(reach.reached), reach.controller), t0)
 
 
-def _high_end_runs(family, lo: float, hi: float, orders, starts: int, seed: int,
-                   stable: bool, verify, doc, write) -> None:
-    """For each of ``orders``, ``starts`` seeded random controllers at ``hi`` continued down
-    (:func:`casflutter.design.search_from_high_end`, kept stable themselves when ``stable``);
-    the one that reached lowest is certified and recorded with the lower ends of all."""
-    from ...design import search_from_high_end  # noqa: PLC0415
+def _random_runs(family, lo: float, hi: float, orders, ends, starts: int, seed: int,
+                 stable: bool, verify, doc, write) -> None:
+    """For each of ``orders`` and each anchor of ``ends``, ``starts`` seeded random
+    controllers continued from that end (:func:`casflutter.design.search_random_starts`,
+    kept stable themselves when ``stable``); the one that reached farthest is certified and
+    recorded with the far ends of all."""
+    from ...design import search_random_starts  # noqa: PLC0415
 
     for order in orders:
-        t0 = time.perf_counter()
-        search = search_from_high_end(family, (lo, hi), order, starts=starts, seed=seed,
-                                      stable_controller=stable)
-        extra = {"random_starts": starts, "stable_controller": stable,
-                 "held_the_top": len(search.reaches),
-                 "lower_ends": [r.reached[0] for r in search.reaches],
-                 "frequency_band": list(search.frequency_band)}
-        best = search.best
-        kind = f"random order-{order} starts at V = {hi:g} (seed {seed})"
-        if best is None:
-            _log.warning("order %d: none of %d random starts held the top", order, starts)
-            doc["runs"].append({"start": kind, "order": order, "anchor": "high",
-                                "reached": None, "met": False,
-                                "error": "no start decayed at the top", **extra,
-                                "wall_time_s": time.perf_counter() - t0})
-            write()
-            continue
-        _add_run(doc, write, f"order {order} from the high end ({len(search.reaches)} of "
-                             f"{starts} starts held the top)", kind, order, best,
-                 verify(0.5 * sum(best.reached), best.controller), t0, **extra)
+        for anchor in ends:
+            t0 = time.perf_counter()
+            search = search_random_starts(family, (lo, hi), order, anchor=anchor,
+                                          starts=starts, seed=seed, stable_controller=stable)
+            far = 0 if anchor == "high" else 1
+            extra = {"random_starts": starts, "stable_controller": stable,
+                     "held_the_anchor": len(search.reaches),
+                     "far_ends": [r.reached[far] for r in search.reaches],
+                     "frequency_band": list(search.frequency_band)}
+            best = search.best
+            V = hi if anchor == "high" else lo
+            kind = f"random order-{order} starts at V = {V:g} (seed {seed})"
+            if best is None:
+                _log.warning("order %d: none of %d random starts held the %s end", order,
+                             starts, anchor)
+                doc["runs"].append({"start": kind, "order": order, "anchor": anchor,
+                                    "reached": None, "met": False,
+                                    "error": f"no start decayed at the {anchor} end", **extra,
+                                    "wall_time_s": time.perf_counter() - t0})
+                write()
+                continue
+            _add_run(doc, write, f"order {order} from the {anchor} end ({len(search.reaches)} "
+                                 f"of {starts} random starts held it)", kind, order, best,
+                     verify(0.5 * sum(best.reached), best.controller), t0, **extra)
 
 
 def _truth_runs(family, lo: float, hi: float, orders, doc, write) -> None:
@@ -255,14 +261,15 @@ def _handler(args: argparse.Namespace) -> int:
     try:
         lo, hi = (float(x) for x in str(args.interval).split(","))
         orders = [int(o) for o in str(args.orders).split(",") if o.strip()]
-        high_orders = [int(o) for o in str(args.high_orders).split(",") if o.strip()]
+        random_orders = [int(o) for o in str(args.random_orders).split(",") if o.strip()]
     except ValueError:
         print("casflutter bench interval: --interval LO,HI, --orders K,K,... and "
-              "--high-orders K,K,... (numbers)", file=sys.stderr)
+              "--random-orders K,K,... (numbers)", file=sys.stderr)
         return 2
-    if not 0 <= lo < hi or any(k < 1 for k in orders + high_orders) or args.high_starts < 1:
-        print("casflutter bench interval: need 0 <= LO < HI, orders >= 1 and "
-              "--high-starts >= 1", file=sys.stderr)
+    if (not 0 <= lo < hi or any(k < 1 for k in orders + random_orders)
+            or args.random_starts < 1 or args.seed < 0):
+        print("casflutter bench interval: need 0 <= LO < HI, orders >= 1, "
+              "--random-starts >= 1 and --seed >= 0", file=sys.stderr)
         return 2
     try:    # everything checked before any design work; nothing is written until a result
         out = check_output_path(args.out, what="--out", suffixes=(".json",))
@@ -308,6 +315,15 @@ def _handler(args: argparse.Namespace) -> int:
         doc["summary"] = {
             "highest_upper_end_from_low": max(reached_low, default=None),
             "lowest_lower_end_from_high": min(reached_high, default=None),
+            # per controller order (JSON keys are strings): the bracket of each order
+            "by_order": {str(k): {
+                "highest_upper_end_from_low": max((r["reached"][1] for r in runs
+                                                   if r["anchor"] == "low" and r["order"] == k),
+                                                  default=None),
+                "lowest_lower_end_from_high": min((r["reached"][0] for r in runs
+                                                   if r["anchor"] == "high" and r["order"] == k),
+                                                  default=None)}
+                for k in sorted({r["order"] for r in runs})},
             "met_by_any": any(r["met"] for r in doc["runs"]),
             "target_certified_by_any": any(
                 r["verified_exact_interval"] is not None
@@ -327,8 +343,9 @@ def _handler(args: argparse.Namespace) -> int:
         def verify(nominal, K):
             return _verified(system, nominal, K)
     _start_runs(family, lo, hi, starts, verify, doc, write)
-    _high_end_runs(family, lo, hi, high_orders, args.high_starts, args.seed, args.high_stable,
-                   verify, doc, write)
+    ends = ("low", "high") if args.random_ends == "both" else (args.random_ends,)
+    _random_runs(family, lo, hi, random_orders, ends, args.random_starts, args.seed,
+                 args.random_stable, verify, doc, write)
     if args.model == "truth":
         _truth_runs(family, lo, hi, orders, doc, write)
         doc["rhp_zero_crossings"] = _rhp_zero_crossings(family, lo, hi, tuple(args.zero_band))
@@ -383,12 +400,15 @@ def register(subparsers) -> None:
     p.add_argument("--start", action="append", default=[], metavar="FILE",
                    help="a saved controller (verification JSON, v = K zm) to continue from "
                         "the low end as well; repeatable")
-    p.add_argument("--high-orders", default="",
-                   help="orders of random starts continued from the high end (default none)")
-    p.add_argument("--high-starts", type=int, default=20,
-                   help="random starts per --high-orders order (seeded by --seed)")
-    p.add_argument("--high-stable", action="store_true",
-                   help="keep the --high-orders controllers stable themselves (their poles "
+    p.add_argument("--random-orders", default="",
+                   help="orders of seeded random starts continued from the ends of the "
+                        "interval (default none)")
+    p.add_argument("--random-ends", choices=("both", "low", "high"), default="both",
+                   help="the ends the random starts are made at")
+    p.add_argument("--random-starts", type=int, default=20,
+                   help="random starts per order and end (seeded by --seed)")
+    p.add_argument("--random-stable", action="store_true",
+                   help="keep the random-start controllers stable themselves (their poles "
                         "join the objective)")
     p.add_argument("--full-order", action=argparse.BooleanOptionalAction, default=True,
                    help="also the full-order continuation from the high end")
@@ -396,6 +416,6 @@ def register(subparsers) -> None:
                    metavar=("W_LO", "W_HI"),
                    help="frequency band [rad/s] of the zero crossings reported")
     p.add_argument("--seed", type=int, default=0,
-                   help="seed of the paper design's starts and of the high-end random starts")
+                   help="seed of the paper design's starts and of the random starts")
     p.add_argument("--out", required=True, help="output JSON file")
     p.set_defaults(func=_handler)
