@@ -8,7 +8,7 @@ the loop is not taken from the optimiser: the verification layer certifies each 
 interval (polynomial guardian map, the loop closed by python-control) and a dense eigenvalue scan
 of the loop closed here with numpy agrees.  The two intervals overlap, so a controller switched
 at a speed in the overlap holds every frozen speed of the paper's interval; no single controller
-of order 3 to 32 was found to.
+of order 3 to 32 was found to.  Both controllers are stable themselves.
 """
 
 from __future__ import annotations
@@ -54,7 +54,7 @@ def test_two_order4_controllers_cover_the_paper_interval_on_the_rom_loop(family)
     c_high = speed_family_interval(plant, high, 2.2)
     assert c_low.lower == 0.0 and 1.90 < c_low.upper < 1.91
     assert 1.84 < c_high.lower < 1.85 and c_high.upper >= 2.4
-    assert c_high.lower < c_low.upper                          # they overlap: (1.847, 1.903)
+    assert c_high.lower < c_low.upper                          # they overlap: (1.844, 1.903)
     # a dense scan of each part, closed here, agrees
     for K, speeds in ((low, np.linspace(0.05, 1.90, 38)), (high, np.linspace(1.85, 2.4, 23))):
         assert max(_abscissa_here(family, K, V) for V in speeds) < 0
@@ -62,10 +62,10 @@ def test_two_order4_controllers_cover_the_paper_interval_on_the_rom_loop(family)
     assert _abscissa_here(family, low, 2.0) > 0 and _abscissa_here(family, high, 1.8) > 0
 
 
-def test_the_upper_controller_is_itself_unstable(family):
-    """The loop holds the upper controller's own unstable resonator (+15.5 ± 56.5j) only
-    above its interval's lower end; the lower controller is stable."""
-    high, low = _controller("rom_order4_high_controller.json"), _controller(
-        "rom_order4_low_controller.json")
-    assert np.max(high.poles().real) == pytest.approx(15.5, abs=0.1)
-    assert np.max(low.poles().real) < 0
+def test_both_controllers_are_stable_themselves():
+    """Found with ``stable_controller`` (upper) and from a stable start (lower): neither
+    relies on the plant to hold its own poles, so a failed flap or sensor leaves a stable
+    controller."""
+    for end in ("low", "high"):
+        K = _controller(f"rom_order4_{end}_controller.json")
+        assert np.max(np.linalg.eigvals(np.asarray(K.A)).real) < -0.1
