@@ -13,6 +13,7 @@ ORDER = (
     "plot_seed_wing_pipeline.py",
     "plot_seed_wing_control_models.py",
     "plot_flutter_mode_residues.py",
+    "plot_two_controllers.py",
     "plot_wing_file.py",
     "plot_sweep.py",
     "plot_sensitivity.py",
