@@ -143,6 +143,15 @@ def _add_run(doc, write, label: str, kind: str, order: int, reach, verified: dic
     write()
 
 
+def _add_failed(doc, write, kind: str, order: int, anchor: str, error: str, t0: float,
+                **extra) -> None:
+    """Record a continuation that could not start (``reached`` None: the summary skips it)."""
+    doc["runs"].append({"start": kind, "order": order, "anchor": anchor, "reached": None,
+                        "met": False, "error": error, **extra,
+                        "wall_time_s": time.perf_counter() - t0})
+    write()
+
+
 def _from_high_end(family, lo: float, hi: float):
     """An LQG controller of the loop's own order at ``hi``, its lower end pushed to ``lo``."""
     from ...design import full_order_start, stabilize_interval  # noqa: PLC0415
@@ -162,9 +171,7 @@ def _start_runs(family, lo: float, hi: float, starts, verify, doc, write) -> Non
             reach = stabilize_interval(family, K, (lo, hi), anchor="low")
         except ConfigError as exc:     # it does not hold this model's low end
             _log.warning("start %s: %s", path, exc)
-            doc["runs"].append({"start": f"file {path}", "order": K.nstates, "anchor": "low",
-                                "reached": None, "met": False, "error": str(exc)})
-            write()
+            _add_failed(doc, write, f"file {path}", K.nstates, "low", str(exc), t0)
             continue
         _add_run(doc, write, f"{path}, order {K.nstates} from the low end", f"file {path}",
                  K.nstates, reach, verify(0.5 * sum(reach.reached), reach.controller), t0)
@@ -194,11 +201,8 @@ def _random_runs(family, lo: float, hi: float, orders, ends, starts: int, seed: 
             if best is None:
                 _log.warning("order %d: none of %d random starts held the %s end", order,
                              starts, anchor)
-                doc["runs"].append({"start": kind, "order": order, "anchor": anchor,
-                                    "reached": None, "met": False,
-                                    "error": f"no start decayed at the {anchor} end", **extra,
-                                    "wall_time_s": time.perf_counter() - t0})
-                write()
+                _add_failed(doc, write, kind, order, anchor,
+                            f"no start decayed at the {anchor} end", t0, **extra)
                 continue
             _add_run(doc, write, f"order {order} from the {anchor} end ({len(search.reaches)} "
                                  f"of {starts} random starts held it)", kind, order, best,
