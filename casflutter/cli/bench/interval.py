@@ -352,27 +352,23 @@ def _handler(args: argparse.Namespace) -> int:
                  args.random_stable, verify, doc, write)
     if args.model == "truth":
         _truth_runs(family, lo, hi, orders, doc, write)
-        doc["rhp_zero_crossings"] = _rhp_zero_crossings(family, lo, hi, tuple(args.zero_band))
-        doc["flutter_mode_grip"] = _flutter_mode_grip(family, lo, hi)
-        write()
-        print(f"wrote {out}", file=sys.stderr)
-        return 0
-    for order in orders:
-        t0 = time.perf_counter()
-        design = design_flutter_controller(
-            system, Vf, order, starts=c.starts, seed=args.seed, options=options,
-            flap_rate_weight=c.flap_rate_weight, flap_rate_bandwidth=c.flap_rate_bandwidth)
-        reach = stabilize_interval(family, design.controller, (lo, hi), anchor="low")
-        _add_run(doc, write, f"order {order} from the low end",
-                 f"paper design at Vf (seed {args.seed})", order, reach,
-                 verify(Vf, reach.controller), t0,
-                 verified_start=_verified(system, Vf, design.controller))   # γ at Vf
-    if args.full_order:
-        t0 = time.perf_counter()
-        reach = _from_high_end(family, lo, hi)
-        n = reach.controller.nstates
-        _add_run(doc, write, f"full order {n} from the high end", f"LQG at V = {hi:g}", n,
-                 reach, verify(hi, reach.controller), t0)
+    else:
+        for order in orders:
+            t0 = time.perf_counter()
+            design = design_flutter_controller(
+                system, Vf, order, starts=c.starts, seed=args.seed, options=options,
+                flap_rate_weight=c.flap_rate_weight, flap_rate_bandwidth=c.flap_rate_bandwidth)
+            reach = stabilize_interval(family, design.controller, (lo, hi), anchor="low")
+            _add_run(doc, write, f"order {order} from the low end",
+                     f"paper design at Vf (seed {args.seed})", order, reach,
+                     verify(Vf, reach.controller), t0,
+                     verified_start=_verified(system, Vf, design.controller))   # γ at Vf
+        if args.full_order:
+            t0 = time.perf_counter()
+            reach = _from_high_end(family, lo, hi)
+            n = reach.controller.nstates
+            _add_run(doc, write, f"full order {n} from the high end", f"LQG at V = {hi:g}", n,
+                     reach, verify(hi, reach.controller), t0)
     doc["rhp_zero_crossings"] = _rhp_zero_crossings(family, lo, hi, tuple(args.zero_band))
     doc["flutter_mode_grip"] = _flutter_mode_grip(family, lo, hi)
     write()
