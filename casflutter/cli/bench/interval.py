@@ -238,13 +238,14 @@ def _truth_runs(family, lo: float, hi: float, orders, doc, write) -> None:
 
 def _reach_record(kind: str, order: int, reach, verified: dict, wall: float) -> dict:
     """One continuation's record, with its controller (``controller_from_json`` reads it)."""
+    from ..._linalg import spectral_abscissa  # noqa: PLC0415
     from ...verify import controller_to_json  # noqa: PLC0415
 
     return {"start": kind, "order": order, "anchor": reach.anchor,
             "reached": list(reach.reached), "met": reach.met,
             "controller": controller_to_json(reach.controller),
             # > 0: the controller itself is unstable (the loop then needs the plant to hold)
-            "controller_spectral_abscissa": float(np.max(np.real(reach.controller.poles()))),
+            "controller_spectral_abscissa": spectral_abscissa(reach.controller.A),
             "worst_abscissa": reach.worst_abscissa, **{f"verified_{k}": v
                                                         for k, v in verified.items()},
             "history": [list(h) for h in reach.history], "wall_time_s": wall}
