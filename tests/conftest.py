@@ -37,3 +37,18 @@ def numpy_global_seed():
     np.random.seed(0)
     yield
     np.random.set_state(state)
+
+
+@pytest.fixture(scope="session")
+def closed_loop_abscissa():
+    """``abscissa(family, K, V)``: the spectral abscissa of ``v = K zm`` closed on
+    ``family.loop(V).flap_to_sensors()`` by python-control (``control.feedback``, positive
+    feedback), independently of the package's own closed-loop map."""
+    import control
+    import numpy as np
+
+    def abscissa(family, K, V):
+        cl = control.feedback(family.loop(V).flap_to_sensors(), K, sign=1)
+        return float(np.max(np.linalg.eigvals(np.asarray(cl.A)).real))
+
+    return abscissa

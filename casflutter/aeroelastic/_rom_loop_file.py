@@ -44,9 +44,13 @@ def load_rom_loop(path: str | os.PathLike) -> tuple[AeroelasticSystem, float]:
         missing names are listed).
     """
     try:
-        d = np.load(path)
+        loaded = np.load(path)
     except (OSError, ValueError) as exc:
         raise DataError(f"{path}: not a readable .npz ROM-loop file ({exc})") from None
+    if not hasattr(loaded, "files"):     # a single .npy array, not named arrays
+        raise DataError(f"{path}: a single array, not an .npz of named arrays")
+    with loaded as npz:                   # closes the file; the arrays stay
+        d = {k: npz[k] for k in npz.files}
     missing = [k for k in _KEYS if k not in d]
     if missing:
         raise DataError(f"{path}: missing {missing}; the file needs {list(_KEYS)} "

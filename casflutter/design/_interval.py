@@ -43,6 +43,7 @@ import numpy as np
 import scipy.linalg
 from scipy.optimize import minimize
 
+from .._linalg import spectral_abscissa
 from .._threads import single_threaded
 from ..aeroelastic import AeroelasticSystem
 from ..errors import ConfigError, DimensionError
@@ -166,7 +167,7 @@ class _ClosedLoopsAtSpeeds:
         a = [float(np.max(np.linalg.eigvals(lp.closed_loop_parts(Ak, Bk, Ck, Dk)[0]).real))
              for lp in self.loops]
         if self.stable_controller:
-            a.append(float(np.max(np.linalg.eigvals(Ak).real)))
+            a.append(spectral_abscissa(Ak))
         return np.array(a)
 
     @staticmethod
@@ -387,7 +388,7 @@ def stabilize_interval(system, controller, interval, *,
     dense = 8 * n_speeds
     with single_threaded():
         start = hi if anchor == "high" else lo
-        own = float(np.max(np.linalg.eigvals(Ak).real))
+        own = spectral_abscissa(Ak)
         if stable_controller and not own < 0:
             raise ConfigError(f"stable_controller: the start controller itself is unstable "
                               f"(a pole with real part {own:.4g}); start from a stable one")

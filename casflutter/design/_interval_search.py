@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import control
 import numpy as np
+import scipy.linalg
 
 from .._threads import single_threaded
 from ..errors import ConfigError
@@ -95,12 +96,7 @@ def _random_start(rng: np.random.Generator, order: int, m: int, band) -> control
         w, z = rng.uniform(*band), rng.uniform(0.005, 0.1)
         wd = w * math.sqrt(1 - z * z)
         blocks.append(np.array([[-z * w, wd], [-wd, -z * w]]))
-    A = np.zeros((order, order))
-    k = 0
-    for blk in blocks:
-        s = blk.shape[0]
-        A[k:k + s, k:k + s] = blk
-        k += s
+    A = scipy.linalg.block_diag(*blocks)
     B = rng.standard_normal((order, m)) * 10.0 ** rng.uniform(-1, 1)
     C = rng.standard_normal((1, order)) * 10.0 ** rng.uniform(-1, 1)
     return control.ss(A, B, C, np.zeros((1, m)))

@@ -26,6 +26,7 @@ import control
 import numpy as np
 import scipy.linalg as sla
 
+from .._linalg import spectral_abscissa
 from ..errors import DataError, DimensionError
 from ._norm import hinf_norm
 
@@ -241,13 +242,6 @@ def load_compleib(path: str | Path) -> tuple[control.StateSpace, int, int, dict[
         except (OSError, json.JSONDecodeError, AttributeError):
             pass
     return P, ny, nu, meta
-
-
-def spectral_abscissa(A: np.ndarray) -> float:
-    """Largest real part of the eigenvalues of ``A`` (``-inf`` for an empty matrix)."""
-    if A.size == 0:
-        return -np.inf
-    return float(np.max(np.linalg.eigvals(A).real))
 
 
 def exact_hinf_norm(sys: control.StateSpace) -> tuple[float, float]:

@@ -40,3 +40,10 @@ def test_every_missing_array_is_listed(tmp_path):
     np.savez(bad, Af=np.eye(2), Vf=1.0)
     with pytest.raises(DataError, match=r"missing \['Bf', 'bf', 'Cf'"):
         load_rom_loop(bad)
+
+
+def test_a_single_npy_array_is_named(tmp_path):
+    path = tmp_path / "loop.npy"
+    np.save(path, np.zeros(3))
+    with pytest.raises(DataError, match="loop.npy: a single array, not an .npz"):
+        load_rom_loop(path)

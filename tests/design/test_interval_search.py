@@ -4,7 +4,7 @@ Fixture: ``problems/seed_wing/rom_loop_seed0.npz`` (Σf and Σs of the default r
 with the flap behind the 40 Hz servo, the loop the bench's ``--servo 251.3`` closes.
 Truth used: the verification layer's exact stable interval
 (:func:`casflutter.verify.speed_family_interval`, guardian map, python-control closing the
-loop) and eigenvalues of the closed loop formed here with numpy.
+loop) and eigenvalues of the loop closed in the test by ``control.feedback``.
 """
 
 from __future__ import annotations
@@ -27,18 +27,8 @@ def frozen_loop_with_servo():
     return rom.with_servo(251.3)
 
 
-def _abscissa_here(family, K, V):
-    """Closed loop of ``v = K zm`` on ``family.loop(V)``'s flap-to-sensor map, formed here."""
-    G = family.loop(V).flap_to_sensors()
-    Ag, Bg, Cg, Dg = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (G.A, G.B, G.C, G.D))
-    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (K.A, K.B, K.C, K.D))
-    s = 1.0 - (Dk @ Dg).item()                     # v = Ck xk + Dk (Cg x + Dg v)
-    A = np.block([[Ag + Bg @ Dk @ Cg / s, Bg @ Ck / s],
-                  [Bk @ (Cg + Dg @ Dk @ Cg / s), Ak + Bk @ Dg @ Ck / s]])
-    return float(np.max(np.linalg.eigvals(A).real))
-
-
-def test_a_random_order3_start_holds_the_top_and_the_certificate_covers_its_claim():
+def test_a_random_order3_start_holds_the_top_and_the_certificate_covers_its_claim(
+        closed_loop_abscissa):
     family = frozen_loop_with_servo()
     search = search_random_starts(family, (2.2, 2.4), 3, starts=4, seed=0)
     # the band is drawn around the flutter mode's frequency at the top (51.5 rad/s)
@@ -50,10 +40,11 @@ def test_a_random_order3_start_holds_the_top_and_the_certificate_covers_its_clai
                                  2.3)
     assert cert.lower <= 2.2 and cert.upper >= 2.4        # the certificate covers the claim
     for V in np.linspace(2.2, 2.4, 9):                    # and eigenvalues formed here agree
-        assert _abscissa_here(family, best.controller, V) < -0.04
+        assert closed_loop_abscissa(family, best.controller, V) < -0.04
 
 
-def test_a_random_start_from_the_low_end_crosses_the_flutter_speed():
+def test_a_random_start_from_the_low_end_crosses_the_flutter_speed(
+        closed_loop_abscissa):
     """Anchored at V = 0.05, a random order-3 start is continued past the frozen ROM loop's
     flutter speed (about 1.2; the open loop at 1.4 is unstable, checked here) and the
     verification layer certifies what it claims."""
@@ -67,7 +58,7 @@ def test_a_random_start_from_the_low_end_crosses_the_flutter_speed():
                                  0.7)
     assert cert.lower <= 0.05 and cert.upper >= 1.4
     for V in np.linspace(0.05, 1.4, 10):
-        assert _abscissa_here(family, best.controller, V) < -0.04
+        assert closed_loop_abscissa(family, best.controller, V) < -0.04
 
 
 @pytest.mark.slow

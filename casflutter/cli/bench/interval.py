@@ -143,6 +143,15 @@ def _add_run(doc, write, label: str, kind: str, order: int, reach, verified: dic
     write()
 
 
+def _add_failed(doc, write, kind: str, order: int, anchor: str, error: str, t0: float,
+                **extra) -> None:
+    """Record a continuation that could not start (``reached`` None: the summary skips it)."""
+    doc["runs"].append({"start": kind, "order": order, "anchor": anchor, "reached": None,
+                        "met": False, "error": error, **extra,
+                        "wall_time_s": time.perf_counter() - t0})
+    write()
+
+
 def _from_high_end(family, lo: float, hi: float):
     """An LQG controller of the loop's own order at ``hi``, its lower end pushed to ``lo``."""
     from ...design import full_order_start, stabilize_interval  # noqa: PLC0415
@@ -162,9 +171,7 @@ def _start_runs(family, lo: float, hi: float, starts, verify, doc, write) -> Non
             reach = stabilize_interval(family, K, (lo, hi), anchor="low")
         except ConfigError as exc:     # it does not hold this model's low end
             _log.warning("start %s: %s", path, exc)
-            doc["runs"].append({"start": f"file {path}", "order": K.nstates, "anchor": "low",
-                                "reached": None, "met": False, "error": str(exc)})
-            write()
+            _add_failed(doc, write, f"file {path}", K.nstates, "low", str(exc), t0)
             continue
         _add_run(doc, write, f"{path}, order {K.nstates} from the low end", f"file {path}",
                  K.nstates, reach, verify(0.5 * sum(reach.reached), reach.controller), t0)
@@ -194,11 +201,8 @@ def _random_runs(family, lo: float, hi: float, orders, ends, starts: int, seed: 
             if best is None:
                 _log.warning("order %d: none of %d random starts held the %s end", order,
                              starts, anchor)
-                doc["runs"].append({"start": kind, "order": order, "anchor": anchor,
-                                    "reached": None, "met": False,
-                                    "error": f"no start decayed at the {anchor} end", **extra,
-                                    "wall_time_s": time.perf_counter() - t0})
-                write()
+                _add_failed(doc, write, kind, order, anchor,
+                            f"no start decayed at the {anchor} end", t0, **extra)
                 continue
             _add_run(doc, write, f"order {order} from the {anchor} end ({len(search.reaches)} "
                                  f"of {starts} random starts held it)", kind, order, best,
@@ -234,13 +238,14 @@ def _truth_runs(family, lo: float, hi: float, orders, doc, write) -> None:
 
 def _reach_record(kind: str, order: int, reach, verified: dict, wall: float) -> dict:
     """One continuation's record, with its controller (``controller_from_json`` reads it)."""
+    from ..._linalg import spectral_abscissa  # noqa: PLC0415
     from ...verify import controller_to_json  # noqa: PLC0415
 
     return {"start": kind, "order": order, "anchor": reach.anchor,
             "reached": list(reach.reached), "met": reach.met,
             "controller": controller_to_json(reach.controller),
             # > 0: the controller itself is unstable (the loop then needs the plant to hold)
-            "controller_spectral_abscissa": float(np.max(np.real(reach.controller.poles()))),
+            "controller_spectral_abscissa": spectral_abscissa(reach.controller.A),
             "worst_abscissa": reach.worst_abscissa, **{f"verified_{k}": v
                                                         for k, v in verified.items()},
             "history": [list(h) for h in reach.history], "wall_time_s": wall}
@@ -348,27 +353,23 @@ def _handler(args: argparse.Namespace) -> int:
                  args.random_stable, verify, doc, write)
     if args.model == "truth":
         _truth_runs(family, lo, hi, orders, doc, write)
-        doc["rhp_zero_crossings"] = _rhp_zero_crossings(family, lo, hi, tuple(args.zero_band))
-        doc["flutter_mode_grip"] = _flutter_mode_grip(family, lo, hi)
-        write()
-        print(f"wrote {out}", file=sys.stderr)
-        return 0
-    for order in orders:
-        t0 = time.perf_counter()
-        design = design_flutter_controller(
-            system, Vf, order, starts=c.starts, seed=args.seed, options=options,
-            flap_rate_weight=c.flap_rate_weight, flap_rate_bandwidth=c.flap_rate_bandwidth)
-        reach = stabilize_interval(family, design.controller, (lo, hi), anchor="low")
-        _add_run(doc, write, f"order {order} from the low end",
-                 f"paper design at Vf (seed {args.seed})", order, reach,
-                 verify(Vf, reach.controller), t0,
-                 verified_start=_verified(system, Vf, design.controller))   # γ at Vf
-    if args.full_order:
-        t0 = time.perf_counter()
-        reach = _from_high_end(family, lo, hi)
-        n = reach.controller.nstates
-        _add_run(doc, write, f"full order {n} from the high end", f"LQG at V = {hi:g}", n,
-                 reach, verify(hi, reach.controller), t0)
+    else:
+        for order in orders:
+            t0 = time.perf_counter()
+            design = design_flutter_controller(
+                system, Vf, order, starts=c.starts, seed=args.seed, options=options,
+                flap_rate_weight=c.flap_rate_weight, flap_rate_bandwidth=c.flap_rate_bandwidth)
+            reach = stabilize_interval(family, design.controller, (lo, hi), anchor="low")
+            _add_run(doc, write, f"order {order} from the low end",
+                     f"paper design at Vf (seed {args.seed})", order, reach,
+                     verify(Vf, reach.controller), t0,
+                     verified_start=_verified(system, Vf, design.controller))   # γ at Vf
+        if args.full_order:
+            t0 = time.perf_counter()
+            reach = _from_high_end(family, lo, hi)
+            n = reach.controller.nstates
+            _add_run(doc, write, f"full order {n} from the high end", f"LQG at V = {hi:g}", n,
+                     reach, verify(hi, reach.controller), t0)
     doc["rhp_zero_crossings"] = _rhp_zero_crossings(family, lo, hi, tuple(args.zero_band))
     doc["flutter_mode_grip"] = _flutter_mode_grip(family, lo, hi)
     write()
