@@ -9,15 +9,19 @@ through the recursion of eq. 3, or Ipopt on a multiple-shooting NLP).
 denominator by variable projection (for aerodynamics linear in the motion).
 """
 
-from ._common_denominator import (CommonDenominatorResult,  # noqa: F401
-                                  identify_common_denominator)
-from ._identify import (FitReport, IdentificationResult, IdentificationSettings,  # noqa: F401
+from ._common_denominator import CommonDenominatorResult, identify_common_denominator
+from ._identify import (FitReport, IdentificationResult, IdentificationSettings,
                         IdentificationWarning, fit_report, identify)
-from ._model import (HWLModel, HWLStructure, UnstableModelWarning,  # noqa: F401
-                     paper_parameter_count)
-from ._orders import HWLOrders  # noqa: F401
-from ._regression import Stage1Result, stage1  # noqa: F401
-from ._select import (OrderCandidate, OrderSelection, order_grid, parse_grid,  # noqa: F401
-                      select_orders)
-from ._synthetic import duffing_data, random_hwl_model, synthetic_data  # noqa: F401
-from ._twins import hwl_predict_function, hwl_simulate_function  # noqa: F401
+from ._model import HWLModel, HWLStructure, UnstableModelWarning, paper_parameter_count
+from ._orders import HWLOrders
+from ._regression import Stage1Result, stage1
+from ._select import OrderCandidate, OrderSelection, order_grid, parse_grid, select_orders
+from ._synthetic import duffing_data, random_hwl_model, synthetic_data
+from ._twins import hwl_predict_function, hwl_simulate_function
+
+__all__ = ["identify", "IdentificationSettings", "IdentificationResult", "IdentificationWarning",
+           "FitReport", "fit_report", "HWLModel", "HWLStructure", "HWLOrders",
+           "UnstableModelWarning", "paper_parameter_count", "Stage1Result", "stage1",
+           "select_orders", "OrderCandidate", "OrderSelection", "order_grid", "parse_grid",
+           "identify_common_denominator", "CommonDenominatorResult", "synthetic_data",
+           "random_hwl_model", "duffing_data", "hwl_predict_function", "hwl_simulate_function"]

@@ -3,7 +3,8 @@
 Closed-loop poles, the exact H∞ norm with its peak frequency (SLICOT ``AB13DD`` via
 slycot, or a numpy/scipy Hamiltonian implementation), the small-gain speed interval
 and the exact speed interval of closed-loop stability (bialternate-sum guardian map), on the
-paper's LFT or on any loop polynomial in the speed index (a truth's own linearisation).
+paper's LFT or on any loop polynomial in the speed index (a truth's own linearisation), and
+the time response of a loop whose speed changes under controllers switched with the speed.
 Uses python-control, slycot, numpy and scipy only; shares no code with
 :mod:`casflutter.design`, whose results it re-checks.
 """
@@ -17,6 +18,7 @@ from ._io import (PlantData, controller_from_json, controller_to_json, load_cont
                   load_plant, plant_from_json, plant_to_json, save_json)
 from ._lft import lft_closed_loop, partition_plant
 from ._report import VerificationReport, delta_family, verify_controller, verify_lft
+from ._schedule import ScheduledResponse, scheduled_response
 from ._sweep import SpeedSweep, speed_sweep
 
 __all__ = [
@@ -29,5 +31,5 @@ __all__ = [
     "plant_from_json", "plant_to_json", "save_json",
     "lft_closed_loop", "partition_plant",
     "VerificationReport", "delta_family", "verify_controller", "verify_lft",
-    "SpeedSweep", "speed_sweep",
+    "SpeedSweep", "speed_sweep", "ScheduledResponse", "scheduled_response",
 ]

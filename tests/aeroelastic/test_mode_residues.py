@@ -12,8 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from casflutter._resources import problems_dir
-from casflutter.aeroelastic import TruthLoop, load_rom_loop, mode_residues
+from casflutter.aeroelastic import TruthLoop, mode_residues
 from casflutter.errors import ConfigError
 from casflutter.truth import SeedWing
 
@@ -27,8 +26,8 @@ def wing():
 
 
 @pytest.fixture(scope="module")
-def rom():
-    return load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")[0]
+def rom(default_rom_loop):
+    return default_rom_loop[0]
 
 
 def _shift(lp, lam, j, eps):

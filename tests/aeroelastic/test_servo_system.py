@@ -1,6 +1,6 @@
 """A ROM loop family with the flap behind a servo (:class:`ServoSystem`).
 
-Fixture: ``problems/seed_wing/rom_loop_seed0.npz`` (the default run's ΣAE).  Truth used: the
+Fixture: ``default_rom_loop`` (the default run's ΣAE).  Truth used: the
 servo's transfer function multiplied in by hand, and python-control closing the loop.
 """
 
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from casflutter._resources import problems_dir
-from casflutter.aeroelastic import ServoSystem, load_rom_loop
+from casflutter.aeroelastic import ServoSystem
 from casflutter.errors import ConfigError
 from casflutter.verify import load_controller
 
@@ -19,8 +19,8 @@ OMEGA, ZETA = 251.3, 0.7
 
 
 @pytest.fixture(scope="module")
-def system():
-    return load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")[0]
+def system(default_rom_loop):
+    return default_rom_loop[0]
 
 
 def test_every_speed_has_the_servo_in_front_of_the_flap(system):

@@ -15,7 +15,6 @@ import numpy as np
 import pytest
 
 from casflutter._resources import problems_dir
-from casflutter.aeroelastic import load_rom_loop
 from casflutter.cli import main
 from casflutter.verify import controller_from_json
 
@@ -127,7 +126,8 @@ def test_a_saved_controller_is_continued_on_the_rom_loop_with_the_servo(tmp_path
     assert 55 < grip["eigenvalue_at_hi"][1] < 65
 
 
-def test_random_order3_starts_from_the_high_end_are_recorded_and_certified(tmp_path):
+def test_random_order3_starts_from_the_high_end_are_recorded_and_certified(tmp_path,
+                                                                          default_rom_loop):
     """Four seeded order-3 starts at the top of the frozen ROM loop with the servo, kept
     stable themselves: the one that held (2.2, 2.4) is recorded with the count of starts that
     held the top, and the verification layer's exact interval covers its claim."""
@@ -146,7 +146,7 @@ def test_random_order3_starts_from_the_high_end_are_recorded_and_certified(tmp_p
     assert lo <= 2.2 and hi >= 2.4
     # the recorded controller is the one certified: its closed loop decays on (2.2, 2.4)
     K = controller_from_json(run["controller"])
-    family = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")[0]
+    family = default_rom_loop[0]
     family = family.with_servo(251.3)
     assert run["controller_spectral_abscissa"] == pytest.approx(
         np.max(np.linalg.eigvals(K.A).real), abs=1e-9)
@@ -158,10 +158,42 @@ def test_random_order3_starts_from_the_high_end_are_recorded_and_certified(tmp_p
                                                 "lowest_lower_end_from_high": 2.2}}
 
 
-def test_the_flutter_mode_grip_record_finds_the_frozen_rom_loops_dip():
+def test_the_flutter_mode_grip_record_finds_the_frozen_rom_loops_dip(default_rom_loop):
     from casflutter.cli.bench.interval import _flutter_mode_grip
-    rom, Vf = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
+    rom, Vf = default_rom_loop
     rec = _flutter_mode_grip(rom.with_servo(251.3), 0.05, 2.4)
     assert 1.85 < rec["weakest_unstable_V"] < 2.05 and rec["growth_rate_there"] > 6
     assert rec["grip_there"] < rec["grip_at_onset"] / 3       # almost four times weaker
     assert min(rec["phase_swing_deg"]) > 180
+
+
+def test_a_truncation_that_does_not_hold_the_low_end_is_recorded_not_dropped(
+        closed_loop_abscissa, default_rom_loop):
+    """The truth runs (full order from the top, then its balanced truncations from the low end)
+    on a short top band of the frozen ROM loop with the servo, a family of the same kind that
+    runs in seconds: every truncation leaves a record, continued when its loop decays at the
+    low end and refused with the reason when it does not, as the loop closed by
+    python-control on the recorded full-order controller says."""
+    import control
+
+    from casflutter.cli.bench.interval import _truth_runs
+    family = default_rom_loop[0]
+    family = family.with_servo(251.3)
+    doc = {"runs": []}
+    _truth_runs(family, 2.3, 2.4, [1, 4], doc, lambda: None)
+    full, *truncations = doc["runs"]
+    assert full["anchor"] == "high" and full["reached"] == [2.3, 2.4]
+    lo, hi = full["verified_exact_interval"]
+    assert lo <= 2.3 and hi >= 2.4
+    assert [r["order"] for r in truncations] == [1, 4]
+    K = controller_from_json(full["controller"])
+    outcomes = []
+    for run in truncations:
+        Kr = control.balred(K, run["order"], method="truncate")
+        Kr = control.ss(Kr.A, Kr.B, Kr.C, np.zeros_like(np.asarray(Kr.D)))
+        holds = closed_loop_abscissa(family, Kr, 2.3) < 0
+        outcomes.append(holds)
+        assert (run["reached"] is not None) == holds
+        if not holds:
+            assert not run["met"] and "anchor V = 2.3" in run["error"]
+    assert outcomes == [False, True]        # both kinds of record are exercised

@@ -1,44 +1,31 @@
 """Flutter suppression over a speed interval on the seed wing's ROM loop (eq. 8-16).
 
-Fixture: ``problems/seed_wing/rom_loop_seed0.npz``, Σf (nf = 15) and Σs of the default
-``casflutter run`` (seed 0), saved once so that the test does not re-identify the ROM.
+Fixture: ``default_rom_loop`` (``problems/seed_wing/rom_loop_seed0.npz``), Σf (nf = 15) and Σs
+of the default ``casflutter run`` (seed 0), saved once so that the test does not re-identify
+the ROM.
 Truth used: the independent verification layer's exact stable interval (guardian map) and
 its H∞ norm.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-from casflutter.aeroelastic import AeroelasticSystem, build_lft
-from casflutter.structure import ModalStructure
+from casflutter.aeroelastic import build_lft
 from casflutter.design import SynthesisOptions, design_flutter_controller, loop_abscissa
 from casflutter.errors import ConfigError
 from casflutter.verify import verify_controller
 
-ROOT = Path(__file__).resolve().parents[2]
-
-
-def seed_wing_loop():
-    d = np.load(ROOT / "problems" / "seed_wing" / "rom_loop_seed0.npz")
-    s = ModalStructure(omega=d["omega"], zeta=d["zeta"], alpha=float(d["alpha"]), Hs=d["Hs"],
-                       sensor=str(d["sensor"]))
-    return AeroelasticSystem(s, d["Af"], d["Bf"], d["bf"], d["Cf"], d["Df"], d["df"]), \
-        float(d["Vf"])
-
-
-def test_fixture_flutters_at_its_vf():
-    system, Vf = seed_wing_loop()
+def test_fixture_flutters_at_its_vf(default_rom_loop):
+    system, Vf = default_rom_loop
     for V, sign in ((0.95 * Vf, -1), (1.05 * Vf, 1)):
         a = np.max(np.linalg.eigvals(system.state_matrix(V)).real)
         assert np.sign(a) == sign
 
 
-def test_interval_design_is_certified_by_the_verification_layer():
-    system, Vf = seed_wing_loop()
+def test_interval_design_is_certified_by_the_verification_layer(default_rom_loop):
+    system, Vf = default_rom_loop
     lo, hi = 0.05, 1.45
     res = design_flutter_controller(system, Vf, 2, interval=(lo, hi), n_speeds=10, steps=1,
                                     starts=1, seed=0,
@@ -55,16 +42,16 @@ def test_interval_design_is_certified_by_the_verification_layer():
     assert np.all(loop_abscissa(system, res.controller, np.linspace(lo, hi, 50)) < 0)
 
 
-def test_interval_must_contain_vf():
-    system, Vf = seed_wing_loop()
+def test_interval_must_contain_vf(default_rom_loop):
+    system, Vf = default_rom_loop
     with pytest.raises(ConfigError, match="interval"):
         design_flutter_controller(system, Vf, 1, interval=(1.5 * Vf, 2 * Vf))
 
 
-def test_interval_design_with_the_flap_rate_output():
+def test_interval_design_with_the_flap_rate_output(default_rom_loop):
     """The default configuration's flap-rate weight with an interval: the stability plants
     carry the flap-rate output too (before, every plant-size check refused the design)."""
-    system, Vf = seed_wing_loop()
+    system, Vf = default_rom_loop
     lo, hi = 0.05, 1.45
     res = design_flutter_controller(system, Vf, 2, interval=(lo, hi), n_speeds=10, steps=1,
                                     starts=1, seed=0, flap_rate_weight=0.003,

@@ -1,6 +1,7 @@
 """How far one controller holds the seed wing's ROM loop stable (continuation in speed).
 
-Fixture: ``problems/seed_wing/rom_loop_seed0.npz`` (Σf and Σs of the default run, seed 0).
+Fixture: ``default_rom_loop`` (``problems/seed_wing/rom_loop_seed0.npz``, Σf and Σs of the
+default run, seed 0).
 Truth used: the independent verification layer's exact stable interval (guardian map on the
 LFT at Vf) and eigenvalues of the closed loop computed here.
 """
@@ -11,15 +12,10 @@ import control
 import numpy as np
 import pytest
 
-from casflutter._resources import problems_dir
-from casflutter.aeroelastic import build_lft, load_rom_loop
+from casflutter.aeroelastic import build_lft
 from casflutter.design import full_order_start, loop_abscissa, stabilize_interval
 from casflutter.errors import ConfigError
 from casflutter.verify import verify_controller
-
-
-def seed_wing_loop():
-    return load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
 
 
 def _exact(system, nominal, K):
@@ -28,8 +24,8 @@ def _exact(system, nominal, K):
     return verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=nominal, n_delta=lft.n_delta)
 
 
-def test_continuation_extends_the_interval_and_the_verification_certifies_it():
-    system, _ = seed_wing_loop()
+def test_continuation_extends_the_interval_and_the_verification_certifies_it(default_rom_loop):
+    system, _ = default_rom_loop
     hi, lo = 2.4, 2.15
     start = full_order_start(system, hi)
     # the start does not hold (lo, hi): the loop is unstable at lo
@@ -44,8 +40,8 @@ def test_continuation_extends_the_interval_and_the_verification_certifies_it():
     assert reach.worst_abscissa < 0
 
 
-def test_full_order_start_stabilises_the_loop_at_its_speed():
-    system, _ = seed_wing_loop()
+def test_full_order_start_stabilises_the_loop_at_its_speed(default_rom_loop):
+    system, _ = default_rom_loop
     for V in (1.5, 2.4):
         K = full_order_start(system, V)
         assert K.nstates == system.n_states
@@ -55,8 +51,8 @@ def test_full_order_start_stabilises_the_loop_at_its_speed():
         assert np.max(np.linalg.eigvals(system.state_matrix(V)).real) > 0
 
 
-def test_bad_requests_are_refused_before_any_work():
-    system, Vf = seed_wing_loop()
+def test_bad_requests_are_refused_before_any_work(default_rom_loop):
+    system, Vf = default_rom_loop
     K = full_order_start(system, 2.4)
     with pytest.raises(ConfigError, match="interval"):
         stabilize_interval(system, K, (2.0, 1.0))
@@ -90,12 +86,12 @@ def test_continuation_on_the_truth_loop_is_certified_on_the_truth():
     assert cert.lower <= lo and cert.upper >= hi
 
 
-def test_the_feedthrough_gradient_is_the_finite_difference_one():
+def test_the_feedthrough_gradient_is_the_finite_difference_one(default_rom_loop):
     """``free_feedthrough``: the eigenvalue gradient with respect to ``Dk`` (through the
     algebraic loop ``1/(1 - Dk D22)`` of the accelerometers) against central differences."""
     from casflutter.design._interval import _ClosedLoopsAtSpeeds, _pack
 
-    system, Vf = seed_wing_loop()
+    system, Vf = default_rom_loop
     assert np.any(system.loop(Vf).D22 != 0)        # the algebraic loop is exercised
     rng = np.random.default_rng(3)
     K = control.ss(rng.normal(size=(3, 3)) - 3 * np.eye(3), rng.normal(size=(3, 2)),
@@ -112,13 +108,13 @@ def test_the_feedthrough_gradient_is_the_finite_difference_one():
         assert np.all(np.abs(fd[-2:]) > 0)
 
 
-def test_the_worst_from_eigenvalues_alone_is_the_full_computation():
+def test_the_worst_from_eigenvalues_alone_is_the_full_computation(default_rom_loop):
     """The objective at ``tau = None`` takes eigenvectors only at the worst speed: its value
     and gradient are those of the loop whose every eigenvector is computed (``rightmost``),
     and its value is the largest real part of eigenvalues computed here."""
     from casflutter.design._interval import _ClosedLoopsAtSpeeds, _pack
 
-    system, Vf = seed_wing_loop()
+    system, Vf = default_rom_loop
     K = full_order_start(system, Vf)
     speeds = np.linspace(0.3, 2.4, 12)
     loops = _ClosedLoopsAtSpeeds(system, speeds, K.nstates, np.asarray(K.D))
@@ -133,8 +129,8 @@ def test_the_worst_from_eigenvalues_alone_is_the_full_computation():
     np.testing.assert_allclose(grad, grads[k], rtol=1e-8, atol=1e-10 * np.max(np.abs(grads[k])))
 
 
-def test_a_free_feedthrough_is_optimised_and_certified():
-    system, Vf = seed_wing_loop()
+def test_a_free_feedthrough_is_optimised_and_certified(default_rom_loop):
+    system, Vf = default_rom_loop
     hi, lo = 2.4, 2.15
     reach = stabilize_interval(system, full_order_start(system, hi), (lo, hi), anchor="high",
                                n_speeds=20, free_feedthrough=True)
@@ -143,13 +139,13 @@ def test_a_free_feedthrough_is_optimised_and_certified():
     assert ver.stable and ver.exact_V[0] <= lo and ver.exact_V[1] >= hi
 
 
-def test_one_controller_for_several_models():
+def test_one_controller_for_several_models(default_rom_loop):
     """A sequence of loop families: the continuation holds the worst of them.  Here the ROM
     loop and the same loop with the flap behind a 40 Hz servo; each result is certified on
     both by the verification layer."""
     from casflutter.verify import speed_family_interval
 
-    system, _ = seed_wing_loop()
+    system, _ = default_rom_loop
     servo = system.with_servo(251.3)
     hi, lo = 2.4, 2.15
     reach = stabilize_interval([system, servo], full_order_start(system, hi), (lo, hi),
@@ -161,13 +157,13 @@ def test_one_controller_for_several_models():
     assert cert.lower <= lo and cert.upper >= hi
 
 
-def test_models_with_other_sensors_are_refused():
+def test_models_with_other_sensors_are_refused(default_rom_loop):
     from dataclasses import replace
 
     from casflutter.aeroelastic import LoopFamily
     from casflutter.errors import DimensionError
 
-    system, _ = seed_wing_loop()
+    system, _ = default_rom_loop
 
     class ThreeSensors(LoopFamily):          # the first accelerometer twice
         def loop(self, V):

@@ -1,6 +1,6 @@
 """Seeded random low-order starts at one end of a speed interval, continued to the other.
 
-Fixture: ``problems/seed_wing/rom_loop_seed0.npz`` (Σf and Σs of the default run, seed 0),
+Fixture: ``default_rom_loop`` (Σf and Σs of the default run, seed 0), as ``family``
 with the flap behind the 40 Hz servo, the loop the bench's ``--servo 251.3`` closes.
 Truth used: the verification layer's exact stable interval
 (:func:`casflutter.verify.speed_family_interval`, guardian map, python-control closing the
@@ -13,8 +13,6 @@ import control
 import numpy as np
 import pytest
 
-from casflutter._resources import problems_dir
-from casflutter.aeroelastic import load_rom_loop
 from casflutter.design import search_random_starts, stabilize_interval
 from casflutter.design._interval import _ClosedLoopsAtSpeeds, _pack
 from casflutter.design._interval_search import _random_start
@@ -22,14 +20,14 @@ from casflutter.errors import ConfigError
 from casflutter.verify import speed_family_interval
 
 
-def frozen_loop_with_servo():
-    rom, _ = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
-    return rom.with_servo(251.3)
+@pytest.fixture(scope="module")
+def family(default_rom_loop):
+    """The frozen ROM loop with the flap behind the 40 Hz servo."""
+    return default_rom_loop[0].with_servo(251.3)
 
 
 def test_a_random_order3_start_holds_the_top_and_the_certificate_covers_its_claim(
-        closed_loop_abscissa):
-    family = frozen_loop_with_servo()
+        closed_loop_abscissa, family):
     search = search_random_starts(family, (2.2, 2.4), 3, starts=4, seed=0)
     # the band is drawn around the flutter mode's frequency at the top (51.5 rad/s)
     assert search.frequency_band == pytest.approx((0.8 * 51.48, 1.6 * 51.48), rel=1e-3)
@@ -44,11 +42,10 @@ def test_a_random_order3_start_holds_the_top_and_the_certificate_covers_its_clai
 
 
 def test_a_random_start_from_the_low_end_crosses_the_flutter_speed(
-        closed_loop_abscissa):
+        closed_loop_abscissa, family):
     """Anchored at V = 0.05, a random order-3 start is continued past the frozen ROM loop's
     flutter speed (about 1.2; the open loop at 1.4 is unstable, checked here) and the
     verification layer certifies what it claims."""
-    family = frozen_loop_with_servo()
     assert np.max(np.linalg.eigvals(family.loop(1.4).A).real) > 1.0
     search = search_random_starts(family, (0.05, 1.4), 3, anchor="low", starts=1, seed=0)
     assert search.anchor == "low" and search.start_indices == (0,)
@@ -62,11 +59,10 @@ def test_a_random_start_from_the_low_end_crosses_the_flutter_speed(
 
 
 @pytest.mark.slow
-def test_order3_starts_from_the_top_of_the_frozen_rom_loop_stall_above_its_dip():
+def test_order3_starts_from_the_top_of_the_frozen_rom_loop_stall_above_its_dip(family):
     """The frozen ROM loop's flutter mode is gripped most weakly near V = 1.93 (growth
     6.6 rad/s): order-3 continuations from the top stop above it, 2.03-2.06 with these
     settings, while the paper's order-3 design from below stops at 1.88."""
-    family = frozen_loop_with_servo()
     search = search_random_starts(family, (0.05, 2.4), 3, starts=4, seed=0)
     assert search.start_indices == (3,)
     (reach,) = search.reaches
@@ -100,18 +96,17 @@ def test_the_starts_depend_on_the_seed_and_the_index_only():
     (dict(anchor="middle"), "anchor = 'middle'"),
     (dict(first=0.1), "unknown continuation settings ['first']"),
 ])
-def test_bad_requests_are_refused_before_any_work(kwargs, words):
+def test_bad_requests_are_refused_before_any_work(kwargs, words, family):
     args = dict(interval=(2.2, 2.4), order=3)
     args.update(kwargs)
     with pytest.raises(ConfigError, match=words.replace("[", r"\[").replace("]", r"\]")):
-        search_random_starts(frozen_loop_with_servo(), args.pop("interval"), args.pop("order"),
+        search_random_starts(family, args.pop("interval"), args.pop("order"),
                              **args)
 
 
-def test_the_controllers_own_abscissa_and_its_gradient_join_the_objective():
+def test_the_controllers_own_abscissa_and_its_gradient_join_the_objective(family):
     """``stable_controller``: one more entry, the largest real part of ``eig(Ak)`` computed
     here, with a gradient (``Ak`` only) equal to central differences."""
-    family = frozen_loop_with_servo()
     rng = np.random.default_rng(5)
     K = control.ss(rng.normal(size=(3, 3)), rng.normal(size=(3, 2)), rng.normal(size=(1, 3)),
                    0.05 * rng.normal(size=(1, 2)))
@@ -127,8 +122,7 @@ def test_the_controllers_own_abscissa_and_its_gradient_join_the_objective():
     assert np.all(fd[9:] == 0) and np.all(grads[-1][9:] == 0)     # B, C, D do not move it
 
 
-def test_a_stable_controller_search_keeps_the_controller_stable_and_is_certified():
-    family = frozen_loop_with_servo()
+def test_a_stable_controller_search_keeps_the_controller_stable_and_is_certified(family):
     search = search_random_starts(family, (2.2, 2.4), 3, starts=2, seed=0,
                                   stable_controller=True)
     assert search.reaches
@@ -140,9 +134,9 @@ def test_a_stable_controller_search_keeps_the_controller_stable_and_is_certified
     assert cert.lower <= best.reached[0] and cert.upper >= best.reached[1]
 
 
-def test_an_unstable_start_is_refused_when_the_controller_must_stay_stable():
+def test_an_unstable_start_is_refused_when_the_controller_must_stay_stable(family):
     K = control.ss(np.diag([0.5, -1.0, -2.0]), np.ones((3, 2)), np.ones((1, 3)),
                    np.zeros((1, 2)))
     with pytest.raises(ConfigError, match=r"itself is unstable \(a pole with real part 0.5"):
-        stabilize_interval(frozen_loop_with_servo(), K, (2.2, 2.4), anchor="high",
+        stabilize_interval(family, K, (2.2, 2.4), anchor="high",
                            stable_controller=True)

@@ -14,7 +14,6 @@ from casflutter.aeroelastic import (AeroelasticSystem, RFASystem, build_lft, fin
 from casflutter.data import GAFTable
 from casflutter.errors import ConfigError, ConvergenceError, DataError, DimensionError
 from casflutter.realize import RFASettings, fit_minimum_state, fit_rfa, fit_roger
-from casflutter.structure import ModalStructure
 from casflutter.truth import JONES_B, GolandParams, GolandWing, problem_definition
 
 REF = problem_definition("goland")["reference"]["flutter"]

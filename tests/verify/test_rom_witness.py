@@ -8,7 +8,8 @@ the loop is not taken from the optimiser: the verification layer certifies each 
 interval (polynomial guardian map, the loop closed by python-control) and a dense eigenvalue
 scan of the loop closed in the test by ``control.feedback`` agrees.  The two intervals overlap,
 so a controller switched at a speed in the overlap holds every frozen speed of the paper's
-interval; no single controller of order 3 to 32 was found to.  Both controllers are stable themselves.
+interval; no single controller of order 3 to 32 was found to.  Both controllers are stable
+themselves.
 """
 
 from __future__ import annotations
@@ -17,15 +18,14 @@ import numpy as np
 import pytest
 
 from casflutter._resources import problems_dir
-from casflutter.aeroelastic import load_rom_loop
 from casflutter.verify import load_controller, speed_family_interval
 
 SERVO = 251.3     # rad/s, the seed wing's 40 Hz servo
 
 
 @pytest.fixture(scope="module")
-def family():
-    rom, _ = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
+def family(default_rom_loop):
+    rom, _ = default_rom_loop
     return rom.with_servo(SERVO)
 
 

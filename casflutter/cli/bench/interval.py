@@ -152,29 +152,45 @@ def _add_failed(doc, write, kind: str, order: int, anchor: str, error: str, t0: 
     write()
 
 
-def _from_high_end(family, lo: float, hi: float):
-    """An LQG controller of the loop's own order at ``hi``, its lower end pushed to ``lo``."""
-    from ...design import full_order_start, stabilize_interval  # noqa: PLC0415
+def _continue(family, K, lo: float, hi: float, anchor: str, label: str, kind: str,
+              certify, doc, write, t0: float | None = None, **extra):
+    """Continue ``K`` from its ``anchor`` end towards the other and record the reach with the
+    verification layer's certificate (``certify(reach)``); a ``K`` that does not hold that end
+    is recorded with the reason instead (``reached`` None).  Returns the reach or None."""
+    from ...design import stabilize_interval  # noqa: PLC0415
+    from ...errors import ConfigError  # noqa: PLC0415
 
+    t0 = time.perf_counter() if t0 is None else t0
+    try:
+        reach = stabilize_interval(family, K, (lo, hi), anchor=anchor)
+    except ConfigError as exc:     # it does not hold this end of the model
+        _log.warning("%s: %s", label, exc)
+        _add_failed(doc, write, kind, K.nstates, anchor, str(exc), t0, **extra)
+        return None
+    _add_run(doc, write, label, kind, K.nstates, reach, certify(reach), t0, **extra)
+    return reach
+
+
+def _from_high_end(family, lo: float, hi: float, label: str, kind: str, certify, doc, write):
+    """An LQG controller of the loop's own order at ``hi``, its lower end pushed to ``lo``."""
+    from ...design import full_order_start  # noqa: PLC0415
+
+    t0 = time.perf_counter()
     K0 = full_order_start(family, hi)
-    return stabilize_interval(family, K0, (lo, hi), anchor="high")
+    return _continue(family, K0, lo, hi, "high", f"{label}, full order {K0.nstates} from the "
+                     "high end", kind, certify, doc, write, t0)
+
+
+def _midpoint(verify):
+    """``verify(nominal, K)`` as a certificate of a reach, built at its interval's midpoint."""
+    return lambda reach: verify(0.5 * sum(reach.reached), reach.controller)
 
 
 def _start_runs(family, lo: float, hi: float, starts, verify, doc, write) -> None:
     """Each saved controller of ``starts`` (path, controller) continued from the low end."""
-    from ...design import stabilize_interval  # noqa: PLC0415
-    from ...errors import ConfigError  # noqa: PLC0415
-
     for path, K in starts:
-        t0 = time.perf_counter()
-        try:
-            reach = stabilize_interval(family, K, (lo, hi), anchor="low")
-        except ConfigError as exc:     # it does not hold this model's low end
-            _log.warning("start %s: %s", path, exc)
-            _add_failed(doc, write, f"file {path}", K.nstates, "low", str(exc), t0)
-            continue
-        _add_run(doc, write, f"{path}, order {K.nstates} from the low end", f"file {path}",
-                 K.nstates, reach, verify(0.5 * sum(reach.reached), reach.controller), t0)
+        _continue(family, K, lo, hi, "low", f"{path}, order {K.nstates} from the low end",
+                  f"file {path}", _midpoint(verify), doc, write)
 
 
 def _random_runs(family, lo: float, hi: float, orders, ends, starts: int, seed: int,
@@ -206,34 +222,26 @@ def _random_runs(family, lo: float, hi: float, orders, ends, starts: int, seed: 
                 continue
             _add_run(doc, write, f"order {order} from the {anchor} end ({len(search.reaches)} "
                                  f"of {starts} random starts held it)", kind, order, best,
-                     verify(0.5 * sum(best.reached), best.controller), t0, **extra)
+                     _midpoint(verify)(best), t0, **extra)
 
 
 def _truth_runs(family, lo: float, hi: float, orders, doc, write) -> None:
-    """Full order from the high end, then ``orders`` from the low end, on the truth loop."""
+    """Full order from the high end, then its balanced truncations to ``orders`` from the low
+    end, on the truth loop; a truncation that does not hold the low end is recorded so."""
     import control  # noqa: PLC0415
 
-    from ...design import stabilize_interval  # noqa: PLC0415
-    from ...errors import ConfigError  # noqa: PLC0415
-
-    t0 = time.perf_counter()
-    high = _from_high_end(family, lo, hi)
-    n = high.controller.nstates
-    _add_run(doc, write, f"truth, full order {n} from the high end",
-             f"LQG at V = {hi:g} (truth, servo {family.servo_omega:g} rad/s)", n, high,
-             _verified_family(family, 0.5 * sum(high.reached), high.controller), t0)
+    certify = _midpoint(lambda nominal, K: _verified_family(family, nominal, K))
+    high = _from_high_end(family, lo, hi, "truth",
+                          f"LQG at V = {hi:g} (truth, servo {family.servo_omega:g} rad/s)",
+                          certify, doc, write)
+    if high is None:
+        return
     for order in orders:
-        t0 = time.perf_counter()
         Kr = control.balred(high.controller, order, method="truncate")
         Kr = control.ss(Kr.A, Kr.B, Kr.C, np.zeros_like(np.asarray(Kr.D)))
-        try:
-            reach = stabilize_interval(family, Kr, (lo, hi), anchor="low")
-        except ConfigError as exc:     # the truncation does not hold the low end
-            _log.warning("truth, order %d: %s", order, exc)
-            continue
-        _add_run(doc, write, f"truth, order {order} from the low end",
-                 "balanced truncation of the full-order truth controller", order, reach,
-                 _verified_family(family, 0.5 * sum(reach.reached), reach.controller), t0)
+        _continue(family, Kr, lo, hi, "low", f"truth, order {order} from the low end",
+                  "balanced truncation of the full-order truth controller", certify, doc,
+                  write)
 
 
 def _reach_record(kind: str, order: int, reach, verified: dict, wall: float) -> dict:
@@ -252,8 +260,7 @@ def _reach_record(kind: str, order: int, reach, verified: dict, wall: float) -> 
 
 
 def _handler(args: argparse.Namespace) -> int:
-    from ...design import (SynthesisOptions, design_flutter_controller,  # noqa: PLC0415
-                           stabilize_interval)
+    from ...design import SynthesisOptions, design_flutter_controller  # noqa: PLC0415
     from ...aeroelastic import TruthLoop, load_rom_loop  # noqa: PLC0415
     from ..._resources import problems_dir  # noqa: PLC0415
     from ...errors import CasflutterError, ConfigError  # noqa: PLC0415
@@ -359,17 +366,13 @@ def _handler(args: argparse.Namespace) -> int:
             design = design_flutter_controller(
                 system, Vf, order, starts=c.starts, seed=args.seed, options=options,
                 flap_rate_weight=c.flap_rate_weight, flap_rate_bandwidth=c.flap_rate_bandwidth)
-            reach = stabilize_interval(family, design.controller, (lo, hi), anchor="low")
-            _add_run(doc, write, f"order {order} from the low end",
-                     f"paper design at Vf (seed {args.seed})", order, reach,
-                     verify(Vf, reach.controller), t0,
-                     verified_start=_verified(system, Vf, design.controller))   # γ at Vf
+            _continue(family, design.controller, lo, hi, "low", f"order {order} from the low "
+                      "end", f"paper design at Vf (seed {args.seed})",
+                      lambda reach: verify(Vf, reach.controller), doc, write, t0,
+                      verified_start=_verified(system, Vf, design.controller))   # γ at Vf
         if args.full_order:
-            t0 = time.perf_counter()
-            reach = _from_high_end(family, lo, hi)
-            n = reach.controller.nstates
-            _add_run(doc, write, f"full order {n} from the high end", f"LQG at V = {hi:g}", n,
-                     reach, verify(hi, reach.controller), t0)
+            _from_high_end(family, lo, hi, "ROM", f"LQG at V = {hi:g}",
+                           lambda reach: verify(hi, reach.controller), doc, write)
     doc["rhp_zero_crossings"] = _rhp_zero_crossings(family, lo, hi, tuple(args.zero_band))
     doc["flutter_mode_grip"] = _flutter_mode_grip(family, lo, hi)
     write()
