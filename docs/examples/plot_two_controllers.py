@@ -142,7 +142,9 @@ fig.tight_layout()
 # alone follows the same path up to the switch and then grows without bound, past its
 # certified end.  This is one sweep rate and one gust, measured, not a proof for every way V
 # can change; a faster sweep or a speed hovering at the switch is for the same function to
-# measure.
+# measure.  And all of it is on the frozen ROM loop: on the wing itself the lower controller
+# holds only up to V = 1.42 and the upper one not at all (the wing's control reversal is at
+# 1.46, the ROM's at 1.93; the tests check both).
 #
 # At the paper's order 3 the same search leaves a gap: from below every random start stops at
 # 1.83-1.89, from above at 2.03-2.06.  On the wing itself two order-3 controllers do overlap,
