@@ -138,13 +138,12 @@ fig.tight_layout()
 # larger (the upper controller's loop decays at only 0.06-0.31 rad/s up there) and it stays
 # at that level until the gust stops; then it decays at the frozen loop's rate at V = 2.4
 # (about 0.057 rad/s, a time constant near 18 s; the tests check the rate against the frozen
-# eigenvalues).  The lower controller
-# alone follows the same path up to the switch and then grows without bound, past its
-# certified end.  This is one sweep rate and one gust, measured, not a proof for every way V
-# can change; a faster sweep or a speed hovering at the switch is for the same function to
-# measure.  And all of it is on the frozen ROM loop: on the wing itself the lower controller
-# holds only up to V = 1.42 and the upper one not at all (the wing's control reversal is at
-# 1.46, the ROM's at 1.93; the tests check both).
+# eigenvalues).  The lower controller alone follows the same path up to the switch and then
+# grows without bound, past its certified end.  This is one sweep rate and one gust, measured,
+# not a proof for every way V can change; a faster sweep or a speed hovering at the switch is
+# for the same function to measure.  And all of it is on the frozen ROM loop: on the wing
+# itself the lower controller holds only up to V = 1.42 and the upper one not at all (the
+# wing's control reversal is at 1.46, the ROM's at 1.93; the tests check both).
 #
 # At the paper's order 3 the same search leaves a gap: from below every random start stops at
 # 1.83-1.89, from above at 2.03-2.06.  On the wing itself two order-3 controllers do overlap,
