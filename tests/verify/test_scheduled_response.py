@@ -44,12 +44,20 @@ def _gust(n_total, n_on, dt=1e-3, seed=0):
     return w
 
 
-def test_at_a_fixed_speed_the_response_is_python_controls(family, pair):
+@pytest.mark.parametrize("servo, feedthrough", [(True, False), (False, True)])
+def test_at_a_fixed_speed_the_response_is_python_controls(default_rom_loop, family, pair,
+                                                          servo, feedthrough):
     """One controller at V = 1.2 from an initial modal displacement: the measurements and the
     flap command agree with ``control.forced_response`` of the loop closed by
-    ``control.feedback`` (exact discretisation on both sides)."""
+    ``control.feedback`` (exact discretisation on both sides).  Also without the servo, where
+    the accelerometers see the flap directly (D22 ≠ 0), with a controller feed-through, so
+    that the algebraic loop ``(1 − Dk D22)⁻¹`` is exercised."""
     V, K = 1.2, pair[0]
-    P = family.loop(V).statespace()
+    if feedthrough:
+        K = control.ss(K.A, K.B, K.C, [[2e-4, -3e-4]])      # Dk D22 ≈ −0.2 at V = 1.2
+    loop = (family if servo else default_rom_loop[0]).loop(V)
+    assert servo or np.any(loop.D22 != 0)
+    P = loop.statespace()
     x0 = np.zeros(P.nstates)
     x0[0] = 1e-2
     r = scheduled_response(lambda _: P, [K], [], [0.0, 3.0], [V, V], x0=x0, dt=2e-3)
