@@ -179,7 +179,14 @@ def mode_residues(family, speeds, *, mode: complex | None = None, min_score: flo
     if not 0.0 < min_score < 1.0:
         raise ConfigError(f"min_score must be in (0, 1), got {min_score}")
     order = grid if mode is not None else grid[::-1]
-    first = _eig_at(family, order[0])
+    computed: dict[float, tuple] = {}       # a bisected step comes back to its end speed
+
+    def eig_at(V: float):
+        if V not in computed:
+            computed[V] = _eig_at(family, V)
+        return computed[V]
+
+    first = eig_at(float(order[0]))
     lam0 = first[0]
     upper = np.flatnonzero(lam0.imag > 0)
     if upper.size == 0:
@@ -193,7 +200,7 @@ def mode_residues(family, speeds, *, mode: complex | None = None, min_score: flo
         while pending:
             Vb, depth = pending[-1]
             Va, cand_a, ka = points[-1]
-            cand = _eig_at(family, Vb)
+            cand = eig_at(Vb)
             kb, score = _follow(cand_a[1][:, ka], cand)
             if score < min_score and depth < max_refine:
                 pending[-1] = (Vb, depth + 1)

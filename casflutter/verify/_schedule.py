@@ -126,15 +126,17 @@ def _augmented(P, nw: int, ncon: int):
 
 def scheduled_response(plant: Callable[[float], object], controllers, switch_speeds, times,
                        speeds, *, ncon: int = 1, disturbance=None, x0=None,
-                       hysteresis: float = 0.0, dt: float = 1e-3, dV: float = 1e-3,
-                       state_limit: float = 1e50) -> ScheduledResponse:
+                       hysteresis: float = 0.0, transfer: str = "rest", dt: float = 1e-3,
+                       dV: float = 1e-3, state_limit: float = 1e50) -> ScheduledResponse:
     """Simulate ``plant(V(t))`` closed by the controller scheduled on ``V(t)`` (``u = K y``).
 
     Controller ``i`` is in use while ``V`` lies between ``switch_speeds[i-1]`` and
     ``switch_speeds[i]``.  With a ``hysteresis`` ``h``, the switch up past ``s`` happens at
     ``s + h/2`` and the switch down at ``s − h/2``, so a speed that hovers at ``s`` does not
-    make the controllers chatter.  The incoming controller starts from rest (zero state); the
-    plant's state carries on.
+    make the controllers chatter.  The plant's state carries on through a switch; the
+    incoming controller starts from rest, or (``transfer="output"``) from the smallest state
+    whose command, for the last measurements, repeats the outgoing controller's last command,
+    so that the flap command does not jump.
 
     Parameters
     ----------
@@ -161,6 +163,9 @@ def scheduled_response(plant: Callable[[float], object], controllers, switch_spe
     hysteresis : float
         Width of the band around each switch speed (>= 0, below the gaps between switch
         speeds).
+    transfer : {"rest", "output"}
+        The incoming controller's state at a switch: zero, or the least-squares state that
+        repeats the outgoing controller's last command.
     dt : float
         Time step [s] (> 0).  The discretisation is exact for the loop frozen over a step.
     dV : float
@@ -177,13 +182,17 @@ def scheduled_response(plant: Callable[[float], object], controllers, switch_spe
     Raises
     ------
     ConfigError
-        A bad profile, switch speeds, hysteresis, step, grid or disturbance shape; a plant or
-        controller that does not fit (named), or no excitation at all (``x0`` and
+        A bad profile, switch speeds, hysteresis, transfer, step, grid or disturbance shape; a
+        plant or controller that does not fit (named), or no excitation at all (``x0`` and
         ``disturbance`` both zero).
     """
     t_bp, V_bp = _check_profile(times, speeds)
     K = [as_statespace(k, f"controllers[{i}]") for i, k in enumerate(controllers)]
     s = _check_switches(switch_speeds, len(K), float(hysteresis))
+    if transfer not in ("rest", "output"):
+        raise ConfigError(f"transfer = {transfer!r}: allowed 'rest' (the incoming controller "
+                          "starts from zero) and 'output' (from the state that repeats the "
+                          "last command)")
     for name, value in (("dt", dt), ("dV", dV)):
         if not (np.isfinite(value) and value > 0):
             raise ConfigError(f"{name} = {value!r} must be > 0")
@@ -256,6 +265,9 @@ def scheduled_response(plant: Callable[[float], object], controllers, switch_spe
         if new != active:
             switches.append((float(t[k]), V, active, new))
             active, xk = new, np.zeros(K[new].nstates)
+            if transfer == "output" and xk.size and k > 0:
+                u_last = out[k - 1, ny:] - ssdata(K[new])[3] @ out[k - 1, :ny]
+                xk = np.linalg.lstsq(ssdata(K[new])[2], u_last, rcond=None)[0]
         used[k] = active
         Ad, Bd, C, D = discrete(active, float(V_mid[min(k, n_steps - 1)]))
         z = np.concatenate([x, xk])

@@ -60,3 +60,20 @@ def test_both_controllers_are_stable_themselves():
     for end in ("low", "high"):
         K = _controller(f"rom_order4_{end}_controller.json")
         assert np.max(np.linalg.eigvals(np.asarray(K.A)).real) < -0.1
+
+
+def test_on_the_wing_itself_the_pair_does_not_hold_above_the_wings_own_dip(
+        closed_loop_abscissa):
+    """The pair holds the frozen ROM loop, not the wing: the ROM puts the flutter mode's
+    control reversal at V = 1.93, the wing at 1.46.  On the wing (its own linearisation, flap
+    behind the same servo) the lower controller's certified interval ends at 1.42, and the
+    upper one leaves the wing unstable at every speed it was made for."""
+    from casflutter.aeroelastic import TruthLoop
+    from casflutter.truth import SeedWing
+
+    wing = TruthLoop(SeedWing(), SERVO)
+    low, high = (_controller(f"rom_order4_{end}_controller.json") for end in ("low", "high"))
+    c_low = speed_family_interval(lambda V: wing.loop(V).flap_to_sensors(), low, 1.0)
+    assert c_low.lower == 0.0 and 1.40 < c_low.upper < 1.45
+    for V in (1.9, 2.1, 2.4):
+        assert closed_loop_abscissa(wing, high, V) > 10, V    # grows in a fraction of a second

@@ -44,12 +44,20 @@ def _gust(n_total, n_on, dt=1e-3, seed=0):
     return w
 
 
-def test_at_a_fixed_speed_the_response_is_python_controls(family, pair):
+@pytest.mark.parametrize("servo, feedthrough", [(True, False), (False, True)])
+def test_at_a_fixed_speed_the_response_is_python_controls(default_rom_loop, family, pair,
+                                                          servo, feedthrough):
     """One controller at V = 1.2 from an initial modal displacement: the measurements and the
     flap command agree with ``control.forced_response`` of the loop closed by
-    ``control.feedback`` (exact discretisation on both sides)."""
+    ``control.feedback`` (exact discretisation on both sides).  Also without the servo, where
+    the accelerometers see the flap directly (D22 ≠ 0), with a controller feed-through, so
+    that the algebraic loop ``(1 − Dk D22)⁻¹`` is exercised."""
     V, K = 1.2, pair[0]
-    P = family.loop(V).statespace()
+    if feedthrough:
+        K = control.ss(K.A, K.B, K.C, [[2e-4, -3e-4]])      # Dk D22 ≈ −0.2 at V = 1.2
+    loop = (family if servo else default_rom_loop[0]).loop(V)
+    assert servo or np.any(loop.D22 != 0)
+    P = loop.statespace()
     x0 = np.zeros(P.nstates)
     x0[0] = 1e-2
     r = scheduled_response(lambda _: P, [K], [], [0.0, 3.0], [V, V], x0=x0, dt=2e-3)
@@ -72,7 +80,8 @@ def test_at_a_fixed_speed_the_response_is_python_controls(family, pair):
 def test_switches_happen_half_the_hysteresis_past_the_switch_speed(family, pair):
     """Up from 1.80 to 2.00 in 10 s and back: with a hysteresis of 0.02 the switch up is at
     V = 1.885 (t = 4.25 s) and the switch down at V = 1.865 (t = 16.75 s); the incoming
-    controller starts from rest, so (strictly proper) its first command is zero."""
+    controller starts from rest, so (strictly proper) its first command is zero; with
+    ``transfer="output"`` it starts where its command repeats the last one."""
     x0 = np.zeros(family.loop(1.8).A.shape[0])
     x0[0] = 1e-2
     dt = 1e-3
@@ -88,6 +97,14 @@ def test_switches_happen_half_the_hysteresis_past_the_switch_speed(family, pair)
     assert all(np.allclose(np.asarray(K.D), 0) for K in pair)
     assert r.control[k_up, 0] == 0.0 and r.control[k_down, 0] == 0.0
     assert r.control[k_up - 1, 0] != 0.0
+    # transfer="output": the incoming controller repeats the last command, so it does not jump
+    smooth = scheduled_response(lambda V: family.loop(V).statespace(), pair, [SWITCH],
+                                [0.0, 10.0, 20.0], [1.8, 2.0, 1.8], x0=x0, hysteresis=0.02,
+                                dt=dt, transfer="output")
+    assert [sw[:2] for sw in smooth.switches] == [sw[:2] for sw in r.switches]
+    for k in (k_up, k_down):
+        assert smooth.control[k, 0] == pytest.approx(smooth.control[k - 1, 0], rel=1e-9)
+        assert smooth.control[k, 0] != 0.0
 
 
 def test_the_order4_pair_holds_a_speed_sweep_the_low_controller_alone_does_not(
@@ -131,6 +148,7 @@ def test_the_order4_pair_holds_a_speed_sweep_the_low_controller_alone_does_not(
     (dict(switch_speeds=[2.0, 1.0], n_controllers=3), "increasing"),
     (dict(hysteresis=0.2, switch_speeds=[1.0, 1.1], n_controllers=3), "smallest gap"),
     (dict(hysteresis=-1.0), ">= 0"),
+    (dict(transfer="bumpless"), "transfer"),
     (dict(dt=0.0), "dt"),
     (dict(dt=5.0), "shorter than the run"),
     (dict(disturbance=np.zeros((3, 5))), "disturbance"),
