@@ -5,8 +5,8 @@ controller holds the loop at every *fixed* speed of its interval.  Two controlle
 certified intervals overlap, switched at a speed in the overlap, then hold every fixed speed of
 the union.  While the speed changes (a wind-tunnel ramp) the loop is time-varying: a stable
 frozen loop stays stable if the speed changes slowly enough, and the switch itself (the
-incoming controller starts from rest while the plant carries the old controller's transient)
-excites the loop.  Neither is covered by the frozen certificate; this module measures both by
+incoming controller takes over with its own state while the plant carries the old
+controller's transient) excites the loop.  Neither is covered by the frozen certificate; this module measures both by
 simulating the linear loop along a speed profile.
 
 The simulation is exact for the loop frozen over each time step: the closed loop at the step's
@@ -80,9 +80,16 @@ class ScheduledResponse:
         return float(np.max(np.linalg.norm(self.measurements[sel], axis=1)))
 
 
+def _numbers(name: str, values) -> np.ndarray:
+    try:
+        return np.asarray(values, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise ConfigError(f"{name} must be numbers, got {values!r}") from None
+
+
 def _check_profile(times, speeds) -> tuple[np.ndarray, np.ndarray]:
-    t = np.asarray(times, dtype=float).ravel()
-    V = np.asarray(speeds, dtype=float).ravel()
+    t = _numbers("times", times)
+    V = _numbers("speeds", speeds)
     if t.size < 2 or t.size != V.size:
         raise ConfigError(f"times and speeds: two or more breakpoints of equal number, got "
                           f"{t.size} times and {V.size} speeds")
@@ -96,7 +103,7 @@ def _check_profile(times, speeds) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _check_switches(switch_speeds, n_controllers: int, hysteresis: float) -> np.ndarray:
-    s = np.asarray(switch_speeds, dtype=float).ravel()
+    s = _numbers("switch_speeds", switch_speeds)
     if n_controllers < 1:
         raise ConfigError("controllers: give at least one")
     if s.size != n_controllers - 1:
@@ -188,7 +195,11 @@ def scheduled_response(plant: Callable[[float], object], controllers, switch_spe
     """
     t_bp, V_bp = _check_profile(times, speeds)
     K = [as_statespace(k, f"controllers[{i}]") for i, k in enumerate(controllers)]
-    s = _check_switches(switch_speeds, len(K), float(hysteresis))
+    try:
+        hysteresis = float(hysteresis)
+    except (TypeError, ValueError):
+        raise ConfigError(f"hysteresis = {hysteresis!r} must be a number >= 0") from None
+    s = _check_switches(switch_speeds, len(K), hysteresis)
     if transfer not in ("rest", "output"):
         raise ConfigError(f"transfer = {transfer!r}: allowed 'rest' (the incoming controller "
                           "starts from zero) and 'output' (from the state that repeats the "

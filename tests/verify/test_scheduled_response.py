@@ -142,12 +142,15 @@ def test_the_order4_pair_holds_a_speed_sweep_the_low_controller_alone_does_not(
 
 @pytest.mark.parametrize("kwargs, words", [
     (dict(times=[0.0], speeds=[1.0]), "two or more breakpoints"),
+    (dict(times=[0.0, "a"], speeds=[1.0, 1.0]), "times must be numbers"),
+    (dict(switch_speeds=["x"]), "switch_speeds must be numbers"),
     (dict(times=[1.0, 2.0], speeds=[1.0, 1.0]), "start at 0"),
     (dict(times=[0.0, 1.0], speeds=[1.0, -1.0]), ">= 0"),
     (dict(switch_speeds=[1.0, 2.0]), "need 1 switch speeds"),
     (dict(switch_speeds=[2.0, 1.0], n_controllers=3), "increasing"),
     (dict(hysteresis=0.2, switch_speeds=[1.0, 1.1], n_controllers=3), "smallest gap"),
     (dict(hysteresis=-1.0), ">= 0"),
+    (dict(hysteresis="wide"), "hysteresis"),
     (dict(transfer="bumpless"), "transfer"),
     (dict(dt=0.0), "dt"),
     (dict(dt=5.0), "shorter than the run"),
