@@ -81,16 +81,9 @@ class ScheduledResponse:
         return float(np.max(np.linalg.norm(self.measurements[sel], axis=1)))
 
 
-def _numbers(name: str, values) -> np.ndarray:
-    """``values`` (a sequence or an array) as finite floats; the error names ``name``."""
-    if isinstance(values, np.ndarray):
-        values = values.ravel().tolist()
-    return np.array(finite_numbers(name, values), dtype=float)
-
-
 def _check_profile(times, speeds) -> tuple[np.ndarray, np.ndarray]:
-    t = _numbers("times", times)
-    V = _numbers("speeds", speeds)
+    t = np.array(finite_numbers("times", times), dtype=float)
+    V = np.array(finite_numbers("speeds", speeds), dtype=float)
     if t.size < 2 or t.size != V.size:
         raise ConfigError(f"times and speeds: two or more breakpoints of equal number, got "
                           f"{t.size} times and {V.size} speeds")
@@ -102,7 +95,7 @@ def _check_profile(times, speeds) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _check_switches(switch_speeds, n_controllers: int, hysteresis: float) -> np.ndarray:
-    s = _numbers("switch_speeds", switch_speeds)
+    s = np.array(finite_numbers("switch_speeds", switch_speeds), dtype=float)
     if n_controllers < 1:
         raise ConfigError("controllers: give at least one")
     if s.size != n_controllers - 1:
