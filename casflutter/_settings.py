@@ -23,6 +23,7 @@ from __future__ import annotations
 import collections.abc
 import dataclasses
 import math
+import numbers
 import re
 import types
 import typing
@@ -241,7 +242,7 @@ def finite_numbers(name: str, value, n: int | None = None, *, what: str = "") ->
     ----------
     name : str
         Field name, for the message.
-    value : sequence
+    value : sequence or 1-D numpy.ndarray
         The numbers.
     n : int, optional
         Required length.
@@ -258,13 +259,15 @@ def finite_numbers(name: str, value, n: int | None = None, *, what: str = "") ->
         Not a sequence, wrong length, or an entry that is not a finite number.
     """
     want = what or (f"{n} numbers" if n is not None else "a list of numbers")
+    if getattr(value, "ndim", None) == 1 and hasattr(value, "tolist"):    # a numpy vector
+        value = value.tolist()
     if isinstance(value, (str, bytes)) or not isinstance(value, collections.abc.Sequence):
         raise ConfigError(f"{name} = {value!r}: give {want}")
     if n is not None and len(value) != n:
         raise ConfigError(f"{name} = {list(value)!r}: give {want}")
     out = []
     for x in value:
-        if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+        if isinstance(x, bool) or not isinstance(x, numbers.Real) or not math.isfinite(x):
             raise ConfigError(f"{name} = {list(value)!r}: {x!r} is not a finite number; "
                               f"give {want}")
         out.append(float(x))

@@ -44,6 +44,7 @@ import scipy.linalg
 from scipy.optimize import minimize
 
 from .._linalg import spectral_abscissa
+from .._settings import finite_numbers
 from .._threads import single_threaded
 from ..aeroelastic import AeroelasticSystem
 from ..errors import ConfigError, DimensionError
@@ -89,12 +90,9 @@ class IntervalReach:
 
 def _speed_interval(interval) -> tuple[float, float]:
     """``(lo, hi)`` of a target speed interval, checked: ``0 <= lo < hi``, both finite."""
-    try:
-        lo, hi = (float(x) for x in interval)
-    except (TypeError, ValueError):
-        raise ConfigError(f"interval = {interval!r}: need two numbers (lo, hi)") from None
-    if not (0 <= lo < hi and math.isfinite(hi)):
-        raise ConfigError(f"interval = {list(interval)!r}: need 0 <= lo < hi, both finite")
+    lo, hi = finite_numbers("interval", interval, 2, what="two numbers (lo, hi)")
+    if not 0 <= lo < hi:
+        raise ConfigError(f"interval = {[lo, hi]!r}: need 0 <= lo < hi")
     return lo, hi
 
 

@@ -22,6 +22,7 @@ import control
 import numpy as np
 import scipy.linalg
 
+from .._settings import finite_numbers
 from .._threads import single_threaded
 from ..errors import ConfigError
 from ._interval import IntervalReach, _Models, _polish, _speed_interval, stabilize_interval
@@ -184,12 +185,10 @@ def search_random_starts(system, interval, order: int, *, anchor: str = "high",
         w = _rightmost_complex_frequency(models, hi)
         band = (0.8 * w, 1.6 * w)
     else:
-        try:
-            band = tuple(float(x) for x in frequency_band)
-        except (TypeError, ValueError):
-            band = ()
-        if not (len(band) == 2 and 0 < band[0] <= band[1] and math.isfinite(band[1])):
-            raise ConfigError(f"frequency_band = {frequency_band!r}: need 0 < low <= high")
+        band = finite_numbers("frequency_band", frequency_band, 2,
+                              what="two numbers (low, high) in rad/s")
+        if not 0 < band[0] <= band[1]:
+            raise ConfigError(f"frequency_band = {list(band)!r}: need 0 < low <= high")
     band_speeds = ([max(lo, hi - anchor_width), hi] if anchor == "high"
                    else [lo, min(hi, lo + anchor_width)])
     free = bool(continuation.get("free_feedthrough", False))

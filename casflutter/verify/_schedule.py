@@ -21,8 +21,9 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-import scipy.linalg
+import scipy.signal
 
+from .._settings import finite_numbers
 from ..errors import ConfigError
 from ._common import as_statespace, ssdata
 from ._lft import lft_closed_loop
@@ -80,21 +81,12 @@ class ScheduledResponse:
         return float(np.max(np.linalg.norm(self.measurements[sel], axis=1)))
 
 
-def _numbers(name: str, values) -> np.ndarray:
-    try:
-        return np.asarray(values, dtype=float).ravel()
-    except (TypeError, ValueError):
-        raise ConfigError(f"{name} must be numbers, got {values!r}") from None
-
-
 def _check_profile(times, speeds) -> tuple[np.ndarray, np.ndarray]:
-    t = _numbers("times", times)
-    V = _numbers("speeds", speeds)
+    t = np.array(finite_numbers("times", times), dtype=float)
+    V = np.array(finite_numbers("speeds", speeds), dtype=float)
     if t.size < 2 or t.size != V.size:
         raise ConfigError(f"times and speeds: two or more breakpoints of equal number, got "
                           f"{t.size} times and {V.size} speeds")
-    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(V))):
-        raise ConfigError("times and speeds must be finite numbers")
     if t[0] != 0.0 or np.any(np.diff(t) <= 0):
         raise ConfigError(f"times must start at 0 and increase, got {t.tolist()}")
     if np.any(V < 0):
@@ -103,15 +95,15 @@ def _check_profile(times, speeds) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _check_switches(switch_speeds, n_controllers: int, hysteresis: float) -> np.ndarray:
-    s = _numbers("switch_speeds", switch_speeds)
+    s = np.array(finite_numbers("switch_speeds", switch_speeds), dtype=float)
     if n_controllers < 1:
         raise ConfigError("controllers: give at least one")
     if s.size != n_controllers - 1:
         raise ConfigError(f"switch_speeds: {n_controllers} controllers need "
                           f"{n_controllers - 1} switch speeds (controller i in use between "
                           f"switch speeds i-1 and i), got {s.size}")
-    if not np.all(np.isfinite(s)) or np.any(np.diff(s) <= 0):
-        raise ConfigError(f"switch_speeds must be finite and increasing, got {s.tolist()}")
+    if np.any(np.diff(s) <= 0):
+        raise ConfigError(f"switch_speeds must increase, got {s.tolist()}")
     if not (np.isfinite(hysteresis) and hysteresis >= 0):
         raise ConfigError(f"hysteresis = {hysteresis!r} must be a number >= 0")
     if s.size > 1 and hysteresis >= np.min(np.diff(s)):
@@ -248,11 +240,8 @@ def scheduled_response(plant: Callable[[float], object], controllers, switch_spe
                 raise ConfigError(f"plant({key[1] * dV:g}) has {Pa.nstates} states; "
                                   f"plant({V_bp[0]:g}) has {n}")
             Acl, Bcl, Ccl, Dcl = ssdata(lft_closed_loop(Pa, K[i], ny, ncon))
-            m = Acl.shape[0]
-            M = np.zeros((m + nw, m + nw))
-            M[:m, :m], M[:m, m:] = Acl * dt, Bcl * dt
-            E = scipy.linalg.expm(M)
-            cache[key] = (E[:m, :m], E[:m, m:], Ccl, Dcl)
+            Ad, Bd, *_ = scipy.signal.cont2discrete((Acl, Bcl, Ccl, Dcl), dt, method="zoh")
+            cache[key] = (Ad, Bd, Ccl, Dcl)
         return cache[key]
 
     def band(V: float) -> int:

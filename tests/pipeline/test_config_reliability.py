@@ -155,3 +155,19 @@ def test_cli_run_checks_the_output_folder_before_any_stage(tmp_path, capsys, mon
     assert main(["run", "--out", str(tmp_path / "afile" / "sub")]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--out" in err[0] and "is a file, not a folder" in err[0]
+
+
+def test_finite_numbers_takes_numpy_vectors_and_scalars_and_names_what_is_wrong():
+    """The shared check of "finite numbers" (config fields, speed intervals, speed profiles):
+    a 1-D numpy array and numpy scalars are numbers; a string, a bool, a NaN or a 2-D array
+    is refused with the field's name."""
+    import numpy as np
+
+    from casflutter._settings import finite_numbers
+    assert finite_numbers("v", np.array([0.0, 2.4])) == (0.0, 2.4)
+    assert finite_numbers("v", (np.float32(0.5), np.int64(2)), 2) == (0.5, 2.0)
+    for bad, words in ((["a"], "'a' is not a finite number"), ([True], "True"),
+                       ([float("nan")], "nan"), (np.zeros((2, 2)), "give"),
+                       ("ab", "give")):
+        with pytest.raises(ConfigError, match=f"(?s)v = .*{words}"):
+            finite_numbers("v", bad)
