@@ -5,7 +5,10 @@
   :class:`ParametricSystem` — the same with Σf interpolated in V; :class:`TruthLoop` — the
   truth's own linearisation as the same loop (flap behind a servo), what the ROM stands in for;
   :class:`ServoSystem` (``AeroelasticSystem.with_servo``) — a ROM family behind the same servo;
-  :class:`LoopFamily` — the interface they share (a loop at every speed index);
+  :class:`LoopFamily` — the interface they share (a loop with one flap at every speed index);
+  :class:`PlantFamily` — any linear plant over a speed range (named inputs and outputs,
+  controls and measurements, units, feedback convention), of which every loop family is one;
+  :class:`GriddedFamily` — state-space models at a grid of speeds, interpolated;
   :func:`load_rom_loop` — a ROM loop kept in an ``.npz`` file.
 - :func:`track_eigenvalues`, :func:`find_flutter` — branch tracking by eigenvector
   continuity, V–g / V–f data, flutter (Hopf) and divergence speeds.
@@ -17,6 +20,7 @@
   Q(ik), and :func:`pk_flutter`, the p-k flutter solution on a Q(ik) table.
 """
 
+from ._family import FEEDBACK_SIGNS, FamilySignals, GriddedFamily, PlantFamily
 from ._flutter import Crossing, FlutterResult, find_flutter, origin_modes
 from ._lft import AeroelasticLFT, build_lft
 from ._loop import (AeroelasticLoop, AeroelasticSystem, LoopFamily, ParametricSystem,
@@ -30,6 +34,7 @@ from ._tracking import EigenTracking, eig_sorted_by_reference, track_eigenvalues
 from ._truth_loop import TruthLoop
 
 __all__ = [
+    "PlantFamily", "FamilySignals", "GriddedFamily", "FEEDBACK_SIGNS",
     "AeroelasticSystem", "AeroelasticLoop", "LoopFamily", "ParametricSystem", "ServoSystem",
     "aeroelastic_loop",
     "split_sigma_f",
