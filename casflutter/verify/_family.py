@@ -318,10 +318,10 @@ class _Margins:
             for name, lm in m.get(side, {}).items():
                 if lm.gain_db < self.gm:
                     out.append((side, name, f"{side} {name!r}: gain margin "
-                                            f"{lm.gain_db:.3g} dB < {self.gm:g} dB"))
+                                            f"{lm.gain_db:.3f} dB < {self.gm:g} dB"))
                 if lm.phase < self.pm:
                     out.append((side, name, f"{side} {name!r}: phase margin "
-                                            f"{lm.phase:.3g} deg < {self.pm:g} deg"))
+                                            f"{lm.phase:.3f} deg < {self.pm:g} deg"))
             if "disk_" + side in m:
                 _, dgm, dpm = m["disk_" + side]
                 if dgm < self.gm or dpm < self.pm:
@@ -411,7 +411,10 @@ def verify_family(family, controller, *, speed_range=None, margins=(6.0, 45.0),
 
     t0 = time.perf_counter()
     mm = _Margins(family, fc, gm_db, pm_deg, disk)
-    table = [mm.at(float(V)) for V in speeds]
+    # where the certificate found the start not stable (a loop family's V = 0, where a truth
+    # is not even defined) the margins are not evaluated there
+    skip_start = not interval.stable_at_start
+    table = [{"stable": False} if skip_start and V == lo else mm.at(float(V)) for V in speeds]
     robust, reason = _robust(mm, speeds, table)
     if interval.loss is not None and (robust is None or interval.loss < robust):
         robust, reason = interval.loss, "the closed loop loses stability (absolute flutter)"
@@ -427,7 +430,7 @@ def verify_family(family, controller, *, speed_range=None, margins=(6.0, 45.0),
     t_margins = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    crossings, b_speeds, b_eigs = _crossings(mm.loop, speeds)
+    crossings, b_speeds, b_eigs = _crossings(mm.loop, speeds, skip_start)
     t_cross = time.perf_counter() - t0
     absolute = interval.loss if interval.lower is not None else lo
     return FamilyVerification(
@@ -468,7 +471,7 @@ def _robust(mm: _Margins, speeds: np.ndarray, table: list):
     return b, "; ".join(f[2] for f in why)
 
 
-def _crossings(loop: _ClosedLoop, speeds: np.ndarray):
+def _crossings(loop: _ClosedLoop, speeds: np.ndarray, skip_start: bool):
     """Closed-loop crossings in the range, and the eigenvalues on the tracking grid.
 
     The number of closed-loop eigenvalues in the right half-plane is counted on the margin
@@ -476,12 +479,13 @@ def _crossings(loop: _ClosedLoop, speeds: np.ndarray):
     change is located by bisection to rounding, and the eigenvalue nearest the imaginary axis
     there gives the frequency.  Two crossings that cancel inside one grid interval (a mode
     that goes unstable and back, or one that stabilises as another destabilises) are not
-    seen: the certified interval does not rely on this list.
+    seen: the certified interval does not rely on this list.  With ``skip_start`` the range's
+    start (found not stable by the certificate) is left out.
     """
     grid = [float(speeds[0])]
     for a, b in zip(speeds[:-1], speeds[1:]):
         grid.extend(float(v) for v in np.linspace(a, b, _TRACK_PER_INTERVAL + 1)[1:])
-    grid = np.asarray(grid)
+    grid = np.asarray(grid[1:] if skip_start else grid)
 
     def eigs(V):
         At = loop.matrix(*loop.plant(float(V)))

@@ -52,7 +52,7 @@ import control
 import numpy as np
 
 from ..errors import ConfigError
-from ._common import is_hurwitz, spectral_abscissa, ssdata
+from ._common import as_statespace, is_hurwitz, spectral_abscissa, ssdata
 from ._interval import _pencil_roots, _pick_ends, bialternate_sum
 
 __all__ = ["PieceCertificate", "CertifiedInterval", "certified_interval"]
@@ -199,7 +199,7 @@ class _ClosedLoop:
     def __init__(self, family, K: control.StateSpace, controls, measurements, sign: float):
         self.family, self.sign = family, float(sign)
         self.controls, self.measurements = tuple(controls), tuple(measurements)
-        self.Ak, self.Bk, self.Ck, self.Dk = ssdata(K)
+        self.Ak, self.Bk, self.Ck, self.Dk = ssdata(as_statespace(K, "the controller"))
         self.strictly_proper = not np.any(self.Dk)
         # the side of the algebraic loop: the controls' unless the measurements are fewer
         k_u, k_y = self.Dk.shape
@@ -523,8 +523,9 @@ def certified_interval(family, K: control.StateSpace, controls, measurements, si
     ----------
     family : casflutter.aeroelastic.PlantFamily
         The plant family.
-    K : control.StateSpace
-        Continuous controller from ``measurements`` to ``controls``.
+    K : control.StateSpace or array_like
+        Continuous controller from ``measurements`` to ``controls`` (a matrix is a static
+        gain).
     controls, measurements : sequence of str
         The family's inputs K drives and outputs K reads, in K's order.
     sign : float
