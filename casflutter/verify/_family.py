@@ -318,10 +318,10 @@ class _Margins:
             for name, lm in m.get(side, {}).items():
                 if lm.gain_db < self.gm:
                     out.append((side, name, f"{side} {name!r}: gain margin "
-                                            f"{lm.gain_db:.3f} dB < {self.gm:g} dB"))
+                                            f"{lm.gain_db:.6g} dB < {self.gm:g} dB"))
                 if lm.phase < self.pm:
                     out.append((side, name, f"{side} {name!r}: phase margin "
-                                            f"{lm.phase:.3f} deg < {self.pm:g} deg"))
+                                            f"{lm.phase:.6g} deg < {self.pm:g} deg"))
             if "disk_" + side in m:
                 _, dgm, dpm = m["disk_" + side]
                 if dgm < self.gm or dpm < self.pm:

@@ -124,8 +124,9 @@ class CertifiedInterval:
         held.
     crossing : str
         What happens at ``loss``: ``"complex pair"`` (flutter), ``"real through 0"``
-        (divergence), ``"ill-posed"``, ``"bisection"`` (a guardian root missed, located by
-        bisection), ``"unstable at start"``, or ``"none"`` (the range is held).
+        (divergence), ``"ill-posed"``, ``"breakpoint"`` (lost exactly at a breakpoint),
+        ``"unstable at start"``, or ``"none"`` (the range is held); `` (bisection)`` is
+        added where a guardian pencil missed the root and the end was bisected instead.
     omega : float
         Frequency (rad per time unit) of the eigenvalue on the axis at ``loss`` (0 for a real
         one, ``nan`` when the range is held).
@@ -614,6 +615,8 @@ def certified_interval(family, K: control.StateSpace, controls, measurements, si
         if status == "loss":
             break
     holds = loss is None
+    if kind == "bisection":           # a guardian root missed, the end bisected instead
+        kind = ("complex pair" if omega > 0 else "real through 0") + " (bisection)"
     if empty:
         return CertifiedInterval(None, None, False, (lo, hi), False, lo, "unstable at start",
                                  omega, tuple(pieces), int(deg), time.perf_counter() - t_start)
