@@ -111,7 +111,8 @@ def plot_closed_loop_damping(result, *, ax=None, n: int = _N_DAMPING) -> Figure:
     ax : Axes, optional
         Where to draw; a new figure otherwise.
     n : int
-        Eigenvalues drawn per speed (the least damped, one of each conjugate pair).
+        Eigenvalues drawn per speed (the least damped, one of each complex pair; real
+        eigenvalues, ζ = ±1, are left out: a divergence shows as its crossing's marker).
 
     Returns
     -------
@@ -124,8 +125,8 @@ def plot_closed_loop_damping(result, *, ax=None, n: int = _N_DAMPING) -> Figure:
     V, lam = result.branch_speeds, result.branch_eigenvalues
     xs, zs, ws = [], [], []
     for v, row in zip(V, lam):
-        row = row[np.isfinite(row) & (row.imag >= 0)]
-        row = row[np.abs(row) > 0]
+        row = row[np.isfinite(row)]
+        row = row[row.imag > 1e-6 * np.abs(row)]        # one of each complex pair
         zeta = -row.real / np.abs(row)
         keep = np.argsort(zeta)[:n]
         xs.extend([v] * keep.size)

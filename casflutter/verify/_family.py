@@ -309,26 +309,42 @@ class _Margins:
         return out
 
     def failures(self, m: dict) -> list[tuple]:
-        """``(side, loop, why)`` for each threshold the margins ``m`` fail (empty when they
-        hold)."""
+        """``(side, loop, what, value, threshold)`` for each threshold the margins ``m`` fail
+        (empty when they hold); ``what`` is ``"gain"`` (dB), ``"phase"`` (deg), ``"disk"``
+        or ``"stability"``."""
         if not m["stable"]:
-            return [("", "", "the closed loop is not stable")]
+            return [("", "", "stability", math.nan, math.nan)]
         out = []
         for side in ("input", "output"):
             for name, lm in m.get(side, {}).items():
                 if lm.gain_db < self.gm:
-                    out.append((side, name, f"{side} {name!r}: gain margin "
-                                            f"{lm.gain_db:.6g} dB < {self.gm:g} dB"))
+                    out.append((side, name, "gain", lm.gain_db, self.gm))
                 if lm.phase < self.pm:
-                    out.append((side, name, f"{side} {name!r}: phase margin "
-                                            f"{lm.phase:.6g} deg < {self.pm:g} deg"))
+                    out.append((side, name, "phase", lm.phase, self.pm))
             if "disk_" + side in m:
                 _, dgm, dpm = m["disk_" + side]
                 if dgm < self.gm or dpm < self.pm:
-                    out.append((side, "disk", f"{side} disk margin {dgm:.3g} dB / "
-                                              f"{dpm:.3g} deg below {self.gm:g} dB / "
-                                              f"{self.pm:g} deg"))
+                    out.append((side, "disk", "disk", (dgm, dpm), (self.gm, self.pm)))
         return out
+
+
+def _why(fails: list, located: bool) -> str:
+    """One sentence per failing threshold (``located``: at a speed found by bisection, where
+    the margin has just crossed its threshold)."""
+    units = {"gain": "dB", "phase": "deg"}
+    out = []
+    for side, name, what, value, thr in fails:
+        if what == "stability":
+            out.append("the closed loop is not stable")
+        elif what == "disk":
+            out.append(f"{side} disk margin {value[0]:.3g} dB / {value[1]:.3g} deg "
+                       f"{'falls' if located else 'is'} below {thr[0]:g} dB / {thr[1]:g} deg")
+        elif located:
+            out.append(f"{side} {name!r}: {what} margin falls below {thr:g} {units[what]}")
+        else:
+            out.append(f"{side} {name!r}: {what} margin {value:.3g} {units[what]} < "
+                       f"{thr:g} {units[what]}")
+    return "; ".join(out)
 
 
 def verify_family(family, controller, *, speed_range=None, margins=(6.0, 45.0),
@@ -455,7 +471,7 @@ def _robust(mm: _Margins, speeds: np.ndarray, table: list):
     if k is None:
         return None, "every margin holds its threshold"
     if k == 0:
-        return float(speeds[0]), "; ".join(f[2] for f in fails[0])
+        return float(speeds[0]), _why(fails[0], located=False)
     a, b = float(speeds[k - 1]), float(speeds[k])
     only = {(f[0], f[1]) for f in fails[k]} if table[k]["stable"] else None
     why = fails[k]
@@ -468,7 +484,7 @@ def _robust(mm: _Margins, speeds: np.ndarray, table: list):
             b, why = mid, f
         else:
             a = mid
-    return b, "; ".join(f[2] for f in why)
+    return b, _why(why, located=True)
 
 
 def _crossings(loop: _ClosedLoop, speeds: np.ndarray, skip_start: bool):

@@ -96,25 +96,33 @@ class LoopMargins:
         return min(self.gain_increase_db, self.gain_decrease_db)
 
 
-def _evaluate(A, B, C, D, omega: float) -> complex:
-    if math.isinf(omega):
-        return complex(D[0, 0])
-    n = A.shape[0]
-    x = np.linalg.solve(1j * omega * np.eye(n) - A, B[:, 0]) if n else np.zeros(0)
-    return complex(C[0] @ x + D[0, 0])
+class _Response:
+    """``L(jω)`` of a SISO state-space loop (one linear solve per frequency: a loop is
+    evaluated at a few frequencies only, where a Schur form would cost more)."""
+
+    def __init__(self, A, B, C, D):
+        self.A, self.b, self.c, self.d = A, B[:, 0], C[0], complex(D[0, 0])
+        self.n = A.shape[0]
+        self.eye = np.eye(self.n)
+
+    def __call__(self, omega: float) -> complex:
+        if math.isinf(omega) or not self.n:
+            return self.d
+        x = np.linalg.solve(1j * omega * self.eye - self.A, self.b)
+        return complex(self.c @ x + self.d)
 
 
-def _polish(A, B, C, D, w0: float) -> float:
+def _polish(L: _Response, w0: float) -> float:
     """A phase crossover near ``w0`` to full accuracy: secant steps on ``Im L(jω)``."""
     if w0 == 0.0 or math.isinf(w0):
         return w0
     w1, w2 = w0, w0 * (1 + 1e-7)
-    f1, f2 = _evaluate(A, B, C, D, w1).imag, _evaluate(A, B, C, D, w2).imag
+    f1, f2 = L(w1).imag, L(w2).imag
     for _ in range(6):
         if f2 == f1:
             break
         w1, w2, f1 = w2, w2 - f2 * (w2 - w1) / (f2 - f1), f2
-        f2 = _evaluate(A, B, C, D, w2).imag
+        f2 = L(w2).imag
         if abs(w2 - w1) <= 1e-12 * abs(w2):
             break
     return w2 if abs(w2 - w0) <= 1e-2 * w0 else w0
@@ -151,13 +159,14 @@ def classical_margins(L: control.StateSpace) -> LoopMargins:
         z = z[np.isfinite(z)]
         neg = (np.abs(z.imag) <= 1e-3 * np.maximum(1.0, np.abs(z))) & (z.real < 0)
         w_pc += list(np.sqrt(-z[neg].real))
+    ev = _Response(A, B, C, D)
     ks = []
     for w in w_pc:
         try:
-            v = _evaluate(A, B, C, D, w)
+            v = ev(w)
             if v.real < 0 and 1e-10 * abs(v) < abs(v.imag) <= 1e-2 * abs(v):   # polish
-                w = _polish(A, B, C, D, w)
-                v = _evaluate(A, B, C, D, w)
+                w = _polish(ev, w)
+                v = ev(w)
         except np.linalg.LinAlgError:      # a pole on the axis
             continue
         if v.real < 0 and abs(v.imag) <= _CONFIRM_TOL * abs(v) and np.isfinite(v):
@@ -175,7 +184,7 @@ def classical_margins(L: control.StateSpace) -> LoopMargins:
         for w in _axis(sla.eigvals(_hamiltonian(A, B, C, D, 1.0), overwrite_a=True,
                                     check_finite=False)):
             try:
-                v = _evaluate(A, B, C, D, w)
+                v = ev(w)
             except np.linalg.LinAlgError:
                 continue
             if abs(abs(v) - 1.0) <= _CONFIRM_TOL * 1e2:
