@@ -390,12 +390,14 @@ class _Piece:
         """Chain inclusion steps from ``t``: ``(t reached, steps, status)``, status
         ``"end"`` (the piece is covered), ``"loss"`` (the loop is unstable within ``xtol``
         above the t reached) or ``"stalled"``."""
-        steps = 0
+        steps, start = 0, t
         while steps < budget:
             h = self.step(t, 1.0 - t)
             steps += 1
             if h >= 1.0 - t:
                 return 1.0, steps, "end"
+            if steps >= 20 and (1.0 - t) * steps > (budget - steps) * (t - start):
+                return t, steps, "stalled"       # at this pace the budget would not do
             if h < xtol:
                 # the steps have shrunk onto a loss of stability, or the bound is too loose
                 probe = min(1.0, t + _PROBE * xtol)

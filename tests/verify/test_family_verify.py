@@ -133,3 +133,34 @@ def test_bad_requests_are_refused_before_any_work():
         verify_family(truth, K, speed_range=(0, 3), margins=(-1, 45))
     with pytest.raises(ConfigError, match="margin_speeds"):
         verify_family(truth, K, speed_range=(0, 3), margin_speeds=[1.0, 4.0])
+
+
+def test_disk_margins_are_inside_the_classical_ones():
+    """The multi-loop disk margin covers gain and phase changes in every channel at once,
+    so its gain and phase margins are at most each loop's classical ones."""
+    fam = random_family(3, with_d=True)
+    K = small_controller(np.random.default_rng(103), 2, 2, 2, gain=3.0, with_d=True)
+    r = verify_family(fam, K, disk=True, margin_speeds=[0.3, 0.6],
+                      speed_range=(0.1, 0.7))
+    for t in (r.inputs, r.outputs):
+        assert t.disk_alpha is not None and np.all(t.disk_alpha > 0)
+        ok = t.stable
+        assert np.all(t.disk_gain_db[ok] <= np.min(t.gain_db[ok], axis=1) * (1 + 1e-6))
+        assert np.all(t.disk_phase_deg[ok] <= np.min(t.phase_deg[ok], axis=1) * (1 + 1e-6))
+    assert "disk margin" in r.robust_reason
+
+
+def test_the_figures_name_the_loops_and_mark_the_speeds(case):
+    from casflutter.report import plot_closed_loop_damping, plot_margins_vs_speed
+
+    _, _, r = case
+    fig = plot_margins_vs_speed(r)
+    labels = {t.get_text() for ax in fig.axes if ax.get_legend()
+              for t in ax.get_legend().get_texts()}
+    for name in ("u0", "u1", "y0", "y1"):      # each loop, with or without a crossover
+        assert name in labels or f"{name} (no crossover)" in labels
+    assert any(lab.startswith("robust flutter speed") for lab in labels)
+    assert any(lab.startswith("absolute flutter speed") for lab in labels)
+    assert fig.axes[2].get_xlabel() == "speed [q]"
+    fig = plot_closed_loop_damping(r)
+    assert "certified stable on [0.1, " in fig.axes[0].get_title()
