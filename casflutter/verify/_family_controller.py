@@ -112,6 +112,21 @@ def _match(pairs, pool: tuple, other: tuple, what: str, role: str, family: str) 
     return tuple(matched)
 
 
+def _side(pairs, size: int, pool: tuple, other: tuple, what: str, role: str, family: str,
+          notes: list) -> tuple:
+    """The family signals of the controller's inputs (or outputs): matched by name, or, when
+    the file names none, the family's own list in its order (if the sizes agree)."""
+    if pairs is not None:
+        return _match(pairs, pool, other, what, role, family)
+    if size != len(pool):
+        raise DimensionError(f"the controller has {size} {what} and no names, but {family} "
+                             f"has {len(pool)} {role}s {list(pool)}; name the controller's "
+                             f"{what} (\"{what}\": [{{\"name\": ...}}]) or give one per {role}")
+    notes.append(f"the controller's {what} are unnamed: taken as the {role}s in the family's "
+                 f"order {list(pool)}")
+    return tuple(pool)
+
+
 def _document(controller) -> dict | None:
     if isinstance(controller, dict):
         return controller
@@ -204,28 +219,10 @@ def match_controller(family, controller, *, feedback: str | None = None
         fb = family.feedback
     others_out = tuple(o for o in sig.outputs if o not in sig.measurements) + sig.inputs
     others_in = tuple(i for i in sig.inputs if i not in sig.controls) + sig.outputs
-    if ins is None:
-        if K.ninputs != len(sig.measurements):
-            raise DimensionError(f"the controller has {K.ninputs} inputs and no names, but "
-                                 f"{fam} has {len(sig.measurements)} measurements "
-                                 f"{list(sig.measurements)}; name the controller's inputs "
-                                 "(\"inputs\": [{\"name\": ...}]) or give one per measurement")
-        measurements = sig.measurements
-        notes.append(f"the controller's inputs are unnamed: taken as the measurements in "
-                     f"the family's order {list(measurements)}")
-    else:
-        measurements = _match(ins, sig.measurements, others_out, "inputs", "measurement", fam)
-    if outs is None:
-        if K.noutputs != len(sig.controls):
-            raise DimensionError(f"the controller has {K.noutputs} outputs and no names, but "
-                                 f"{fam} has {len(sig.controls)} controls "
-                                 f"{list(sig.controls)}; name the controller's outputs "
-                                 "(\"outputs\": [{\"name\": ...}]) or give one per control")
-        controls = sig.controls
-        notes.append(f"the controller's outputs are unnamed: taken as the controls in the "
-                     f"family's order {list(controls)}")
-    else:
-        controls = _match(outs, sig.controls, others_in, "outputs", "control", fam)
+    measurements = _side(ins, K.ninputs, sig.measurements, others_out, "inputs",
+                         "measurement", fam, notes)
+    controls = _side(outs, K.noutputs, sig.controls, others_in, "outputs", "control", fam,
+                     notes)
     for note in notes:
         _log.info("%s", note)
     K = control.ss(*ssdata(K), inputs=list(measurements), outputs=list(controls))
