@@ -147,9 +147,13 @@ def verdict(result, require_v=None) -> dict:
     out["robust"] = result.robust_over(lo, hi)
     lb, ub = result.stable_interval
     if not out["covered"]:
-        reason = (f"not covered: certified stable only on [{lb:.6g}, {ub:.6g}) {u} "
-                  f"(absolute flutter speed {result.absolute_flutter_speed:.6g} {u}), which "
-                  f"does not cover the required [{lo:.6g}, {hi:.6g}]")
+        iv = result.interval
+        where = (f"{'[' if iv.stable_at_start else '('}{lb:.6g}, {ub:.6g}"
+                 f"{']' if iv.holds_range else ')'} {u}")
+        why = ("" if result.absolute_flutter_speed is None else
+               f" (absolute flutter speed {result.absolute_flutter_speed:.6g} {u})")
+        reason = (f"not covered: certified stable only on {where}{why}, which does not cover "
+                  f"the required [{lo:.6g}, {hi:.6g}]")
     elif not out["robust"]:
         reason = (f"not robust: margins below {result.gain_margin_db:g} dB / "
                   f"{result.phase_margin_deg:g} deg from {result.robust_flutter_speed:.6g} "

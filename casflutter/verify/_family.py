@@ -430,7 +430,8 @@ def verify_family(family, controller, *, speed_range=None, margins=(6.0, 45.0),
     # where the certificate found the start not stable (a loop family's V = 0, where a truth
     # is not even defined) the margins are not evaluated there
     skip_start = not interval.stable_at_start
-    table = [{"stable": False} if skip_start and V == lo else mm.at(float(V)) for V in speeds]
+    table = [{"stable": False, "skipped": True} if skip_start and V == lo else mm.at(float(V))
+             for V in speeds]
     robust, reason = _robust(mm, speeds, table)
     if interval.loss is not None and (robust is None or interval.loss < robust):
         robust, reason = interval.loss, "the closed loop loses stability (absolute flutter)"
@@ -465,8 +466,9 @@ def verify_family(family, controller, *, speed_range=None, margins=(6.0, 45.0),
 def _robust(mm: _Margins, speeds: np.ndarray, table: list):
     """The lowest speed at which a margin fails, and why: the first failing margin speed,
     then bisection from the speed before it on the loops that fail there (all loops when the
-    loop is unstable there)."""
-    fails = [mm.failures(m) for m in table]
+    loop is unstable there).  A marginally stable start that was not evaluated counts as
+    neither failing nor holding: the bisection then starts from it."""
+    fails = [[] if m.get("skipped") else mm.failures(m) for m in table]
     k = next((i for i, f in enumerate(fails) if f), None)
     if k is None:
         return None, "every margin holds its threshold"

@@ -38,7 +38,8 @@ both feed-throughs are nonzero ``A_cl = P + Q M⁻¹ R`` is rational in t.  Two 
   (:func:`casflutter.verify.polynomial_stability_interval`'s rule).
 
 Neither is a grid scan: every speed of the returned interval lies in a chain step proved
-stable or between two guardian roots judged stable.
+stable or between two guardian roots judged stable (in floating point: the residual of the
+computed eigen-decomposition is part of the bound, other rounding errors are not).
 """
 
 from __future__ import annotations
