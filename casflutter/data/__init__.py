@@ -3,8 +3,9 @@ analysis of response records (decay, LCO, divergence), tables of frequency-domai
 generalised aerodynamic forces Q(ik) with their files, and gridded plant-family files
 (state-space models at a grid of speeds, :class:`FamilyFile`)."""
 
+from ._family_arrays import check_grid_speeds, check_stack, read_family_arrays
 from ._family_file import (FAMILY_KIND, FEEDBACK_CONVENTIONS, INTERPOLATIONS, FamilyFile,
-                           check_grid_speeds, check_stack, read_family_arrays, read_family_file)
+                           read_family_file)
 from ._gaf import GAFTable, load_gaf
 from ._records import IOData, Record
 from ._response import ResponseAnalysis, analyze_response, dominant_frequency, envelope_growth_rate

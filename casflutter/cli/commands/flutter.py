@@ -272,7 +272,6 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
 def run(args) -> int:
     """Handler: run the route, print or write JSON, save the figure."""
     from ...data import FamilyFile
-    from ...pipeline import flutter_config, run as run_config
     from ...errors import ConfigError
     from ...truth import GAFProblem, WingProblem, load_problem, parse_sets, problem_label
     from ._flutter_family import run_family
@@ -292,6 +291,8 @@ def run(args) -> int:
                           "its flutter speed comes from `casflutter run` with a run "
                           "configuration whose [problem] name is the file (e.g. "
                           "problems/example_wing/run.toml, stages = [] for flutter only)")
+    from ...pipeline import flutter_config, run as run_config
+
     label = problem_label(args.problem)
     _, from_unit, vunit = _speed_conv(truth)
     updates = {"problem.set": changes}

@@ -56,20 +56,11 @@ def _print_family(info: dict) -> None:
             f" ({r['role']})" if r["role"] in ("disturbance", "other") else "")
             for r in info[key]))
     print(f"  data file: {info['data_file']}")
-
-
-def _print_truth(info: dict) -> None:
-    print(f"{info['name']}  ({info['truth']})")
-    print(f"  {info['description']}")
-    print(f"  speed index: {info['speed_index']};  time unit: {info['time_unit']}")
-    print(f"  modes: {', '.join(info['modes'])}")
-    print("  parameters:")
-    w = max(len(r["name"]) for r in info["parameters"])
-    for r in info["parameters"]:
-        mark = "" if r["value"] == r["default"] else f"  (default {r['default']:g})"
-        value = f"{r['value']:<12g}" if isinstance(r["value"], (int, float)) else \
-            f"{r['value']!s:<12}"
-        print(f"    {r['name']:<{w}} = {value} [{r['unit']}]  {r['doc']}{mark}")
+    for key, vals in info["reference"].items():
+        items = (", ".join(f"{k}={v}" for k, v in vals.items()) if isinstance(vals, dict)
+                 else vals)
+        print(f"  reference {key} (the file's [reference]): {items}")
+    print()
 
 
 def _info(name: str, sets) -> dict:
@@ -112,11 +103,20 @@ def run(args) -> int:
     for info in infos:
         if info.get("kind") == "plant_family":
             _print_family(info)
-        else:
-            _print_truth(info)
+            continue
+        print(f"{info['name']}  ({info['truth']})")
+        print(f"  {info['description']}")
+        print(f"  speed index: {info['speed_index']};  time unit: {info['time_unit']}")
+        print(f"  modes: {', '.join(info['modes'])}")
+        print("  parameters:")
+        w = max(len(r["name"]) for r in info["parameters"])
+        for r in info["parameters"]:
+            mark = "" if r["value"] == r["default"] else f"  (default {r['default']:g})"
+            value = f"{r['value']:<12g}" if isinstance(r["value"], (int, float)) else \
+                f"{r['value']!s:<12}"
+            print(f"    {r['name']:<{w}} = {value} [{r['unit']}]  {r['doc']}{mark}")
         if info["reference"]:
-            print("  reference values (the file's [reference]):" if "kind" in info
-                  else "  published reference values:")
+            print("  published reference values:")
             for key, vals in info["reference"].items():
                 items = ", ".join(f"{k}={v}" for k, v in vals.items())
                 print(f"    {key}: {items}")
