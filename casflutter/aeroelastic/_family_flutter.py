@@ -109,6 +109,9 @@ def _suspect(fa, fb, da, db, ok) -> np.ndarray:
 
 def _grid(family: PlantFamily, speeds, n_grid: int | None, subdivide: int) -> np.ndarray:
     lo, hi = family.speed_range
+    if speeds is None and not math.isfinite(hi):
+        raise ConfigError(f"{family.name} has the open speed range [{lo:g}, {hi:g}]: give the "
+                          "speeds of the search (e.g. speeds=family.speed_grid(101, lo, hi))")
     if speeds is None:
         if family.speed_degree == 1 and family.breakpoints and n_grid is None:
             v = np.array([lo, *family.breakpoints, hi], dtype=float)

@@ -163,7 +163,8 @@ def _read_npz(path: Path) -> dict:
             if key.endswith("_names"):
                 if value.dtype.kind not in "US":
                     raise DataError(f"{path}: {key} must hold strings, got dtype {value.dtype}")
-                value = tuple(str(s) for s in np.atleast_1d(value))
+                value = tuple(s.decode() if isinstance(s, bytes) else str(s)
+                              for s in np.atleast_1d(value).tolist())
             elif value.dtype.kind not in "biuf":
                 raise DataError(f"{path}: {key} has dtype {value.dtype}; it must be real "
                                 "numbers")

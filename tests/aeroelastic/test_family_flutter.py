@@ -190,3 +190,8 @@ def test_settings_are_checked_first(kw, match):
     fam = load_family(problems_dir() / "goland_4flaps")
     with pytest.raises(ConfigError, match=match):
         family_flutter(fam, **kw)
+
+
+def test_an_open_range_needs_speeds():
+    with pytest.raises(ConfigError, match="open speed range .* give the speeds"):
+        family_flutter(TruthLoop(SeedWing(), 251.3))

@@ -95,6 +95,14 @@ def test_default_names_and_time_unit(tmp_path):
     assert rec.name == tmp_path.name                  # problem.toml: named by its folder
 
 
+def test_npz_names_stored_as_bytes_read_as_text(tmp_path):
+    np.savez(tmp_path / "g.npz", speeds=[1.0, 2.0], A=-np.ones((2, 1, 1)), B=np.ones((2, 1, 1)),
+             C=np.ones((2, 1, 1)), D=np.zeros((2, 1, 1)), input_names=np.array([b"aileron"]),
+             output_names=np.array(["q"]))
+    rec = read_family_file(_toml(tmp_path / "f.toml", "g.npz"))
+    assert rec.input_names == ("aileron",) and rec.output_names == ("q",)
+
+
 def _npz(tmp_path, **change):
     rec = _record()
     arrays = dict(speeds=rec.speeds, A=rec.A, B=rec.B, C=rec.C, D=rec.D,
