@@ -107,6 +107,23 @@ def _suspect(fa, fb, da, db, ok) -> np.ndarray:
     return ok & (hump | extra)
 
 
+def _sign_changes(re: np.ndarray) -> list[tuple[int, int]]:
+    """``(interval, branch)`` of every sign change of ``Re λ`` along the branches.
+
+    A sign change across a run of exact zeros counts once, in the interval that ends at the
+    first zero (the crossing is that grid speed); zeros at the start of the range (an
+    undamped structure at zero speed) are no crossing.
+    """
+    out = []
+    s = np.sign(re)
+    for k in range(s.shape[1]):
+        nz = np.flatnonzero(s[:, k])
+        for p, q in zip(nz[:-1], nz[1:]):
+            if s[p, k] != s[q, k]:
+                out.append((int(p), int(k)))
+    return sorted(out)
+
+
 def _grid(family: PlantFamily, speeds, n_grid: int | None, subdivide: int) -> np.ndarray:
     lo, hi = family.speed_range
     if speeds is None and not math.isfinite(hi):
@@ -284,21 +301,20 @@ def family_flutter(family: PlantFamily, *, speeds=None, n_grid: int | None = Non
                              np.array([n.R for n in nodes]), np.array(scores), n_refined,
                              n_unresolved)
     crossings = []
-    for i, (dA_a, dA_b) in enumerate(intervals):
-        a, b = nodes[i], nodes[i + 1]
-        for k in np.flatnonzero(a.lam.real * b.lam.real < 0):
-            if a.lam[k].imag < -1e-9 * scale and b.lam[k].imag < -1e-9 * scale:
-                continue                      # the conjugate partner reports this crossing
-            Vc, lc, slope, ok = _locate(fn, a, b, dA_a, dA_b, int(k), xtol)
-            divergence = abs(lc.imag) <= 1e-7 * scale
-            if not divergence and lc.imag < 0:
-                continue
-            crossings.append(Crossing(
-                V=Vc, eigenvalue=lc, omega=0.0 if divergence else abs(lc.imag),
-                frequency_hz=0.0 if divergence else abs(lc.imag) / (2 * np.pi), branch=int(k),
-                origin_mode=-1, kind="divergence" if divergence else "flutter",
-                direction="destabilizing" if b.lam[k].real > a.lam[k].real else "stabilizing",
-                slope=slope, converged=ok, bracket=(a.V, b.V)))
+    for i, k in _sign_changes(lam.real):
+        (dA_a, dA_b), a, b = intervals[i], nodes[i], nodes[i + 1]
+        if a.lam[k].imag < -1e-9 * scale and b.lam[k].imag < -1e-9 * scale:
+            continue                      # the conjugate partner reports this crossing
+        Vc, lc, slope, ok = _locate(fn, a, b, dA_a, dA_b, int(k), xtol)
+        divergence = abs(lc.imag) <= 1e-7 * scale
+        if not divergence and lc.imag < 0:
+            continue
+        crossings.append(Crossing(
+            V=Vc, eigenvalue=lc, omega=0.0 if divergence else abs(lc.imag),
+            frequency_hz=0.0 if divergence else abs(lc.imag) / (2 * np.pi), branch=int(k),
+            origin_mode=-1, kind="divergence" if divergence else "flutter",
+            direction="destabilizing" if b.lam[k].real > a.lam[k].real else "stabilizing",
+            slope=slope, converged=ok, bracket=(a.V, b.V)))
     crossings.sort(key=lambda c: c.V)
     return _result(family, tracking, tuple(crossings), scale)
 

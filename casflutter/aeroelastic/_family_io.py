@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._resources import problems_dir
 from ..data import FamilyFile, read_family_file
 from ..errors import ConfigError, DataError
 from ._family import FamilySignals, GriddedFamily, PlantFamily
@@ -29,7 +30,8 @@ def load_family(source) -> GriddedFamily:
     ----------
     source : str, Path or casflutter.data.FamilyFile
         The problem file (TOML, ``kind = "plant_family"``), a folder holding it as
-        ``problem.toml``, or a record already read.
+        ``problem.toml``, the name of such a folder of the package's ``problems/`` (e.g.
+        ``"goland_4flaps"``), or a record already read.
 
     Returns
     -------
@@ -47,8 +49,8 @@ def load_family(source) -> GriddedFamily:
 
     Examples
     --------
-    >>> import casflutter as cf
-    >>> fam = cf.aeroelastic.load_family(cf._resources.problems_dir() / "goland_4flaps")
+    >>> from casflutter.aeroelastic import load_family
+    >>> fam = load_family("goland_4flaps")
     >>> fam.n_states, len(fam.signals.controls), len(fam.signals.measurements)
     (50, 4, 8)
     """
@@ -56,6 +58,9 @@ def load_family(source) -> GriddedFamily:
         rec = source
     else:
         path = Path(source)
+        if not path.exists() and path.suffix != ".toml" and len(path.parts) == 1 and \
+                (problems_dir() / path).is_dir():
+            path = problems_dir() / path
         if path.is_dir():
             path = path / "problem.toml"
         rec = read_family_file(path)

@@ -29,8 +29,8 @@ import scipy.linalg as sla
 from numpy.testing import assert_allclose
 
 from casflutter._resources import problems_dir
-from casflutter.aeroelastic import (FamilySignals, FlapWingFamily, PlantFamily, TruthLoop,
-                                    family_flutter, find_flutter, load_family)
+from casflutter.aeroelastic import (FamilySignals, FlapWingFamily, GriddedFamily, PlantFamily,
+                                    TruthLoop, family_flutter, find_flutter, load_family)
 from casflutter.data import read_family_file
 from casflutter.errors import ConfigError
 from casflutter.report import family_branches
@@ -76,6 +76,24 @@ def test_a_hump_inside_one_interval_and_a_divergence_are_found_exactly():
         ["divergence"]
 
 
+def _pair_grid(re):
+    """A gridded family at speeds 0, 1, 2 whose pair is ``re(V) ± 5i`` at the grid speeds."""
+    V = np.array([0.0, 1.0, 2.0])
+    A = [np.array([[re(v), 5.0], [-5.0, re(v)]]) for v in V]
+    return GriddedFamily(V, A, np.ones((3, 2, 1)), np.ones((3, 1, 2)), np.zeros((3, 1, 1)))
+
+
+@pytest.mark.parametrize("re, want", [
+    (lambda v: v - 1.0, [(1.0, "destabilizing")]),        # through zero at a grid speed
+    (lambda v: 1.0 - v, [(1.0, "stabilizing")]),
+    (lambda v: -v, []),                                    # undamped at the first speed only
+])
+def test_crossings_at_grid_speeds_count_once_and_a_neutral_start_does_not(re, want):
+    res = family_flutter(_pair_grid(re))
+    assert [(c.V, c.direction) for c in res.crossings] == want
+    assert_allclose([c.omega for c in res.crossings], [5.0] * len(want), rtol=1e-14)
+
+
 def test_the_same_crossings_as_find_flutter_on_a_truth_loop():
     loop = TruthLoop(GolandWing(), 2 * np.pi * 40)
     grid = np.linspace(0.5, 3.0, 51)
@@ -117,7 +135,6 @@ def test_every_crossing_of_a_small_grid_is_the_exact_pencil_one(tmp_path):
     small = TruthLoop(GolandWing(GolandParams(n_bending=2, n_torsion=2)), 2 * np.pi * 40)
     V = np.linspace(1.0, 3.0, 21)
     P = [small.plant(v) for v in V]
-    from casflutter.aeroelastic import GriddedFamily
     fam = GriddedFamily(V, [p.A for p in P], [p.B for p in P], [p.C for p in P],
                         [p.D for p in P])
     _check_against_pencils(fam)
