@@ -27,7 +27,7 @@ Problem file (``kind = "plant_family"``)::
 
 ``feedback`` has no default: the sign convention decides whether a controller damps or
 drives the flutter mode, and a file that does not say it cannot be read safely.  The time
-unit defaults to seconds, the unit of every aeroelastic code's export.
+unit defaults to seconds.
 
 Data file, NPZ (``numpy.savez`` or ``savez_compressed``; read with ``allow_pickle=False``)
     ``speeds`` ``(k,)`` strictly increasing; ``A`` ``(k, n, n)``, ``B`` ``(k, n, m)``,
