@@ -131,10 +131,12 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
         Speed index (forcing ``V² y``).
     n_steps : int
         Number of ROM samples.
-    xs0 : array_like (2N,), optional
-        Initial structural state ``[u_1, u̇_1, ...]`` (zero by default).  The ROM's past
-        inputs are the initial displacements held constant (the wing is held deflected and
-        released at t = 0); its past outputs and flap inputs are zero.
+    xs0 : ModalState or array_like (2N,), optional
+        Initial structural state: a :class:`~casflutter.structure.ModalState` (e.g.
+        ``structure.displaced_state(mode, deflection)``) or Σs's own state
+        ``[u_1, u̇_1, ...]`` (zero by default).  The ROM's past inputs are the initial
+        displacements held constant (the wing is held deflected and released at t = 0); its
+        past outputs and flap inputs are zero.
     w : None, callable t -> (N,), or array (n_steps, N)
         Disturbance added to ``V² y`` (eq. 7).
     v : None, callable t -> float, or array (n_steps,)
@@ -178,7 +180,7 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
     Vext = _signal(v, n_steps, dt, None, "v")
     Kd = None if controller is None else _discrete_controller(controller, m, dt)
     g = (lambda t: 1.0) if gain is None else gain
-    xs = np.zeros(s.n_states) if xs0 is None else np.asarray(xs0, dtype=float).reshape(s.n_states)
+    xs = s.layout.initial(xs0, s.n_states)
     rec, stopped = _run_loop(rom, s, float(V), xs, W, Vext, Kd, g, n_steps, blowup)
     n = len(rec["u"])
     tpts = dt * np.arange(n)

@@ -115,9 +115,9 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
         Speed index.
     timepts : array_like, shape (K,)
         Uniform sample times.
-    x0 : array_like
-        Initial state: ``[u, u']`` (flow at rest, e.g. :meth:`displaced_state`) or the full
-        state.
+    x0 : ModalState or array_like
+        Initial state: a :class:`~casflutter.structure.ModalState` (e.g.
+        :meth:`displaced_state`) or ``[u, u']``, the flow at rest; or the truth's full state.
     gain : callable
         ``g(t)`` multiplying the controller output.
     actuator_omega, actuator_zeta : float
@@ -170,9 +170,7 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     servo = _FlapServo.of(actuator_omega, actuator_zeta, flap_limit, flap_rate_limit)
     t = np.asarray(timepts, dtype=float)
     dt = float(t[1] - t[0])
-    s = np.zeros(truth.state_matrix(V).shape[0])
-    x0 = np.asarray(x0, dtype=float).ravel()
-    s[:x0.size] = x0  # [u, u'] (flow at rest) or the full state
+    s = truth.layout.initial(x0, truth.state_matrix(V).shape[0])  # the flow at rest
     Hs = _sensor_rows(truth, sensor_rows)
     ZM = np.full((t.size, Hs.shape[0]), np.nan)
     Vf = np.zeros(t.size)
@@ -205,7 +203,7 @@ def _run_closed_loop(truth, f, s, controller, servo, Hs, acceleration: bool, t, 
     kicked = kick is None
     for k in range(n):
         if not kicked and t[k] >= kick[0]:
-            s[:2 * N] += truth.displaced_state(kick[1], kick[2])
+            s[:2 * N] += truth.layout.vector(truth.displaced_state(kick[1], kick[2]))
             kicked = True
         _, acc = f(s, xa[0], xa[1], servo.acceleration(xa, vc))
         zm = Hs @ (acc if acceleration else s[:Hs.shape[1]])

@@ -95,8 +95,9 @@ import casadi as ca
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from ..structure import SpeedConvention
 from ._aero import JONES_A, JONES_B, strip_coefficients
-from ._base import AeroelasticTruth, AeroMatrices, SimulationResult
+from ._base import AeroelasticTruth, AeroMatrices, AirspeedMixin, SimulationResult
 from ._goland import _bending_shapes
 from ._params import ChordGeometryMixin, ParamsMixin, require
 
@@ -175,7 +176,7 @@ class SeedWingParams(ChordGeometryMixin, ParamsMixin):
         require(2 <= self.n_strips <= 100, f"n_strips = {self.n_strips} must be in 2..100")
 
 
-class SeedWing(AeroelasticTruth):
+class SeedWing(AirspeedMixin, AeroelasticTruth):
     """Full-order nonlinear truth of the paper's wind-tunnel wing (module docstring).
 
     Parameters
@@ -217,35 +218,13 @@ class SeedWing(AeroelasticTruth):
         super().__init__(p)
 
     # conventions --------------------------------------------------------------------
-    def speed_index(self, U: float) -> float:
-        """Speed index ``V = U / U_ref`` for an airspeed ``U`` [m/s].
-
-        Parameters
-        ----------
-        U : float
-            Airspeed [m/s].
-
-        Returns
-        -------
-        float
-            Speed index.
-        """
-        return float(U) / self.params.U_ref
-
-    def airspeed(self, V: float) -> float:
-        """Airspeed ``U = V U_ref`` [m/s] for a speed index ``V``.
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        float
-            Airspeed [m/s].
-        """
-        return float(V) * self.params.U_ref
+    @property
+    def speed(self) -> SpeedConvention:
+        """Speed index ``V = U / U_ref`` (Table I: ``U_ref = 28.9 m/s``), time in seconds,
+        dynamic pressure from ``rho``."""
+        p = self.params
+        return SpeedConvention(f"V = U / U_ref, U_ref = {p.U_ref:g} m/s (Table I)", "s",
+                               U_ref=p.U_ref, rho=p.rho)
 
     @property
     def alpha(self) -> float:
@@ -548,6 +527,4 @@ class SeedWing(AeroelasticTruth):
                 "sensor_names": ("Acc1 (bending/torsion)", "Acc2 (lateral)"),
                 # Hs u: the tip store's deflections [m] (the shapes are per unit u)
                 "sensor_units": ("m", "m"),
-                "sensor": "acceleration",
-                "time_unit": "s",
-                "speed_index": "V = U / U_ref, U_ref = 28.9 m/s (Table I)"}
+                "sensor": "acceleration"}
