@@ -38,13 +38,13 @@ import numpy as np
 
 from ..errors import ConfigError, DimensionError
 from ..realize import RationalApproximation
-from ..structure import ModalStructure, SpeedConvention
+from ..structure import AirspeedMixin, ModalStructure, SpeedConvention
 
 __all__ = ["RFASystem"]
 
 
 @dataclass(frozen=True)
-class RFASystem:
+class RFASystem(AirspeedMixin):
     """The aeroelastic system of an RFA and a modal structure, in the airspeed ``U``.
 
     Parameters
@@ -107,14 +107,6 @@ class RFASystem:
         return SpeedConvention(f"V = U / U_ref, U_ref = {self.U_ref:g} m/s", own.time_unit,
                                U_ref=self.U_ref)
 
-    def speed_index(self, U: float) -> float:
-        """``V = U / U_ref`` (:meth:`SpeedConvention.speed_index`)."""
-        return self.speed.speed_index(U)
-
-    def airspeed(self, V: float) -> float:
-        """``U = V U_ref`` [m/s] (:meth:`SpeedConvention.airspeed`)."""
-        return self.speed.airspeed(V)
-
     def _check_U(self, U) -> float:
         U = float(U)
         if not np.isfinite(U) or U <= 0:
@@ -145,7 +137,8 @@ class RFASystem:
         Parameters
         ----------
         U : float
-            Airspeed [m/s].
+            Airspeed [m/s] (> 0): the lag rates ``gamma U / b`` and the forcing
+            ``alpha (U / U_ref)^2`` follow it.
 
         Returns
         -------
@@ -170,7 +163,7 @@ class RFASystem:
         Parameters
         ----------
         U : float
-            Airspeed [m/s].
+            Airspeed [m/s] (> 0), as in :meth:`state_matrix`.
 
         Returns
         -------

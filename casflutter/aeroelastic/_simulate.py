@@ -162,9 +162,7 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
     Examples
     --------
     >>> import casflutter as cf
-    >>> truth = cf.load_problem("typical_section")
-    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
-    >>> rom = cf.identify_common_denominator(data).model
+    >>> truth, rom = cf.load_problem("typical_section"), cf.example_rom()
     >>> structure = truth.modal_structure()
     >>> sim = cf.simulate_loop(rom, structure, 1.5, 500, xs0=structure.displaced_state(1, 0.01))
     >>> sim.zm.shape, bool(abs(sim.zm[-50:]).max() < 0.1 * abs(sim.zm[:50]).max())

@@ -247,6 +247,7 @@ class IOData:
         Returns
         -------
         IOData
+            One record of the arrays.
 
         Raises
         ------
@@ -572,6 +573,7 @@ class IOData:
         Returns
         -------
         IOData
+            The same records at ``dt * factor``.
 
         Raises
         ------

@@ -9,8 +9,8 @@ it keeps one (Σs: ``[u_1, u̇_1, ..., u_N, u̇_N]``, one block per mode as in e
 """
 
 from ._modal import SENSOR_KINDS, ModalStructure, check_sensor_rows
-from ._speed import SpeedConvention
-from ._state import ModalLayout, ModalState
+from ._speed import AirspeedMixin, SpeedConvention
+from ._state import ModalLayout, ModalState, ModalStates
 
-__all__ = ["ModalStructure", "SENSOR_KINDS", "check_sensor_rows", "ModalState", "ModalLayout",
-           "SpeedConvention"]
+__all__ = ["ModalStructure", "SENSOR_KINDS", "check_sensor_rows", "ModalState", "ModalLayout", "ModalStates",
+           "SpeedConvention", "AirspeedMixin"]

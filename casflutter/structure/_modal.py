@@ -43,7 +43,7 @@ import numpy as np
 
 from ..errors import ConfigError, DimensionError
 from ._speed import SpeedConvention
-from ._state import ModalLayout, ModalState
+from ._state import ModalLayout, ModalStates
 
 __all__ = ["ModalStructure", "SENSOR_KINDS", "check_sensor_rows"]
 
@@ -103,7 +103,7 @@ def check_sensor_rows(rows, n_modes: int, *, key: str = "sensors.rows",
 
 
 @dataclass(frozen=True)
-class ModalStructure:
+class ModalStructure(ModalStates):
     """N-mode structural model Σs of eq. 6-7, with its sensors and names.
 
     Parameters
@@ -255,39 +255,6 @@ class ModalStructure:
         """Where ``x_s`` keeps each mode: ``[u_1, u̇_1, u_2, u̇_2, ...]`` (eq. 7)."""
         return ModalLayout(self.n_modes, interleaved=True)
 
-    def modal_state(self, u=None, udot=None) -> ModalState:
-        """The structural state of given modal displacements and velocities.
-
-        Parameters
-        ----------
-        u, udot : array_like, shape (N,), optional
-            Modal displacements and velocities (default zero).
-
-        Returns
-        -------
-        ModalState
-            Right for every model of these modes (:func:`casflutter.aeroelastic.simulate_loop`
-            puts it where Σs keeps it, ``layout.vector(state)``; a truth's simulation where
-            the truth keeps it).
-        """
-        return ModalState.of(self.n_modes, u, udot)
-
-    def displaced_state(self, mode: int, deflection: float) -> ModalState:
-        """The structural state at rest with mode ``mode`` displaced by ``deflection``.
-
-        Parameters
-        ----------
-        mode : int
-            0-based mode index.
-        deflection : float
-            Modal displacement ``u_mode``.
-
-        Returns
-        -------
-        ModalState
-        """
-        return ModalState.displaced(self.n_modes, mode, deflection)
-
     @property
     def mode_states(self) -> list[np.ndarray]:
         """State indices ``[u_i, u̇_i]`` of each mode in ``x_s`` (for eigenvector
@@ -380,7 +347,7 @@ class ModalStructure:
         Parameters
         ----------
         V : float
-            Speed index.
+            Speed index: the generalised forces ``y`` enter scaled by ``V²``.
 
         Returns
         -------

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from ..errors import ConfigError
 
-__all__ = ["SpeedConvention"]
+__all__ = ["SpeedConvention", "AirspeedMixin"]
 
 
 def _positive(name: str, value) -> float | None:
@@ -40,9 +40,12 @@ class SpeedConvention:
         What the speed index is, e.g. ``"V = U / U_ref, U_ref = 28.9 m/s"``.
     time_unit : str
         Unit of time of the problem (frequencies are in rad per this unit).
-    U_ref : float, optional
+    U_ref : float or tuple of float, optional
         Airspeed per unit speed index [m/s], ``U = V U_ref``; ``None``: the problem has no
-        airspeed scale (a nondimensional section).
+        airspeed scale (a nondimensional section).  A tuple gives ``U_ref`` as the product
+        of its factors (e.g. ``(b, omega_ref)`` for ``V = U / (b omega_ref)``), and
+        :meth:`airspeed` multiplies ``V`` by them in that order, as the problem's own
+        equations do; ``U_ref`` is then stored as their product.
     rho : float, optional
         Air density [kg/m^3] for the dynamic pressure ``q = rho U^2 / 2``; ``None``: not
         known.
@@ -66,7 +69,17 @@ class SpeedConvention:
     rho: float | None = None
 
     def __post_init__(self):
-        object.__setattr__(self, "U_ref", _positive("U_ref", self.U_ref))
+        factors = self.U_ref if isinstance(self.U_ref, tuple) else (self.U_ref,)
+        factors = tuple(_positive("U_ref", f) for f in factors)
+        if None in factors and len(factors) > 1:
+            raise ConfigError(f"U_ref = {self.U_ref!r}: give positive factors, or None")
+        U_ref = None
+        if factors != (None,):
+            U_ref = factors[0]
+            for f in factors[1:]:
+                U_ref = U_ref * f
+        object.__setattr__(self, "_factors", factors)
+        object.__setattr__(self, "U_ref", U_ref)
         object.__setattr__(self, "rho", _positive("rho", self.rho))
         if self.rho is not None and self.U_ref is None:
             raise ConfigError("rho without U_ref: a dynamic pressure needs the airspeed scale "
@@ -96,7 +109,11 @@ class SpeedConvention:
         ConfigError
             The problem has no airspeed scale.
         """
-        return float(V) * self._need_airspeed()
+        self._need_airspeed()
+        U = float(V)
+        for f in self._factors:
+            U = U * f
+        return U
 
     def speed_index(self, U: float) -> float:
         """Speed index ``V = U / U_ref`` of an airspeed ``U`` [m/s].
@@ -141,3 +158,41 @@ class SpeedConvention:
     def frequency_unit(self) -> str:
         """``"Hz"`` for a problem in seconds, else ``"cycles per time unit <unit>"``."""
         return "Hz" if self.time_unit == "s" else f"cycles per time unit {self.time_unit}"
+
+
+class AirspeedMixin:
+    """``airspeed(V)`` and ``speed_index(U)`` of a model whose ``speed`` (a
+    :class:`SpeedConvention`) has an airspeed scale: the truths with one, the wing files,
+    the RFA system."""
+
+    speed: SpeedConvention
+
+    def airspeed(self, V: float) -> float:
+        """Airspeed [m/s] of a speed index (:meth:`SpeedConvention.airspeed`).
+
+        Parameters
+        ----------
+        V : float
+            Speed index (``speed.definition``).
+
+        Returns
+        -------
+        float
+            ``U = V U_ref`` [m/s].
+        """
+        return self.speed.airspeed(V)
+
+    def speed_index(self, U: float) -> float:
+        """Speed index of an airspeed (:meth:`SpeedConvention.speed_index`).
+
+        Parameters
+        ----------
+        U : float
+            Airspeed [m/s] (``speed.U_ref`` per unit speed index).
+
+        Returns
+        -------
+        float
+            ``V = U / U_ref``.
+        """
+        return self.speed.speed_index(U)

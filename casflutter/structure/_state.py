@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import DimensionError
 
-__all__ = ["ModalState", "ModalLayout"]
+__all__ = ["ModalState", "ModalLayout", "ModalStates"]
 
 
 def _modal_vector(values, n_modes: int, name: str) -> np.ndarray:
@@ -53,7 +53,7 @@ class ModalState:
     Examples
     --------
     >>> from casflutter.structure import ModalLayout, ModalState
-    >>> x = ModalState.displaced(3, 1, 0.5)
+    >>> x = ModalState(u=[0.0, 0.5, 0.0], udot=[0.0, 0.0, 0.0])
     >>> ModalLayout(3, interleaved=True).vector(x).tolist()
     [0.0, 0.0, 0.5, 0.0, 0.0, 0.0]
     >>> ModalLayout(3, interleaved=False).vector(x).tolist()
@@ -72,56 +72,6 @@ class ModalState:
     def n_modes(self) -> int:
         """Number of modes ``N``."""
         return int(self.u.size)
-
-    @classmethod
-    def of(cls, n_modes: int, u=None, udot=None) -> "ModalState":
-        """The state of ``n_modes`` modes with the given displacements and velocities.
-
-        Parameters
-        ----------
-        n_modes : int
-            Number of modes ``N``.
-        u, udot : array_like, shape (N,), optional
-            Modal displacements and velocities (default zero).
-
-        Returns
-        -------
-        ModalState
-
-        Raises
-        ------
-        DimensionError
-            ``u`` or ``udot`` not of length ``n_modes``.
-        """
-        return cls(_modal_vector(u, n_modes, "u"), _modal_vector(udot, n_modes, "udot"))
-
-    @classmethod
-    def displaced(cls, n_modes: int, mode: int, deflection: float) -> "ModalState":
-        """The structure at rest with mode ``mode`` displaced by ``deflection``.
-
-        Parameters
-        ----------
-        n_modes : int
-            Number of modes ``N``.
-        mode : int
-            0-based mode index.
-        deflection : float
-            Modal displacement ``u_mode``.
-
-        Returns
-        -------
-        ModalState
-
-        Raises
-        ------
-        DimensionError
-            ``mode`` is not one of the ``n_modes`` modes.
-        """
-        if not 0 <= int(mode) < n_modes:
-            raise DimensionError(f"mode {mode} is not one of the {n_modes} modes (0-based)")
-        u = np.zeros(n_modes)
-        u[int(mode)] = deflection
-        return cls(u, np.zeros(n_modes))
 
 
 @dataclass(frozen=True)
@@ -235,3 +185,59 @@ class ModalLayout:
                                  f"{2 * self.n_modes} structural states or all {size} states")
         out[:x.size] = x
         return out
+
+
+class ModalStates:
+    """``modal_state`` and ``displaced_state`` of a model of ``n_modes`` structural modes
+    (Σs and the truths): each builds a :class:`ModalState`, which the model's simulation
+    puts where its ``layout`` keeps it."""
+
+    n_modes: int
+
+    def modal_state(self, u=None, udot=None) -> ModalState:
+        """The structural state of given modal displacements and velocities.
+
+        Parameters
+        ----------
+        u, udot : array_like, shape (N,), optional
+            Modal displacements and velocities (default zero).
+
+        Returns
+        -------
+        ModalState
+            Right for every model of these modes: each simulation puts it where its own
+            model keeps it (``layout.vector(state)``).
+
+        Raises
+        ------
+        DimensionError
+            ``u`` or ``udot`` not of length ``N``.
+        """
+        return ModalState(_modal_vector(u, self.n_modes, "u"),
+                          _modal_vector(udot, self.n_modes, "udot"))
+
+    def displaced_state(self, mode: int, deflection: float) -> ModalState:
+        """The structure at rest with mode ``mode`` displaced by ``deflection``.
+
+        Parameters
+        ----------
+        mode : int
+            0-based mode index.
+        deflection : float
+            Modal displacement ``u_mode``.
+
+        Returns
+        -------
+        ModalState
+            An initial state of any simulation of these modes (the flow at rest).
+
+        Raises
+        ------
+        DimensionError
+            ``mode`` is not one of the ``N`` modes.
+        """
+        if not 0 <= int(mode) < self.n_modes:
+            raise DimensionError(f"mode {mode} is not one of the {self.n_modes} modes (0-based)")
+        u = np.zeros(self.n_modes)
+        u[int(mode)] = deflection
+        return self.modal_state(u)

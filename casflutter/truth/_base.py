@@ -32,10 +32,10 @@ from scipy.interpolate import make_interp_spline
 from scipy.linalg import eigh
 
 from ..errors import ConfigError, DataError, DimensionError
-from ..structure import ModalLayout, ModalState, ModalStructure, SpeedConvention
+from ..structure import ModalLayout, ModalStates, ModalStructure, SpeedConvention
 from ._aero import JONES_A, check_timepts, integrate_lags, sample_derivatives
 
-__all__ = ["AeroMatrices", "SimulationResult", "AeroelasticTruth", "AirspeedMixin"]
+__all__ = ["AeroMatrices", "SimulationResult", "AeroelasticTruth"]
 
 
 @dataclass(frozen=True)
@@ -99,39 +99,6 @@ class SimulationResult:
     nfev: int
 
 
-class AirspeedMixin:
-    """``airspeed(V)`` and ``speed_index(U)`` of a problem whose speed convention
-    (its ``speed``, a :class:`~casflutter.structure.SpeedConvention`) has an airspeed scale."""
-
-    def airspeed(self, V: float) -> float:
-        """Airspeed [m/s] of a speed index ``V`` (:meth:`SpeedConvention.airspeed`).
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        float
-        """
-        return self.speed.airspeed(V)
-
-    def speed_index(self, U: float) -> float:
-        """Speed index of an airspeed ``U`` [m/s] (:meth:`SpeedConvention.speed_index`).
-
-        Parameters
-        ----------
-        U : float
-            Airspeed [m/s].
-
-        Returns
-        -------
-        float
-        """
-        return self.speed.speed_index(U)
-
-
 def _as_2d(name: str, arr, K: int, N: int) -> np.ndarray:
     a = np.asarray(arr, dtype=float)
     if a.ndim == 1 and N == 1:
@@ -153,7 +120,7 @@ def _as_1d(name: str, arr, K: int) -> np.ndarray:
     return a
 
 
-class AeroelasticTruth(abc.ABC):
+class AeroelasticTruth(ModalStates, abc.ABC):
     """Base class of the truth simulators (typical section, Goland wing).
 
     Subclasses provide the structural matrices, the aerodynamic operator at a speed index
@@ -261,40 +228,6 @@ class AeroelasticTruth(abc.ABC):
         """Indices ``[u_i, u'_i]`` of each mode in the truth's state ``[u, u', lags]`` (for the
         origin-mode attribution of :func:`casflutter.aeroelastic.find_flutter`)."""
         return self.layout.mode_states
-
-    def modal_state(self, u=None, udot=None) -> ModalState:
-        """The structural state of given modal displacements and velocities (an initial state
-        of :meth:`simulate`, the flow at rest).
-
-        Parameters
-        ----------
-        u, udot : array_like, shape (N,), optional
-            Modal displacements and velocities (default zero).
-
-        Returns
-        -------
-        ModalState
-            The same for every model of these modes: :meth:`simulate` puts it where the truth
-            keeps it (``layout.vector(state)``, ``[u, u']``).
-        """
-        return ModalState.of(self.n_modes, u, udot)
-
-    def displaced_state(self, mode: int, deflection: float) -> ModalState:
-        """The structural state at rest with mode ``mode`` displaced by ``deflection``.
-
-        Parameters
-        ----------
-        mode : int
-            0-based mode index.
-        deflection : float
-            Modal displacement ``u_mode``.
-
-        Returns
-        -------
-        ModalState
-            An initial state of :meth:`simulate` (the flow at rest).
-        """
-        return ModalState.displaced(self.n_modes, mode, deflection)
 
     def sensor_units(self) -> tuple[str, ...]:
         """Units of the sensor rows' readings (``""`` where the problem gives none)."""

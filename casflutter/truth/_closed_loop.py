@@ -367,7 +367,7 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
     Parameters
     ----------
     truth : AeroelasticTruth
-        The simulator.
+        The nonlinear simulator (:func:`closed_loop_truth` runs it with the flap servo).
     K : control.StateSpace
         Controller from the accelerometers to the flap command.
     V_flutter : float
@@ -474,7 +474,7 @@ def truth_loop_matrix(truth, K: control.StateSpace, V: float, *, actuator_omega:
     Parameters
     ----------
     truth : AeroelasticTruth
-        The simulator.
+        The simulator, linearised at ``V`` (its :meth:`statespace` with the actuator).
     K : control.StateSpace
         Controller from the sensors to the flap command.
     V : float
@@ -538,10 +538,8 @@ def truth_loop_sweep(truth, K: control.StateSpace, V_flutter: float, V, *,
         The truth's flutter speed index: the stable interval reported is the one around it.
     V : array_like
         Increasing speed indices.
-    actuator_omega, actuator_zeta : float
-        The flap actuator.
-    sensor_rows : array_like, optional
-        ``Hs`` (default: the truth's own).
+    actuator_omega, actuator_zeta, sensor_rows :
+        The actuator and the sensor rows, as in :func:`truth_loop_matrix`.
 
     Returns
     -------

@@ -29,25 +29,22 @@ on the assumed-mode coordinates.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import brentq
 from scipy.special import hankel2
 
 from ..errors import ConfigError
-from ..structure import SpeedConvention
+from ..structure import AirspeedMixin, SpeedConvention
 from ._aero import JONES_B, jones_C, strip_coefficients
-from ._base import AeroelasticTruth, AeroMatrices, AirspeedMixin
+from ._base import AeroelasticTruth, AeroMatrices
 from ._params import ChordGeometryMixin, ParamsMixin, require
+from ._params import parameter as _p  # the parameter fields below
 
 __all__ = ["GolandParams", "GolandWing", "clamped_free_roots", "theodorsen_C"]
 
 _NQUAD = 200
-
-
-def _p(default, unit, doc):
-    return field(default=default, metadata={"unit": unit, "doc": doc})
 
 
 @dataclass(frozen=True)
@@ -206,7 +203,7 @@ class GolandWing(AirspeedMixin, AeroelasticTruth):
         dynamic pressure from ``rho``."""
         p = self.params
         return SpeedConvention("V = U / (b omega_ref), omega_ref = (pi/2L) sqrt(GJ/I)", "s",
-                               U_ref=p.b * p.omega_ref, rho=p.rho)
+                               U_ref=(p.b, p.omega_ref), rho=p.rho)
 
     @property
     def alpha(self) -> float:

@@ -57,9 +57,9 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from ..errors import ConfigError
-from ..structure import SpeedConvention
+from ..structure import AirspeedMixin, SpeedConvention
 from ._aero import JONES_B, strip_coefficients
-from ._base import AeroelasticTruth, AeroMatrices, AirspeedMixin
+from ._base import AeroelasticTruth, AeroMatrices
 
 __all__ = ["PitchPlungeParams", "FlapCoefficients", "PitchPlungeSection", "PITCH_PLUNGE_KIND"]
 

@@ -89,17 +89,18 @@ rho U_ref^2 b L / modal_mass`` so that ``alpha V^2 y = Q / modal_mass`` with ``y
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ..structure import SpeedConvention
+from ..structure import AirspeedMixin, SpeedConvention
 from ._aero import JONES_A, JONES_B, strip_coefficients
-from ._base import AeroelasticTruth, AeroMatrices, AirspeedMixin, SimulationResult
+from ._base import AeroelasticTruth, AeroMatrices, SimulationResult
 from ._goland import _bending_shapes
 from ._params import ChordGeometryMixin, ParamsMixin, require
+from ._params import parameter as _p  # the parameter fields below
 
 __all__ = ["SeedWingParams", "SeedWing", "SEED_FREQUENCIES_HZ", "SEED_SENSOR_ROWS",
            "SEED_MODE_NAMES", "SEED_U_REF"]
@@ -115,10 +116,6 @@ SEED_SENSOR_ROWS = ((0.1299, -0.0006, -0.2866, -0.1130, 0.0766),
 SEED_U_REF = 28.9
 
 _BENDING_ORDER = (1, 1, 2, 1, 3)  # clamped-free shape carrying each mode's vertical part
-
-
-def _p(default, unit, doc):
-    return field(default=default, metadata={"unit": unit, "doc": doc})
 
 
 @dataclass(frozen=True)

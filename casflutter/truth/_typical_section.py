@@ -19,7 +19,7 @@ axis, both on the chord ``2b``), the paper's force-coefficient outputs.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -27,12 +27,9 @@ from ..structure import SpeedConvention
 from ._aero import JONES_B, strip_coefficients
 from ._base import AeroelasticTruth, AeroMatrices
 from ._params import ParamsMixin, require
+from ._params import parameter as _p  # the parameter fields below
 
 __all__ = ["TypicalSectionParams", "TypicalSection"]
-
-
-def _p(default, unit, doc):
-    return field(default=default, metadata={"unit": unit, "doc": doc})
 
 
 @dataclass(frozen=True)

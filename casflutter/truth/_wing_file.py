@@ -71,8 +71,8 @@ from ..data import GAFTable, IOData, Record, load_gaf
 from ..data._matfile import read_mat
 from ..data._records import _read_npz
 from ..errors import ConfigError, DataError
-from ..structure import SENSOR_KINDS, ModalStructure, SpeedConvention, check_sensor_rows
-from ._base import AirspeedMixin
+from ..structure import (SENSOR_KINDS, AirspeedMixin, ModalStructure, SpeedConvention,
+                         check_sensor_rows)
 
 __all__ = ["WING_KIND", "GAF_KIND", "WingProblem", "GAFProblem"]
 
