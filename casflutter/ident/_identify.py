@@ -22,12 +22,13 @@ from .._threads import single_threaded
 from ..data import IOData, Record
 from ..errors import ConfigError, ConvergenceError, DataError, OrderError
 from ._fit import FitReport, fit_report
-from ._model import HWLModel, HWLStructure, UnstableModelWarning
+from ._model import HWLModel, UnstableModelWarning
 from ._orders import HWLOrders
 from ._refine import refine
 from ._regression import stage1
 from ._settings import IdentificationSettings, IdentificationWarning
 from ._simfit import FreeRunProblem, fit_simulation_error
+from ._structure import HWLStructure
 
 __all__ = ["IdentificationSettings", "IdentificationResult", "IdentificationWarning",
            "FitReport", "identify", "fit_report"]

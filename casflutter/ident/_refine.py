@@ -27,7 +27,7 @@ import numpy as np
 from .._nlp import NLPResult, make_solver
 from ..data import IOData
 from ..errors import ConfigError
-from ._model import HWLStructure, _input_part
+from ._structure import HWLStructure, _input_part
 from ._twins import ar_weights, recursion_step
 from ._regression import regressor_matrix, weights_matrix
 from ._simfit import FreeRunProblem

@@ -12,8 +12,9 @@ from ..errors import ConfigError
 from ..truth import load_problem, truth_records
 from ._common_denominator import identify_common_denominator
 from ._kernels import duffing_rk4
-from ._model import HWLModel, HWLStructure
+from ._model import HWLModel
 from ._orders import HWLOrders
+from ._structure import HWLStructure
 
 __all__ = ["random_hwl_model", "synthetic_data", "duffing_data", "example_rom"]
 
