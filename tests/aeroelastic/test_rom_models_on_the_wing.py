@@ -36,7 +36,7 @@ from casflutter.truth import RecordSettings, SeedWing, truth_records
 from casflutter.verify import load_controller, speed_family_interval
 
 #: the test witnesses (tests/witnesses/README.md): inputs of the tests, each certified here
-WITNESSES = Path(__file__).resolve().parents[1] / "witnesses"
+WITNESS_DIR = Path(__file__).resolve().parents[1] / "witnesses"
 
 SERVO = 251.3                           # rad/s, the seed wing's 40 Hz servo
 SPEEDS = np.linspace(0.3, 2.3, 21)      # the parametric ROM's nodes span (0.3, 2.5)
@@ -56,7 +56,7 @@ def models():
     rom = ParametricROM(nodes, tuple(
         identify_common_denominator(truth_records(truth, records, V0=float(v)), 2, 6)
         for v in nodes))
-    K = load_controller(WITNESSES / "truth_interval_controller_order8.json")
+    K = load_controller(WITNESS_DIR / "truth_interval_controller_order8.json")
     return ParametricSystem(rom, truth.modal_structure()), TruthLoop(truth, SERVO), K
 
 

@@ -23,7 +23,7 @@ from casflutter.truth import SeedWing
 from casflutter.verify import load_controller, speed_family_interval
 
 #: the test witnesses (tests/witnesses/README.md): inputs of the tests, each certified here
-WITNESSES = Path(__file__).resolve().parents[1] / "witnesses"
+WITNESS_DIR = Path(__file__).resolve().parents[1] / "witnesses"
 
 INTERVAL = (0.05, 1.6)
 
@@ -35,7 +35,7 @@ def wing():
 
 @pytest.fixture(scope="module")
 def witness():
-    return load_controller(WITNESSES / "truth_interval_controller_order8.json")
+    return load_controller(WITNESS_DIR / "truth_interval_controller_order8.json")
 
 
 def test_lower_orders_hold_the_interval_and_the_verification_certifies_them(wing, witness):

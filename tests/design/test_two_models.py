@@ -19,7 +19,7 @@ from casflutter.truth import SeedWing
 from casflutter.verify import load_controller, speed_family_interval
 
 #: the test witnesses (tests/witnesses/README.md): inputs of the tests, each certified here
-WITNESSES = Path(__file__).resolve().parents[1] / "witnesses"
+WITNESS_DIR = Path(__file__).resolve().parents[1] / "witnesses"
 
 SERVO = 251.3       # rad/s, the seed wing's 40 Hz servo
 V0 = 0.69           # the paper's identification speed (Table I)
@@ -35,7 +35,7 @@ def families(seed_wing_sigma_f):
 
 @pytest.mark.parametrize("model", ["rom", "wing"])
 def test_the_order_5_controller_holds_both_models_over_the_paper_interval(families, model):
-    K = load_controller(WITNESSES / "rom_and_truth_interval_controller_order5.json")
+    K = load_controller(WITNESS_DIR / "rom_and_truth_interval_controller_order5.json")
     assert K.nstates == 5
     fam = families[model]
     cert = speed_family_interval(lambda V: fam.loop(V).flap_to_sensors(), K, V0)

@@ -22,7 +22,7 @@ import pytest
 from casflutter.verify import load_controller, speed_family_interval
 
 #: the test witnesses (tests/witnesses/README.md): inputs of the tests, each certified here
-WITNESSES = Path(__file__).resolve().parents[1] / "witnesses"
+WITNESS_DIR = Path(__file__).resolve().parents[1] / "witnesses"
 
 SERVO = 251.3     # rad/s, the seed wing's 40 Hz servo
 
@@ -34,7 +34,7 @@ def family(default_rom_loop):
 
 
 def _controller(name):
-    return load_controller(WITNESSES / name)
+    return load_controller(WITNESS_DIR / name)
 
 
 def test_two_order4_controllers_cover_the_paper_interval_on_the_rom_loop(family,

@@ -22,7 +22,7 @@ from casflutter.errors import ConfigError
 from casflutter.verify import load_controller, scheduled_response
 
 #: the test witnesses (tests/witnesses/README.md): inputs of the tests, each certified here
-WITNESSES = Path(__file__).resolve().parents[1] / "witnesses"
+WITNESS_DIR = Path(__file__).resolve().parents[1] / "witnesses"
 
 SERVO = 251.3
 SWITCH = 1.875              # inside the overlap (1.8442, 1.9033) of the two certificates
@@ -35,7 +35,7 @@ def family(default_rom_loop):
 
 @pytest.fixture(scope="module")
 def pair():
-    return [load_controller(WITNESSES / f"rom_order4_{end}_controller.json")
+    return [load_controller(WITNESS_DIR / f"rom_order4_{end}_controller.json")
             for end in ("low", "high")]
 
 

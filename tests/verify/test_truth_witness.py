@@ -26,7 +26,7 @@ from casflutter.truth import SeedWing
 from casflutter.verify import load_controller, speed_family_interval
 
 #: the test witnesses (tests/witnesses/README.md): inputs of the tests, each certified here
-WITNESSES = Path(__file__).resolve().parents[1] / "witnesses"
+WITNESS_DIR = Path(__file__).resolve().parents[1] / "witnesses"
 
 SERVO = 251.3     # rad/s, the seed wing's 40 Hz servo (run.toml: controller.flap_rate_bandwidth)
 WITNESSES = {"truth_interval_controller.json": 32, "truth_interval_controller_order8.json": 8,
@@ -42,7 +42,7 @@ def plant():
 
 @pytest.fixture(scope="module", params=sorted(WITNESSES))
 def witness(request):
-    K = load_controller(WITNESSES / request.param)
+    K = load_controller(WITNESS_DIR / request.param)
     assert K.nstates == WITNESSES[request.param]
     return K
 
@@ -65,7 +65,7 @@ def test_a_dense_scan_agrees(plant, witness):
 def test_the_best_order_3_controller_found_holds_the_wing_to_2_26(plant):
     """The figure the documentation quotes for order 3 (the paper's order): certified, and
     short of the paper's 2.4."""
-    K = load_controller(WITNESSES / "truth_best_order3_controller.json")
+    K = load_controller(WITNESS_DIR / "truth_best_order3_controller.json")
     assert K.nstates == 3
     cert = speed_family_interval(plant, K, 1.2)
     assert cert.lower == 0.0 and 2.259 < cert.upper < 2.4
@@ -76,7 +76,7 @@ def test_an_order_3_controller_holds_the_upper_part_through_the_grip_dip(plant):
     V = 1.03 to 2.40, across the dip of the flap's grip on the flutter mode (V ≈ 1.46), and
     loses it lower down, where its resonator destabilises the same mode's low-speed branch
     (the lateral mode); a dense scan agrees."""
-    K = load_controller(WITNESSES / "truth_order3_upper_controller.json")
+    K = load_controller(WITNESS_DIR / "truth_order3_upper_controller.json")
     assert K.nstates == 3
     cert = speed_family_interval(plant, K, 2.0)
     assert 1.0 < cert.lower < 1.04 and cert.upper >= 2.4
