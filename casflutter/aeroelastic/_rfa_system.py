@@ -94,8 +94,9 @@ class RFASystem(AirspeedMixin):
 
     @property
     def mode_states(self) -> list[np.ndarray]:
-        """State indices ``[u_i, u_i']`` of each mode (for :func:`find_flutter`)."""
-        return [np.array([2 * i, 2 * i + 1]) for i in range(self.n_modes)]
+        """State indices ``[u_i, u_i']`` of each mode (for :func:`find_flutter`): the
+        structure's layout, its states first."""
+        return self.structure.mode_states
 
     @cached_property
     def speed(self) -> SpeedConvention:

@@ -12,5 +12,5 @@ from ._modal import SENSOR_KINDS, ModalStructure, check_sensor_rows
 from ._speed import AirspeedMixin, SpeedConvention
 from ._state import ModalLayout, ModalState, ModalStates
 
-__all__ = ["ModalStructure", "SENSOR_KINDS", "check_sensor_rows", "ModalState", "ModalLayout", "ModalStates",
-           "SpeedConvention", "AirspeedMixin"]
+__all__ = ["ModalStructure", "SENSOR_KINDS", "check_sensor_rows", "ModalState", "ModalLayout",
+           "ModalStates", "SpeedConvention", "AirspeedMixin"]

@@ -65,7 +65,7 @@ class SpeedConvention:
 
     definition: str = "V"
     time_unit: str = "s"
-    U_ref: float | None = None
+    U_ref: float | tuple | None = None
     rho: float | None = None
 
     def __post_init__(self):
