@@ -3,10 +3,10 @@
 The first file says what is verified: a ``.json`` plant is the single-speed LFT route of
 :mod:`casflutter.cli.commands.verify`; anything else is a plant family:
 
-* a family file (TOML ``kind = "plant_family"``, a folder holding one, or a problem name:
-  :func:`casflutter.aeroelastic.load_family`);
+* a family file (TOML ``kind = "plant_family"``, a folder holding one, or a problem name
+  such as ``goland_4flaps``: :func:`casflutter.aeroelastic.load_family`);
 * a ROM loop kept in an ``.npz`` (:func:`casflutter.aeroelastic.load_rom_loop`, the frozen
-  loop of eq. 8, e.g. ``problems/seed_wing/rom_loop_seed0.npz``), with ``--servo OMEGA`` for
+  loop of eq. 8, e.g. ``problems/seed_wing_rom/rom_loop_seed0.npz``), with ``--servo OMEGA`` for
   the flap behind a second-order servo (damping 0.7), in its speed index.
 
 It prints (or writes as JSON with ``--json``) what :func:`casflutter.verify.verify_family`
@@ -27,7 +27,7 @@ import math
 from pathlib import Path
 
 from .._outputs import check_figure_path, print_json
-from ..errors import ConfigError, DataError
+from ..errors import ConfigError
 
 __all__ = ["add_arguments", "is_family", "load_plant_family", "run", "verify_command",
            "verdict"]
@@ -97,22 +97,18 @@ def load_plant_family(source: str, servo: float | None = None):
     Raises
     ------
     ConfigError
-        ``--servo`` with a family file, or family files without the loader.
+        ``--servo`` with a family file.
     DataError
         A file that cannot be read.
     """
-    from .. import aeroelastic
+    from ..aeroelastic import load_family, load_rom_loop
 
     if Path(source).suffix.lower() == ".npz":
-        system, _ = aeroelastic.load_rom_loop(source)
+        system, _ = load_rom_loop(source)
         return system if servo is None else system.with_servo(float(servo))
     if servo is not None:
         raise ConfigError(f"--servo is for a ROM loop kept in an .npz; {source} is a family "
                           "file, whose plant already holds its actuators")
-    load_family = getattr(aeroelastic, "load_family", None)
-    if load_family is None:                   # pragma: no cover - until family files land
-        raise DataError(f"{source}: reading plant-family files needs "
-                        "casflutter.aeroelastic.load_family, which this installation lacks")
     return load_family(source)
 
 

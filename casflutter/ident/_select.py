@@ -22,8 +22,9 @@ import numpy as np
 from ..data import IOData
 from ..errors import CasflutterError, ConfigError, DataError
 from ._identify import (IdentificationResult, IdentificationSettings, fit_report, identify)
-from ._model import HWLModel, HWLStructure
+from ._model import HWLModel
 from ._orders import _NAMES, HWLOrders
+from ._structure import HWLStructure
 
 __all__ = ["OrderCandidate", "OrderSelection", "select_orders", "order_grid", "parse_grid"]
 

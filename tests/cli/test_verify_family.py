@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from casflutter import aeroelastic
+from casflutter.aeroelastic import write_family
 from casflutter._resources import problems_dir
 from casflutter.cli import main
 from casflutter.cli._verify_family import verify_command
@@ -21,11 +21,11 @@ from casflutter.errors import ConfigError
 from casflutter.verify import controller_to_json
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "verify"))
-from family_helpers import random_family, small_controller  # noqa: E402
+from family_helpers import WITNESSES, random_family, small_controller  # noqa: E402
 
 KEYS = {"stable_interval", "absolute_flutter_speed", "robust_flutter_speed", "margins",
         "crossings", "verdict", "speed_unit", "frequency_unit"}
-SEED = problems_dir() / "seed_wing"
+ROM_LOOP = problems_dir() / "seed_wing_rom" / "rom_loop_seed0.npz"
 
 
 @pytest.fixture(scope="module")
@@ -74,8 +74,8 @@ def test_a_required_range_outside_the_verified_one_is_refused(family_and_file):
 def test_the_seed_wing_rom_loop_on_the_command_line():
     """The default run's ROM loop behind the wing's servo, with its order-4 'low' controller
     (designed to hold V in (0, 1.9033)): certified to there, so V up to 2.0 is not covered."""
-    rc, text = _run(main, ["verify", str(SEED / "rom_loop_seed0.npz"),
-                           str(SEED / "rom_order4_low_controller.json"), "--servo", "251.3",
+    rc, text = _run(main, ["verify", str(ROM_LOOP),
+                           str(WITNESSES / "rom_order4_low_controller.json"), "--servo", "251.3",
                            "--range", "0", "2.4", "--require-v", "0.5", "2.0", "--json"])
     doc = json.loads(text)
     assert rc == 1 and KEYS <= set(doc) and doc["speed_unit"] == "speed index"
@@ -84,16 +84,14 @@ def test_the_seed_wing_rom_loop_on_the_command_line():
 
 
 def test_options_of_the_other_route_are_refused(capsys):
-    rc = main(["verify", str(SEED / "rom_loop_seed0.npz"),
-               str(SEED / "rom_order4_low_controller.json"), "--nmeas", "2"])
+    rc = main(["verify", str(ROM_LOOP),
+               str(WITNESSES / "rom_order4_low_controller.json"), "--nmeas", "2"])
     assert rc == 1 and "--nmeas" in capsys.readouterr().err
 
 
-@pytest.mark.skipif(not hasattr(aeroelastic, "load_family"),
-                    reason="family files (casflutter.aeroelastic.load_family) not installed")
-def test_a_family_file(tmp_path):    # pragma: no cover - until family files land
+def test_a_family_file(tmp_path):
     fam = random_family(4)
-    aeroelastic.write_family(fam, tmp_path / "fam.toml", fam.speeds)
+    write_family(fam, tmp_path / "fam.toml", fam.speeds)
     K = small_controller(np.random.default_rng(104), 2, 2, 2, gain=0.3, with_d=False)
     doc = controller_to_json(K)
     doc["inputs"], doc["outputs"] = ["y0", "y1"], ["u0", "u1"]

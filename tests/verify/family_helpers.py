@@ -5,12 +5,16 @@ wing's truth loop sampled on a grid, and an independent closed-loop map (python-
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import control
 import numpy as np
 
 from casflutter.aeroelastic import FamilySignals, GriddedFamily, PlantFamily, TruthLoop
 from casflutter.truth import SeedWing
 
+#: the test witnesses (tests/witnesses/README.md)
+WITNESSES = Path(__file__).resolve().parents[1] / "witnesses"
 SERVO = 251.3     # rad/s: the seed wing's 40 Hz servo (run.toml: controller.flap_rate_bandwidth)
 
 

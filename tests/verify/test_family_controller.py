@@ -9,13 +9,12 @@ import control
 import numpy as np
 import pytest
 
-from casflutter._resources import problems_dir
 from casflutter.aeroelastic import TruthLoop
 from casflutter.errors import ConfigError, DimensionError
 from casflutter.truth import SeedWing
 from casflutter.verify import controller_to_json, match_controller
 
-from family_helpers import SERVO, random_family
+from family_helpers import SERVO, WITNESSES, random_family
 
 
 def _doc(K, inputs=None, outputs=None, **extra):
@@ -104,7 +103,7 @@ def test_the_seed_wing_witness_and_a_run_export_match_the_loop_family():
     """An old witness file without names (sizes equal: order assumed) and a run's export
     (sensor names, ``"signal": "v"`` for the flap command) both fit the wing's loop family."""
     fam = TruthLoop(SeedWing(), SERVO)
-    path = problems_dir() / "seed_wing" / "truth_interval_controller_order4.json"
+    path = WITNESSES / "truth_interval_controller_order4.json"
     old = match_controller(fam, path)
     assert old.controls == ("v",) and old.measurements == fam.signals.measurements
     assert old.feedback == "positive" and old.notes

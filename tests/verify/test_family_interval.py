@@ -16,13 +16,12 @@ import control
 import numpy as np
 import pytest
 
-from casflutter._resources import problems_dir
 from casflutter.aeroelastic import FamilySignals, GriddedFamily, TruthLoop
 from casflutter.errors import ConfigError
 from casflutter.truth import SeedWing
 from casflutter.verify import certified_interval, load_controller, speed_family_interval
 
-from family_helpers import (SERVO, QuadraticFamily, abscissa, random_family,
+from family_helpers import (SERVO, WITNESSES, QuadraticFamily, abscissa, random_family,
                              seed_wing_grid, small_controller)
 
 
@@ -74,7 +73,7 @@ def test_the_seed_wing_truth_from_v_0_matches_the_polynomial_interval():
     """A loop family from V = 0 (marginally stable there: the lag states ∝ V) is certified by
     the guardian map from the start, as :func:`speed_family_interval` certifies it."""
     fam = TruthLoop(SeedWing(), SERVO)
-    K = load_controller(problems_dir() / "seed_wing" / "truth_interval_controller_order4.json")
+    K = load_controller(WITNESSES / "truth_interval_controller_order4.json")
     cert = certified_interval(fam, K, ("v",), fam.signals.measurements, 1.0, (0.0, 3.0))
     ref = speed_family_interval(lambda V: fam.loop(V).flap_to_sensors(), K, 1.2)
     assert cert.lower == 0.0 and not cert.stable_at_start
@@ -85,7 +84,7 @@ def test_the_seed_wing_truth_from_v_0_matches_the_polynomial_interval():
 @pytest.mark.slow
 def test_the_seed_wing_grid_chain_against_the_guardian_map():
     fam = seed_wing_grid(np.linspace(0.1, 3.0, 30))
-    K = load_controller(problems_dir() / "seed_wing" / "truth_interval_controller_order4.json")
+    K = load_controller(WITNESSES / "truth_interval_controller_order4.json")
     chain, guard = _certify(fam, K), _certify(fam, K, "guardian")
     assert chain.loss == pytest.approx(guard.loss, rel=1e-9)
     # the grid's interpolation moves the wing's end (2.41256) only a little

@@ -20,18 +20,17 @@ import control
 import numpy as np
 import pytest
 
-from casflutter._resources import problems_dir
 from casflutter.aeroelastic import TruthLoop
 from casflutter.truth import SeedWing
 from casflutter.verify import broken_loops, classical_margins, load_controller, loop_margins
 
-from family_helpers import SERVO, random_family, small_controller
+from family_helpers import SERVO, WITNESSES, random_family, small_controller
 
 
 @pytest.fixture(scope="module")
 def wing():
     fam = TruthLoop(SeedWing(), SERVO)
-    K = load_controller(problems_dir() / "seed_wing" / "truth_interval_controller_order4.json")
+    K = load_controller(WITNESSES / "truth_interval_controller_order4.json")
     return fam, K
 
 
@@ -70,7 +69,7 @@ def _cases():
     """Loops whose open loop is unstable (the wing above its flutter speed) and a random
     family's loops (both sides, a controller with a feed-through)."""
     fam = TruthLoop(SeedWing(), SERVO)
-    K = load_controller(problems_dir() / "seed_wing" / "truth_interval_controller_order4.json")
+    K = load_controller(WITNESSES / "truth_interval_controller_order4.json")
     yield "wing V=2.0", fam.control_plant(2.0), K, 1.0
     rf = random_family(3, with_d=True)
     Kr = small_controller(np.random.default_rng(103), 2, 2, 2, gain=3.0, with_d=True)

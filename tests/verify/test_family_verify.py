@@ -20,7 +20,7 @@ from casflutter.errors import ConfigError
 from casflutter.truth import SeedWing
 from casflutter.verify import verify_family
 
-from family_helpers import SERVO, abscissa, random_family, small_controller
+from family_helpers import SERVO, WITNESSES, abscissa, random_family, small_controller
 
 KEYS = {"stable_interval", "absolute_flutter_speed", "robust_flutter_speed",
         "robust_flutter_reason", "margins", "crossings", "speed_unit", "frequency_unit"}
@@ -108,14 +108,14 @@ def test_the_seed_wing_loop_families_give_the_same_keys():
     loop behind the same servo (its order-4 'low' controller, certified on (0, 1.9033) by
     its design), in the speed index."""
     truth = TruthLoop(SeedWing(), SERVO)
-    w = verify_family(truth, problems_dir() / "seed_wing" /
-                      "truth_interval_controller_order4.json", speed_range=(0.0, 3.0),
+    w = verify_family(truth, WITNESSES / "truth_interval_controller_order4.json",
+                      speed_range=(0.0, 3.0),
                       margin_speeds=13)
     assert w.stable_interval[0] == 0.0 and not w.interval.stable_at_start
     assert w.absolute_flutter_speed == pytest.approx(2.41256, abs=1e-5)
-    rom = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")[0]
-    r = verify_family(rom.with_servo(SERVO), problems_dir() / "seed_wing" /
-                      "rom_order4_low_controller.json", speed_range=(0.0, 2.4),
+    rom = load_rom_loop(problems_dir() / "seed_wing_rom" / "rom_loop_seed0.npz")[0]
+    r = verify_family(rom.with_servo(SERVO), WITNESSES / "rom_order4_low_controller.json",
+                      speed_range=(0.0, 2.4),
                       margin_speeds=13)
     assert r.absolute_flutter_speed == pytest.approx(1.9033, abs=1e-4)
     for res in (w, r):
@@ -126,7 +126,7 @@ def test_the_seed_wing_loop_families_give_the_same_keys():
 
 def test_bad_requests_are_refused_before_any_work():
     truth = TruthLoop(SeedWing(), SERVO)
-    K = problems_dir() / "seed_wing" / "truth_interval_controller_order4.json"
+    K = WITNESSES / "truth_interval_controller_order4.json"
     with pytest.raises(ConfigError, match="not a finite interval; pass speed_range"):
         verify_family(truth, K)
     with pytest.raises(ConfigError, match="margins"):
