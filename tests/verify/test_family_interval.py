@@ -133,3 +133,20 @@ def test_a_family_without_a_degree_or_with_a_wrong_one_is_refused():
         certified_interval(fam, K, ("u",), ("y0", "y1"), -1.0, (0.1, 1.5))
     with pytest.raises(ConfigError, match="finite range"):
         certified_interval(fam, K, ("u",), ("y0", "y1"), -1.0, (0.1, math.inf), degree=2)
+
+
+def test_the_open_loop_of_the_50_state_family_matches_its_flutter_search():
+    """With no controller, the certified interval of ``goland_4flaps`` (50 states, 41 speeds)
+    ends at the grid's flutter speed as :func:`casflutter.aeroelastic.family_flutter` finds it
+    (eigenvalue derivatives and Newton steps: a computation that shares nothing with the
+    certificate)."""
+    from casflutter.aeroelastic import family_flutter, load_family
+
+    fam = load_family("goland_4flaps")
+    s = fam.signals
+    cert = certified_interval(fam, np.zeros((4, 8)), s.controls, s.measurements,
+                              fam.feedback_sign, fam.speed_range)
+    ref = family_flutter(fam)
+    assert cert.loss == pytest.approx(ref.Vf, rel=1e-8)
+    assert cert.omega == pytest.approx(ref.omega_f, rel=1e-6)
+    assert {p.method for p in cert.pieces} == {"inclusion"}
