@@ -18,6 +18,7 @@ import json
 import math
 
 from ...errors import ConfigError
+from .. import _verify_family
 
 __all__ = ["register", "run", "verdict"]
 
@@ -48,6 +49,7 @@ def register(subparsers) -> None:
                    help="speed-index range over which the loop must stay stable (exact "
                         "interval, eq. 10-15); not covered -> exit code 1")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
+    _verify_family.add_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -110,6 +112,8 @@ def _strict(obj):
 def run(args) -> int:
     """Handler of ``casflutter verify``: 0 when the verdict passes, 1 when the loop is not
     stable or not robust over ``--require-v``."""
+    if _verify_family.is_family(args.plant):
+        return _verify_family.run(args)
     from ...verify import load_controller, load_plant, verify_controller
 
     plant = load_plant(args.plant)
