@@ -56,8 +56,9 @@ from typing import Any, Mapping, Sequence
 import control
 import numpy as np
 
+from .._nlp import check_solver_options
 from .._threads import single_threaded
-from ..errors import ConfigError, DataError, DimensionError, SynthesisError
+from ..errors import CasflutterError, ConfigError, DataError, DimensionError, SynthesisError
 from ._fullorder import full_order_controller, reduced_controllers
 from ._plant import Partition, partition
 from ._problem import Cut, Problem, realize, verify_closed_loop
@@ -75,7 +76,8 @@ instead (:func:`_best_start`)."""
 _NUMERICAL_FAILURES = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError,
                        OverflowError, ValueError)
 """Exceptions that end one start as ``"failed"`` (scipy raises ``ValueError`` on arrays
-with infs or NaNs); the package's own errors are raised before the starts run."""
+with infs or NaNs); the package's own errors (e.g. an Ipopt option refused when the first QP
+is built) are raised as they are."""
 
 
 @dataclass(frozen=True)
@@ -155,6 +157,8 @@ class SynthesisOptions:
                               "trust_region, 0<active_ratio<1, abandon_after>=1, abandon_ratio>1, "
                               "stall_window>=2, 0<=stall_tol<1, "
                               "time_limit None or >0, full_order_gamma_factor>1")
+        if self.ipopt:     # refused here, not as a solver error in the middle of a start
+            check_solver_options(self.ipopt, "SynthesisOptions.ipopt")
 
 
 @dataclass(frozen=True)
@@ -691,6 +695,8 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
         statuses: list[str] = []
         try:
             rec, K, alpha = _run_start(prob, qp, opts, s, kind, K0, statuses, deadline, records)
+        except CasflutterError:
+            raise
         except _NUMERICAL_FAILURES as exc:
             # a numerical failure ends this start only (module docstring)
             log.info("start %d (%s): failed (%s: %s)", s, kind, type(exc).__name__, exc)
@@ -714,6 +720,8 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
             alpha_s = max((float(verify_closed_loop(P, controller, nmeas, ncon)[2])
                            for P in stab_list), default=-np.inf)
             break
+        except CasflutterError:
+            raise
         except _NUMERICAL_FAILURES as exc:
             log.info("start %d: its controller failed the final check (%s)", best.start,
                      _reason(exc))
@@ -822,12 +830,12 @@ def _best_start(ok: Sequence[StartRecord]) -> StartRecord:
     """The start whose controller is returned: the lowest γ, where a later start replaces
     an earlier one only when its γ is lower by more than ``GAMMA_TIE_RTOL`` (relative).
 
-    Starts that end in the same local minimum agree in γ to a few parts in 1e7 or better (the
-    norm is exact to 2e-9, the stopping test asks for less than ``tol`` = 1e-5 of predicted
-    decrease); a plain minimum would choose between them by their last bits, which change
-    from machine to machine.  The earlier start wins such ties, so the choice (and the
-    controller returned) does not hinge on rounding, at a cost in γ of at most one part in
-    1e6, far below the 1 % to which results are promised across machines."""
+    Starts that end in the same local minimum reach it only to the stopping tolerance
+    (``tol`` = 1e-5 of predicted relative decrease), and the norm itself is exact to 2e-9: a
+    difference of a part in a million is no evidence that one start is better, and a plain
+    minimum would choose between such starts by their last bits, which change from machine
+    to machine.  The earlier start wins such ties, at a cost in γ of at most one part in 1e6,
+    far below the 1 % to which results are promised across machines."""
     best = ok[0]
     for r in ok[1:]:
         if r.gamma < best.gamma * (1.0 - GAMMA_TIE_RTOL):
