@@ -354,18 +354,14 @@ def _shrunk(prob: Problem, K0: np.ndarray) -> np.ndarray | None:
     Z = K0.copy()
     Z[:prob.nu, :] = 0.0
     Z[:, :prob.ny] = 0.0
-    try:
-        a0 = max(float(np.max(prob.alphas(Z)[0])), 0.0) + 0.05
-    except np.linalg.LinAlgError:
+    a0 = max(float(np.max(prob.alphas(Z)[0])), 0.0) + 0.05
+    if not np.isfinite(a0):        # the loop without couplings has no abscissa
         return None
     K = K0.copy()
     for _ in range(20):
         K = Z + 0.5 * (K - Z)
-        try:
-            if prob.well_posed(K) and float(np.max(prob.alphas(K)[0])) <= a0:
-                return K
-        except np.linalg.LinAlgError:
-            return None
+        if prob.well_posed(K) and float(np.max(prob.alphas(K)[0])) <= a0:
+            return K
     return None
 
 
