@@ -56,7 +56,6 @@ from typing import Any, Mapping, Sequence
 import control
 import numpy as np
 
-from .._nlp import check_solver_options
 from .._threads import single_threaded
 from ..errors import CasflutterError, ConfigError, DataError, DimensionError, SynthesisError
 from ._fullorder import full_order_controller, reduced_controllers
@@ -157,8 +156,6 @@ class SynthesisOptions:
                               "trust_region, 0<active_ratio<1, abandon_after>=1, abandon_ratio>1, "
                               "stall_window>=2, 0<=stall_tol<1, "
                               "time_limit None or >0, full_order_gamma_factor>1")
-        if self.ipopt:     # refused here, not as a solver error in the middle of a start
-            check_solver_options(self.ipopt, "SynthesisOptions.ipopt")
 
 
 @dataclass(frozen=True)
