@@ -56,13 +56,16 @@ class SynthesisError(CasflutterError, RuntimeError):
     """Fixed-order synthesis found no stabilising controller.
 
     ``.best_spectral_abscissa`` holds the smallest closed-loop spectral abscissa
-    reached over all starts.
+    reached over all starts, ``.starts`` the record of every start (with its status and
+    why it failed).
     """
 
-    def __init__(self, message: str, best_spectral_abscissa: float | None = None, result=None):
+    def __init__(self, message: str, best_spectral_abscissa: float | None = None, result=None,
+                 starts: tuple = ()):
         super().__init__(message)
         self.best_spectral_abscissa = best_spectral_abscissa
         self.result = result
+        self.starts = tuple(starts)
 
 
 class OutputError(CasflutterError, OSError):

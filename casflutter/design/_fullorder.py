@@ -38,6 +38,9 @@ __all__ = ["full_order_controller", "reduced_controllers"]
 log = logging.getLogger("casflutter.design")
 
 _RANK_TOL = 1e-8
+_AXIS_TOL = 1e-9
+"""Relative distance to the imaginary axis within which a controller pole counts as
+unstable (:func:`reduced_controllers`): the count then does not hinge on rounding."""
 
 
 def _full_rank(M: np.ndarray, rows: bool) -> bool:
@@ -152,7 +155,10 @@ def reduced_controllers(K: control.StateSpace, order: int) -> list[control.State
     Km = slow_modal(K, order)
     if Km is not None:
         out.append(Km)
-    unstable = int(np.sum(np.linalg.eigvals(np.asarray(K.A, float)).real >= 0))
+    # poles within _AXIS_TOL of the imaginary axis (an integrator of the central controller)
+    # count as unstable whatever the sign of their rounded real part
+    lam = np.linalg.eigvals(np.asarray(K.A, float))
+    unstable = int(np.sum(lam.real >= -_AXIS_TOL * np.maximum(np.abs(lam), 1.0)))
     for method in ("truncate", "matchdc"):
         if unstable > order:
             # balred keeps the whole unstable part: the result would exceed the order

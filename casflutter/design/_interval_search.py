@@ -31,6 +31,11 @@ __all__ = ["RandomStartSearch", "search_random_starts"]
 
 log = logging.getLogger("casflutter.design")
 
+REACH_TIE = 1e-9
+"""Relative difference of two reached interval ends below which they tie
+(:attr:`RandomStartSearch.best` keeps the earlier start); far below the continuation's
+smallest step (``min_step``, 2.5e-3 by default)."""
+
 
 @dataclass(frozen=True)
 class RandomStartSearch:
@@ -65,10 +70,14 @@ class RandomStartSearch:
     @property
     def best(self) -> IntervalReach | None:
         """The continuation that reached farthest from the anchor (``None`` when no start
-        held the anchor band)."""
-        if self.anchor == "high":
-            return min(self.reaches, key=lambda r: r.reached[0], default=None)
-        return max(self.reaches, key=lambda r: r.reached[1], default=None)
+        held the anchor band); of ends within ``REACH_TIE`` of each other (sums of
+        continuation steps that differ only in rounding), the earlier start's."""
+        best = None
+        for r in self.reaches:
+            far = r.reached[0] if self.anchor == "high" else -r.reached[1]
+            if best is None or far < best[0] - REACH_TIE * max(1.0, abs(best[0])):
+                best = (far, r)
+        return None if best is None else best[1]
 
     @property
     def met(self) -> bool:
