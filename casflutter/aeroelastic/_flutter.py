@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq, linear_sum_assignment
 
+from .._format import result_repr
 from ..errors import ConfigError
 from ._tracking import (EigenTracking, as_matrix_fn, eig_sorted_by_reference,
                         track_eigenvalues)
@@ -53,6 +54,8 @@ class Crossing:
     bracket : tuple of float
         Grid interval that contained the sign change.
     """
+
+    __repr__ = result_repr
 
     V: float
     eigenvalue: complex
@@ -103,6 +106,8 @@ class FlutterResult:
     message : str
         Human-readable summary.
     """
+
+    __repr__ = result_repr
 
     status: str
     Vf: float | None

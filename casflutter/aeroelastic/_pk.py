@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
+from .._format import result_repr
 from ..data import GAFTable
 from ..errors import ConfigError, ConvergenceError, DataError, DimensionError
 from ..structure import ModalStructure
@@ -71,6 +72,8 @@ class PKResult:
     message : str
         Summary.
     """
+
+    __repr__ = result_repr
 
     U: np.ndarray
     modes: tuple[int, ...]

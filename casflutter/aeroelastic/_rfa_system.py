@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError, DimensionError
 from ..realize import RationalApproximation
 from ..structure import ModalStructure
@@ -62,6 +63,8 @@ class RFASystem:
     ConfigError
         ``U_ref`` not positive.
     """
+
+    __repr__ = result_repr
 
     rfa: RationalApproximation
     structure: ModalStructure

@@ -16,6 +16,7 @@ from typing import Sequence
 
 import numpy as np
 
+from .._format import result_repr
 from ..errors import DataError
 from ._matfile import read_mat
 
@@ -91,6 +92,8 @@ class Record:
     name : str
         Label used in messages and reports.
     """
+
+    __repr__ = result_repr
 
     y: np.ndarray
     u: np.ndarray | None = None
@@ -173,6 +176,8 @@ class IOData:
     >>> d.n_modes, d.has_u, d.has_v
     (2, True, False)
     """
+
+    __repr__ = result_repr
 
     records: tuple[Record, ...]
     dt: float

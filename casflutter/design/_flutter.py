@@ -34,6 +34,7 @@ from typing import Any, Mapping
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..aeroelastic import AeroelasticLFT, AeroelasticSystem, build_lft
 from ..errors import ConfigError, SynthesisError
 from ._synthesis import SynthesisOptions, SynthesisResult, synthesize
@@ -69,6 +70,8 @@ class FlutterDesign:
     met : bool
         True when ``reached`` is the target.
     """
+
+    __repr__ = result_repr
 
     controller: control.StateSpace
     synthesis: SynthesisResult

@@ -43,6 +43,7 @@ import numpy as np
 import scipy.linalg
 from scipy.optimize import minimize
 
+from .._format import result_repr
 from .._linalg import spectral_abscissa
 from .._settings import finite_numbers
 from .._threads import single_threaded
@@ -78,6 +79,8 @@ class IntervalReach:
     met : bool
         True when ``reached`` is the target.
     """
+
+    __repr__ = result_repr
 
     controller: control.StateSpace
     reached: tuple
@@ -505,6 +508,8 @@ class OrderStep:
         low end (:func:`stabilize_interval`).
     """
 
+    __repr__ = result_repr
+
     order: int
     controller: control.StateSpace
     worst_abscissa: float
@@ -526,6 +531,8 @@ class OrderReduction:
         The orders held, highest first (with the half-way orders of split steps), and last
         the first order that missed, if one did.
     """
+
+    __repr__ = result_repr
 
     interval: tuple
     decay: float
@@ -667,6 +674,8 @@ class IntervalDesign:
     met : bool
         ``controller`` has the requested order and holds the interval.
     """
+
+    __repr__ = result_repr
 
     controller: control.StateSpace
     order: int

@@ -22,6 +22,7 @@ import control
 import numpy as np
 import scipy.linalg
 
+from .._format import result_repr
 from .._settings import finite_numbers
 from .._threads import single_threaded
 from ..errors import ConfigError
@@ -53,6 +54,8 @@ class RandomStartSearch:
     frequency_band : tuple of float
         The band (rad/s) the resonators' frequencies were drawn from.
     """
+
+    __repr__ = result_repr
 
     anchor: str
     order: int

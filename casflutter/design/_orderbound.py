@@ -45,6 +45,7 @@ import control
 import numpy as np
 from scipy.optimize import minimize, minimize_scalar
 
+from .._format import result_repr
 from ..errors import ConfigError, DimensionError
 from . import _exact
 from ._plant import Partition, partition
@@ -81,6 +82,8 @@ class OrderBound:
         (``k >= min(ncon, nmeas)`` with one frequency, ``k >= max(ncon, nmeas)`` with more):
         the value is then only the best each frequency allows on its own.
     """
+
+    __repr__ = result_repr
 
     order: int
     frequencies: tuple
@@ -319,6 +322,8 @@ class StaticDirectionBound:
         The bound each frequency gives on its own for any controller, ``‖Π⊥ P11(jω)‖`` with
         Π⊥ the projector off the range of ``P12(jω)``: ``value`` is at least their maximum.
     """
+
+    __repr__ = result_repr
 
     value: float
     estimate: float

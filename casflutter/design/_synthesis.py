@@ -39,6 +39,7 @@ from typing import Any, Mapping, Sequence
 import control
 import numpy as np
 
+from .._format import result_repr
 from .._threads import single_threaded
 from ..errors import ConfigError, DimensionError, SynthesisError
 from ._fullorder import full_order_controller, reduced_controllers
@@ -165,6 +166,8 @@ class StartRecord:
         Seconds spent on this start.
     """
 
+    __repr__ = result_repr
+
     start: int
     kind: str
     stabilized: bool
@@ -219,6 +222,8 @@ class SynthesisResult:
     norm_method : str
         What computed γ.
     """
+
+    __repr__ = result_repr
 
     controller: control.StateSpace
     gamma: float

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
+from .._format import result_repr
 from .._threads import single_threaded
 
 from .._nlp import DEFAULT_IPOPT_OPTIONS, NLPResult
@@ -205,6 +206,8 @@ class FitReport:
         Leading samples of each record excluded from the scores.
     """
 
+    __repr__ = result_repr
+
     mode: str
     error_percent: np.ndarray
     nrmse: np.ndarray
@@ -326,6 +329,8 @@ class IdentificationResult:
     solver : str
         ``"ipopt"``, ``"gauss-newton"`` or ``"none"``.
     """
+
+    __repr__ = result_repr
 
     model: HWLModel
     initial_model: HWLModel

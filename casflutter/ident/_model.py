@@ -42,6 +42,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+from .._format import result_repr
 from ..errors import DataError, DimensionError, OrderError
 from ._kernels import free_run
 from ._orders import HWLOrders
@@ -287,6 +288,8 @@ class HWLModel:
     v_name : str
         Name of the flap input.
     """
+
+    __repr__ = result_repr
 
     structure: HWLStructure
     theta: np.ndarray

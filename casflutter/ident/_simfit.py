@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import LinAlgError, cho_factor, cho_solve
+from .._format import result_repr
 from .._threads import single_threaded
 
 from ..data import IOData
@@ -80,6 +81,8 @@ class LMResult:
         Segment lengths used (0: whole records).
     wall_time : float
     """
+
+    __repr__ = result_repr
 
     theta: np.ndarray
     initial_outputs: tuple

@@ -10,6 +10,7 @@ from typing import Any, Mapping
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..aeroelastic import (AeroelasticLFT, AeroelasticSystem, FlutterResult, LoopSimulation,
                            ParametricSystem, PKResult, RFASystem)
 from ..data import IOData
@@ -56,6 +57,8 @@ class LcoResult:
         (``lco.branch_points > 0``).
     """
 
+    __repr__ = result_repr
+
     rom: LoopSimulation
     truth: TruthLco | None
     V: float
@@ -79,6 +82,8 @@ class ParametricResult:
     flutter : FlutterResult
         Its flutter search.
     """
+
+    __repr__ = result_repr
 
     rom: ParametricROM
     system: ParametricSystem
@@ -105,6 +110,8 @@ class SimulationCheck:
     open_eig_rate, closed_eig_rate : float
         Spectral abscissae of the linear open and closed loops at ``V``.
     """
+
+    __repr__ = result_repr
 
     model: str
     V: float
@@ -141,6 +148,8 @@ class ClosedLoopChecks:
     rom_simulation, truth_simulation : SimulationCheck
         Open and closed loop above each model's flutter speed.
     """
+
+    __repr__ = result_repr
 
     truth_sweep: TruthLoopSweep
     rom_simulation: SimulationCheck
@@ -267,6 +276,8 @@ class RunResult:
     system: AeroelasticSystem | None
     flutter: FlutterResult | None
     flutter_truth: FlutterResult | None
+    __repr__ = result_repr
+
     flutter_frozen: FlutterResult | None = None
     parametric: ParametricResult | None = None
     lco: LcoResult | None = None

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field, replace
 import casadi as ca
 import numpy as np
 
+from .._format import result_repr
 from .._nlp import NLPResult, solve_nlp
 from ..data import GAFTable
 from ..errors import ConfigError, ConvergenceError, DataError
@@ -170,6 +171,8 @@ class RationalApproximation:
         or ``Search_Direction_Becomes_Too_Small`` when the data are exactly rational in the
         roots and the residual sits at the rounding floor).
     """
+
+    __repr__ = result_repr
 
     method: str
     b: float

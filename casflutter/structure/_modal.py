@@ -41,6 +41,7 @@ from dataclasses import dataclass, field, replace
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError, DimensionError
 
 __all__ = ["ModalStructure", "SENSOR_KINDS", "check_sensor_rows"]
@@ -144,6 +145,8 @@ class ModalStructure:
     ConfigError
         Non-positive or non-finite frequencies, negative damping, unknown sensor kind.
     """
+
+    __repr__ = result_repr
 
     omega: np.ndarray
     zeta: np.ndarray

@@ -23,6 +23,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 from scipy.linalg import eig
 
+from .._format import result_repr
 from ..aeroelastic import find_flutter
 from ..errors import ConfigError, ConvergenceError
 from ..truth import load_problem
@@ -55,6 +56,8 @@ class ParameterSensitivity:
     difference : str
         ``"central"`` or ``"forward"`` (``∂A/∂p`` at a domain bound).
     """
+
+    __repr__ = result_repr
 
     name: str
     value: float
@@ -89,6 +92,8 @@ class FlutterSensitivity:
     method : str
         ``"eigenvalue perturbation"``.
     """
+
+    __repr__ = result_repr
 
     problem: str
     params: Mapping[str, float]

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError, DimensionError
 from ._common import NotHurwitzError, SystemLike, as_statespace, is_hurwitz, ssdata
 from ._hinf import HinfNorm, hinf_norm
@@ -55,6 +56,8 @@ class VerificationReport:
     notes : tuple of str
         Why something was not computed, and other remarks.
     """
+
+    __repr__ = result_repr
 
     closed_loop: control.StateSpace
     poles: np.ndarray
