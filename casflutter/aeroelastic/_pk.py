@@ -255,7 +255,7 @@ def pk_flutter(table: GAFTable, structure: ModalStructure, speeds, *, U_ref: flo
         return PKResult(U, modes, names, lam, kk, its, False, None, None, None, None, msg)
     Uf, sf, m = best
     kf = sf.imag * table.b / Uf
-    msg = (f"p-k flutter at U = {Uf:.6g} m/s, {sf.imag:.6g} rad/s (k = {kf:.4g}), mode {m} "
-           f"({table.mode_names[m]!r})")
-    log.info(msg)
+    msg = (f"p-k flutter at U = {Uf:.6g} m/s, {sf.imag:.6g} rad/s (k = {kf:.4g}), mode "
+           f"{m + 1} ({table.mode_names[m]!r})")
+    log.debug(msg)
     return PKResult(U, modes, names, lam, kk, its, True, Uf, float(sf.imag), float(kf), m, msg)

@@ -253,7 +253,7 @@ def design_flutter_controller(system: AeroelasticSystem, Vf: float, order: int =
             e_new = edge(trial.controller)
         except SynthesisError:
             trial, e_new = None, e
-        log.info("interval design: target V = %.4g -> decays up to %.4g", top, e_new)
+        log.debug("interval design: target V = %.4g -> decays up to %.4g", top, e_new)
         if trial is not None and e_new > e:
             K, e, dV = trial.controller, e_new, 1.5 * dV
             best = (trial, e)

@@ -389,11 +389,11 @@ class _Phase:
                     history_at[-1] >= it - 1 and _stalled(history, history_at, it,
                                                           opts.stall_window,
                                                           min(opts.stall_tol, 10 * opts.tol)):
-                log.info("%s: stalled at gamma %.6g (less than %.1e relative decrease in %d "
-                         "iterations)", label, f, opts.stall_tol, opts.stall_window)
+                log.debug("%s: stalled at gamma %.6g (less than %.1e relative decrease in %d "
+                          "iterations)", label, f, opts.stall_tol, opts.stall_window)
                 break
             if it > opts.abandon_after and f > self.abandon_above:
-                log.info("%s: abandoned at gamma %.6g (another start is far better)", label, f)
+                log.debug("%s: abandoned at gamma %.6g (another start is far better)", label, f)
                 break
             if cuts_cache is None:
                 cuts_cache = self.cuts(K, f, info, delta, memory)
@@ -462,8 +462,8 @@ class _Phase:
                     delta = min(2.0 * delta, opts.max_trust_region * max(1.0, np.max(np.abs(K))))
                 elif ratio < 0.25:
                     delta = 0.5 * dmax
-                log.info("%s %s it %d: %s %.6g (ratio %.2f, radius %.3g)", label, self.kind, it,
-                         "gamma" if self.kind == "hinf" else "abscissa", f, ratio, delta)
+                log.debug("%s %s it %d: %s %.6g (ratio %.2f, radius %.3g)", label, self.kind, it,
+                          "gamma" if self.kind == "hinf" else "abscissa", f, ratio, delta)
             else:
                 delta = 0.5 * dmax
                 if self.kind == "hinf" and info_n is not None:
@@ -477,7 +477,7 @@ class _Phase:
                     cuts_cache = None
                 else:
                     cuts_cache = None
-                log.info("%s %s it %d: rejected (ratio %.3g), radius %.3g", label, self.kind,
+                log.debug("%s %s it %d: rejected (ratio %.3g), radius %.3g", label, self.kind,
                           it, ratio, delta)
                 if delta < 1e-10 * max(1.0, float(np.max(np.abs(K)))):
                     break
@@ -616,8 +616,8 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
                      if Kr.nstates or np.any(np.asarray(Kr.D) != 0)]
     records, gains = [], []
     best_alpha = np.inf
-    log.info("synthesis: order %d, %d H-inf plant(s) (%d states), %d stability plant(s), "
-             "%d start(s)", order, len(parts), parts[0].nx, len(sparts), len(plan))
+    log.debug("synthesis: order %d, %d H-inf plant(s) (%d states), %d stability plant(s), "
+              "%d start(s)", order, len(parts), parts[0].nx, len(sparts), len(plan))
     for s, (kind, g) in enumerate(plan):
         t0 = time.perf_counter()
         K0 = _initial_gain(prob, kind, rng, g)
@@ -644,16 +644,16 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
             # loop is no more unstable than with the zero controller (deterministic)
             K1 = _shrunk(prob, K0)
             if K1 is not None:
-                log.info("%s: stabilisation failed (abscissa %.4g rad/s); retried from the "
-                         "random gain shrunk towards zero", label, a_h)
+                log.debug("%s: stabilisation failed (abscissa %.4g rad/s); retried from the "
+                          "random gain shrunk towards zero", label, a_h)
                 r1b = stab.run(K1, label, opts.max_stab_rounds)
                 K, phi = r1b["K"], r1b["f"]
                 r1 = dict(r1b, iterations=r1["iterations"] + r1b["iterations"])
                 a_h = float(np.max(prob.alphas(K)[0])) * prob.w0
                 best_alpha = min(best_alpha, a_h)
                 ok = prob.feasible(K) and (phi <= 0.0 or (a_h < 0 and np.isfinite(phi)))
-        log.info("%s: stabilisation %s after %d iterations (abscissa %.4g rad/s)", label,
-                 "reached the decay rates" if ok else "failed", r1["iterations"], a_h)
+        log.debug("%s: stabilisation %s after %d iterations (abscissa %.4g rad/s)", label,
+                  "reached the decay rates" if ok else "failed", r1["iterations"], a_h)
         if ok:
             best_g = min((r.gamma for r in records if r.stabilized), default=np.inf)
             hinf = _Phase(prob, qp, opts, "hinf", m_start, deadline, statuses,
@@ -666,8 +666,8 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
             hist, conv, outer, pred = tuple(r2["history"]), r2["converged"], r2["iterations"], \
                 r2["pred"]
             a_h = float(np.max(prob.alphas(K)[0])) * prob.w0
-            log.info("%s: gamma %.6g after %d H-inf iterations (%s)", label, gam, outer,
-                     "converged" if conv else "budget spent")
+            log.debug("%s: gamma %.6g after %d H-inf iterations (%s)", label, gam, outer,
+                      "converged" if conv else "budget spent")
         else:
             gam, hist, conv, outer, pred = np.inf, (), False, 0, np.inf
         records.append(StartRecord(start=s, kind=kind, stabilized=bool(ok),
@@ -694,8 +694,9 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
     alpha_v = max(float(c[2]) for c in checks)
     alpha_s = max((float(verify_closed_loop(P, controller, nmeas, ncon)[2]) for P in stab_list),
                   default=-np.inf)
-    log.info("synthesis: best start %d, gamma %.6g, %.1f s", best.start, gamma,
-             time.perf_counter() - t_start)
+    log.info("synthesis: order %d, best of %d starts (start %d): gamma %.6g, the largest "
+             "H-inf norm over the %d design plant(s), %.1f s", order, len(records), best.start,
+             gamma, len(sys_list), time.perf_counter() - t_start)
     return SynthesisResult(
         controller=controller, gamma=gamma, gammas=gammas,
         delta_bound=float(1.0 / gamma) if np.isfinite(gamma) and gamma > 0 else 0.0,
