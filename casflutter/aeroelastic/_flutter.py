@@ -291,11 +291,11 @@ def find_flutter(system, V_range=None, *, V_grid=None, n_grid: int = 101, mode_s
     div = next((c for c in crossings if c.kind == "divergence" and c.direction == "destabilizing"), None)
     if flut is not None:
         status = "flutter"
-        msg = (f"flutter at V = {flut.V:.10g}, {flut.omega:.6g} rad/s ({flut.frequency_hz:.6g} Hz), "
+        msg = (f"flutter at V = {flut.V:.6g}, {flut.omega:.6g} rad/s ({flut.frequency_hz:.6g} Hz), "
                + (f"structural mode {flut.origin_mode + 1} (numbered from 1)"
                   if flut.origin_mode >= 0 else f"branch {flut.branch} (not a structural mode)"))
     elif div is not None:
-        status, msg = "divergence", f"no flutter; static divergence at V = {div.V:.10g}"
+        status, msg = "divergence", f"no flutter; static divergence at V = {div.V:.6g}"
     else:
         status = "no_crossing"
         msg = (f"no eigenvalue crosses the imaginary axis for V in [{tr.V[0]:g}, {tr.V[-1]:g}]; "
