@@ -174,6 +174,16 @@ def _flutter_summary(res: FlutterResult | None) -> dict | None:
             "mode": None if mode is None or mode < 0 else int(mode) + 1, "status": res.status}
 
 
+def skipped_notes(skipped: Mapping[str, str]) -> list[str]:
+    """``skipped A, B (reason)``: one line per reason of a run's skipped stages (each
+    ``"what: why"``)."""
+    by_reason: dict = {}
+    for text in skipped.values():
+        what, _, why = text.partition(": ")
+        by_reason.setdefault(why, []).append(what)
+    return [f"skipped {', '.join(whats)} ({why})" for why, whats in by_reason.items()]
+
+
 def _rel(a, b):
     return None if a is None or b is None else float(a / b - 1.0)
 
@@ -266,6 +276,8 @@ class RunResult:
         thread settings, libraries) and its start time (``started``).
     """
 
+    __repr__ = result_repr
+
     config: RunConfig
     truth: AeroelasticTruth | None
     data: IOData | None
@@ -276,8 +288,6 @@ class RunResult:
     system: AeroelasticSystem | None
     flutter: FlutterResult | None
     flutter_truth: FlutterResult | None
-    __repr__ = result_repr
-
     flutter_frozen: FlutterResult | None = None
     parametric: ParametricResult | None = None
     lco: LcoResult | None = None
@@ -378,6 +388,16 @@ class RunResult:
             text += (f" Parametric ROM ({len(self.parametric.rom.speeds)} speeds): "
                      f"{pct(self.parametric_error)}.")
         return text
+
+    def skipped_notes(self) -> list[str]:
+        """The stages that did not run and why, one line per reason.
+
+        Returns
+        -------
+        list of str
+            ``skipped A, B (reason)``; empty when every stage ran.
+        """
+        return skipped_notes(self.skipped)
 
     # ------------------------------------------------------------------ verification
     @property
