@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._outputs import atomic_file
-from ...errors import ConfigError
+from ...errors import ConfigError, DataWarning
 
 
 def check_writable(path, flag: str) -> None:
@@ -109,7 +109,11 @@ def _main(args) -> int:
         raise ConfigError(f"--validation {args.validation}: give a fraction in (0, 1)")
     settings = dict(criterion=args.criterion, regularization=reg, offset=args.offset,
                     max_time=args.max_time)
-    data = _load(args)
+    with warnings.catch_warnings(record=True) as caught:   # said before the fit, not after
+        warnings.simplefilter("always", DataWarning)
+        data = _load(args)
+    for w in caught:
+        print(f"casflutter: warning: {w.message}", file=sys.stderr)
     selection = None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", IdentificationWarning)
