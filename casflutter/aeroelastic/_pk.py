@@ -127,7 +127,7 @@ class _PK:
                 QIk = Q.imag / k
         except DataError:
             raise DataError(
-                f"p-k: mode {mode} ({self.t.mode_names[mode]!r}) at U = {U:g} m/s needs "
+                f"p-k: mode {mode + 1} ({self.t.mode_names[mode]!r}) at U = {U:g} m/s needs "
                 f"k = {k:.4g}, outside the table's k = [{self.t.k[0]:g}, {self.t.k[-1]:g}]; "
                 "extend the table or track fewer modes (modes=...)") from None
         return Q.real, QIk
@@ -157,7 +157,7 @@ class _PK:
                 return s_cur, it
             k = k_new
         raise ConvergenceError(
-            f"p-k did not converge for mode {mode} ({self.t.mode_names[mode]!r}) at "
+            f"p-k did not converge for mode {mode + 1} ({self.t.mode_names[mode]!r}) at "
             f"U = {U:g} m/s after {self.max_iter} iterations (last k = {k:.6g}); use finer "
             "speed steps or raise max_iter")
 

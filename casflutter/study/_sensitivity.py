@@ -118,7 +118,7 @@ class FlutterSensitivity:
 
     def table(self) -> str:
         """Plain-text ranked table."""
-        lines = [f"{self.problem}: Vf = {self.Vf:.8g}, omega_f = {self.omega_f:.6g} "
+        lines = [f"{self.problem}: Vf = {self.Vf:.6g}, omega_f = {self.omega_f:.6g} "
                  f"({self.method})",
                  f"{'rank':>4}  {'parameter':<12} {'value':>11} {'dVf/dp':>13} "
                  f"{'normalised':>11}  {'domega/dp':>11}"]
