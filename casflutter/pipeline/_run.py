@@ -26,7 +26,8 @@ A wing file without a simulator (``[problem] name`` a ``kind = "wing"`` file: mo
 sensors and records, :class:`casflutter.truth.WingProblem`) runs the same stages on its records
 at its own ``V0``; the stages that need the truth (its flutter search, ``frozen``,
 ``parametric``, the truth's LCO, ``closed_loop``, ``suppression``) are skipped with a logged
-note and listed in ``RunResult.skipped``.
+note and listed in ``RunResult.skipped``.  So is ``lco`` when the configured ROM is linear
+(the common-denominator ROM, or HWL orders with p = q = 1): a linear model has no limit cycle.
 
 A wing file with frequency-domain aerodynamics (``kind = "gaf"``: modal data and ``Q(ik)``,
 :class:`casflutter.truth.GAFProblem`) replaces stages 1-5 by the rational-function
@@ -178,8 +179,8 @@ def _run_gaf(cfg: RunConfig, gaf: GAFProblem, settings: RFASettings, structure, 
                             max_refine=cfg.flutter.max_refine)
         pk = pk_flutter(gaf.table, structure, np.linspace(U_lo, U_hi, 29),
                         modes=_pk_modes(gaf, U_lo))
-    prog.note(f"RFA ΣAE(U): Uf = {fl_U.Vf if fl_U.Vf is not None else float('nan'):.5g} m/s, "
-              f"{fl_U.omega_f if fl_U.omega_f is not None else float('nan'):.5g} rad/s; p–k: "
+    prog.note("RFA ΣAE(U): " + (f"Uf = {fl_U.Vf:.5g} m/s, {fl_U.omega_f:.5g} rad/s"
+                                 if fl_U.Vf is not None else "no flutter") + "; p–k: "
               + (f"{pk.flutter_speed:.5g} m/s" if pk.found else "no flutter"))
     if fl_U.Vf is None:
         raise CasflutterError(f"the RFA system of {gaf.name!r} has no flutter crossing in "

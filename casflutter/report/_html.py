@@ -84,20 +84,20 @@ def flutter_speed_flags(summary: dict, threshold: float = VF_FLAG_FRACTION) -> l
         return []
     scale = _airspeed_scale(summary)
     out = []
-    for key, what in (("flutter", "the ROM's (the paper's route)"),
-                      ("flutter_parametric", "the parametric ROM's")):
+    for key, what in (("flutter", "The ROM's flutter speed (the paper's route)"),
+                      ("flutter_parametric", "The parametric ROM's flutter speed")):
         V = (summary.get(key) or {}).get("V")
         if V is None:
             continue
         rel = V / truth - 1.0
         if abs(rel) <= threshold:
             continue
-        side = ("above the truth's: unconservative (a clearance read off the ROM would admit "
-                "speeds at which the wing flutters)" if rel > 0 else
-                "below the truth's: conservative")
-        out.append(f"Flutter speed {what} {_with_airspeed(V, scale)} is "
-                   f"{100 * abs(rel):.3g} % {side}; truth {_with_airspeed(truth, scale)}. "
-                   f"Flagged when the difference exceeds {100 * threshold:g} %.")
+        side = ("above the truth's, {t}: unconservative, a clearance read off the ROM would "
+                "admit speeds at which the wing flutters" if rel > 0 else
+                "below the truth's, {t}: conservative")
+        out.append(f"{what}, V = {_with_airspeed(V, scale)}, is {100 * abs(rel):.3g} % "
+                   + side.format(t=_with_airspeed(truth, scale))
+                   + f" (flagged when the difference exceeds {100 * threshold:g} %).")
     return out
 
 

@@ -66,14 +66,14 @@ def test_a_rom_flutter_speed_off_the_truths_is_flagged_with_its_side():
 
     flags = flutter_speed_flags(SUMMARY)
     assert len(flags) == 1
-    assert "10.6 % above the truth's: unconservative" in flags[0]
+    assert "10.6 % above the truth's, 1.085: unconservative" in flags[0]
     assert f"{100 * VF_FLAG_FRACTION:g} %" in flags[0]
     assert '<li class="flag">' in html_report(SUMMARY, {})
     close = dict(SUMMARY, flutter={"V": 1.08499 * (1 + 0.5 * VF_FLAG_FRACTION)})
     assert flutter_speed_flags(close) == [] and "<h2>Flags</h2>" not in html_report(close, {})
     low = dict(SUMMARY, flutter={"V": 1.0}, flutter_parametric={"V": 1.2})
     texts = flutter_speed_flags(low)
-    assert "below the truth's: conservative" in texts[0] and "parametric" in texts[1]
+    assert "below the truth's, 1.085: conservative" in texts[0] and "parametric" in texts[1]
     assert flutter_speed_flags(dict(SUMMARY, flutter_truth=None)) == []
 
 
