@@ -394,7 +394,7 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
         V0 = float(Vf)
     fit = (ident.fit if isinstance(ident, IdentificationResult)
            else fit_report(model, data, "simulation"))
-    prog.note(f"{model}; fit error % " + ", ".join(f"{e:.3g}" for e in fit.error_percent))
+    prog.note(f"{model}; fit error % " + ", ".join(f"{e:.4g}" for e in fit.error_percent))
     rom_vf = f"ROM Vf = {Vf:.5g}" if Vf is not None else "ROM: no flutter in flutter.V_range"
     if flutter_truth is not None:   # no truth on a wing file: nothing to say of it
         rom_vf += (f"; truth Vf = {flutter_truth.Vf:.5g}" if flutter_truth.flutter is not None

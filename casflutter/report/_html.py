@@ -152,7 +152,7 @@ def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflu
     rows = "\n".join(f"<tr><td>{html.escape(k)}</td><td>{ours[k]}</td>"
                      f"<td>{truth.get(k, _fmt(None))}</td>"
                      f"<td>{html.escape(v)}</td></tr>" for k, v in PAPER_TABLE_I.items())
-    fit = ", ".join(sig(e, 3) for e in s.get("fit_error_percent") or [])
+    fit = ", ".join(sig(e, 4) for e in s.get("fit_error_percent") or [])
     imgs = []
     for name, path in figures.items():
         data = base64.b64encode(Path(path).read_bytes()).decode("ascii")

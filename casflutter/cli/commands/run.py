@@ -69,7 +69,7 @@ def _main(args) -> int:
         lines = [
             f"problem {s['problem']}: orders {tuple(s['orders'])}, {s['n_params']} parameters, "
             f"nf = {s['nf']}, ns = {s['ns']}, nae = {s['nae']}",
-            "ROM fit error per mode [%]: " + ", ".join(sig(e, 3)
+            "ROM fit error per mode [%]: " + ", ".join(sig(e, 4)
                                                        for e in s["fit_error_percent"])]
     else:                            # a GAF wing file: the RFA of Q(ik) in place of the ROM
         r = s["rfa"]
