@@ -36,7 +36,8 @@ def sig(x, digits: int = 5, *, none: str = "-") -> str:
     x : float, int, sequence of them, or None
         A number, or a pair / list of numbers (written ``(a, b)``).
     digits : int
-        Significant digits (4-6 on screen and in the report).
+        Significant digits (4-6 on screen and in the report); at least the integer part's
+        below 10^6 (no exponent for 11410).
     none : str
         What ``None`` becomes.
 
@@ -53,7 +54,11 @@ def sig(x, digits: int = 5, *, none: str = "-") -> str:
         return str(int(x))
     if isinstance(x, Real):
         x = float(x)
-        return str(x) if not math.isfinite(x) else f"{x:.{digits}g}"
+        if not math.isfinite(x):
+            return str(x)
+        if 1.0 <= abs(x) < 1e6:        # the integer part whole: 11410, not 1.141e+04
+            digits = max(digits, len(str(int(abs(x)))))
+        return f"{x:.{digits}g}"
     if isinstance(x, complex):
         return f"{x.real:.{digits}g}{x.imag:+.{digits}g}j"
     if isinstance(x, (list, tuple, np.ndarray)):
