@@ -52,13 +52,14 @@ def _airspeed_scale(s: dict) -> float | None:
 
 
 def _with_airspeed(V, scale: float | None) -> str:
-    """``1.2 (34.68 m/s)``: a speed index and, where the problem has a scale, its airspeed."""
+    """``1.2 (34.68 m/s)``, ``(0, 1.568) = (0, 45.31) m/s``: a speed index (or an interval of
+    them) and, where the problem has a scale, its airspeed."""
     if V is None:
         return "—"
     if scale is None:
         return _fmt(V)
     if isinstance(V, (list, tuple)):
-        return f"{_fmt(V)} ({_fmt([None if v is None else v * scale for v in V])} m/s)"
+        return f"{_fmt(V)} = {_fmt([None if v is None else v * scale for v in V])} m/s"
     return f"{_fmt(V)} ({_fmt(V * scale)} m/s)"
 
 

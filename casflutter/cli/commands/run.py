@@ -81,14 +81,16 @@ def _main(args) -> int:
                 lines.append(f"flutter ({label}): U = {sig(b['airspeed_m_s'])} m/s, "
                              f"{sig(b['omega_rad_s'])} rad/s, mode {b['mode']}")
     lines.append(f"speeds: V is the {s['units']['V']}")
+    hz = s["units"].get("freq_hz") or "Hz"     # cycles per time unit in nondimensional time
     if fl is not None:
         what = "ROM" if s["orders"] is not None else "ΣAE(V), Σf frozen at Uf"
-        lines.append(f"flutter ({what}):   {_speed(fl)}, {sig(fl['freq_hz'])} Hz, "
+        lines.append(f"flutter ({what}):   {_speed(fl)}, {sig(fl['freq_hz'])} {hz}, "
                      f"mode {fl['mode']}")
     if ft is not None:
-        lines.append(f"flutter (truth): {_speed(ft)}, {sig(ft['freq_hz'])} Hz, mode {ft['mode']}")
+        lines.append(f"flutter (truth): {_speed(ft)}, {sig(ft['freq_hz'])} {hz}, "
+                     f"mode {ft['mode']}")
     if s["lco"] is not None:
-        lines.append(f"LCO: {sig(s['lco']['freq_hz'])} Hz ({s['lco']['kind']})")
+        lines.append(f"LCO: {sig(s['lco']['freq_hz'])} {hz} ({s['lco']['kind']})")
     if s["controller"] is not None:
         lines += _controller_lines(s["controller"], res)
     if s["suppression"] is not None:
