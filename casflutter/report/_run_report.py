@@ -124,6 +124,7 @@ def write_figures(out: Path, result) -> dict:
             fig = plot_vg_vf(fl, branches=modes, hz=False, mode_names=names, speed_unit="m/s",
                              speed_label="airspeed U [m/s]")
             speed_axes(fig.axes[0], result.problem.U_ref, "speed index V = U / U_ref")
+            fig.tight_layout()
             files["vg_vf_airspeed"] = _save(fig, out / "vg_vf_airspeed.png")
         if result.flutter is not None:
             files["vg_vf"] = _save(plot_vg_vf(result.flutter, mode_names=names,
