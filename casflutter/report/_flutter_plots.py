@@ -194,7 +194,7 @@ def _last_cycles(t, X, freq_hz: float, cycles: int):
 
 def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | None = None,
              truth=None, labels=None, cycles: int = 6, title: str | None = None,
-             speed_scale: float = 1.0, speed_unit: str = "") -> Figure:
+             speed_scale: float = 1.0, speed_unit: str = "", time_unit: str = "s") -> Figure:
     """LCO time history and spectrum (paper Fig. 9).
 
     One row per channel and a spectrum row.  With the truth's response the ROM's is drawn
@@ -227,6 +227,8 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
         that unit beside the speed index (``V = 1.248 (36.07 m/s)``).
     speed_unit : str
         Unit of ``speed_scale`` (``"m/s"``; empty: the speed index alone).
+    time_unit : str
+        The problem's time unit: time in it, frequencies in cycles per it (Hz for seconds).
 
     Returns
     -------
@@ -244,6 +246,7 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
     if truth is not None and which == "sensors":
         pairs.append(("truth", truth.timepts, truth.zm, truth.analysis, truth.V))
     ncol = len(pairs)
+    hz = "Hz" if time_unit == "s" else f"cycles per {time_unit}"
     fig, axes = plt.subplots(len(chans) + 1, ncol, figsize=(5.2 * ncol + 1.2, 2.1 * len(chans) + 2.6),
                              squeeze=False, sharey="row")
     for col, (label, t, Z, a, V) in enumerate(pairs):
@@ -252,7 +255,7 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
         air = f" ({V * speed_scale:.4g} {speed_unit})" if speed_unit else ""
         head = f"{label} at V = {V:.4g}{air}: {a.kind if a is not None else ''}"
         if a is not None and a.kind == "lco":
-            head += f", {f:.3g} Hz"
+            head += f", {f:.3g} {hz}"
         axes[0, col].set_title(head, fontsize="medium")
         for row, j in enumerate(chans):
             ax = axes[row, col]
@@ -267,7 +270,8 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
                 ax.set_ylabel(names[row], fontsize="small")
             ax.grid(True, alpha=0.3)
         axes[len(chans) - 1, col].set_xlabel(
-            "time [s]" + (f" (last {cycles} periods)" if np.isfinite(f) and f > 0 else ""))
+            f"time [{time_unit}]" + (f" (last {cycles} periods)" if np.isfinite(f) and f > 0
+                                     else ""))
         afr = axes[len(chans), col]
         dom = a.dominant if a is not None else 0
         if a is not None and a.spectrum.size:
@@ -278,7 +282,7 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
                            and np.isfinite(an.frequency_hz) else None)
         if fmax:
             afr.set_xlim(0, fmax)
-        afr.set_xlabel("frequency [Hz]")
+        afr.set_xlabel(f"frequency [{hz}]")
         dom_name = names[chans.index(dom)] if dom in chans else f"{word} {dom + 1}"
         afr.set_ylabel("|FFT|", fontsize="small")
         afr.set_title(f"spectrum of {dom_name.split(' [')[0]}", fontsize="small")

@@ -153,7 +153,8 @@ def write_figures(out: Path, result) -> dict:
         pct = 100 * (result.config.lco.speed_factor - 1)
         files["fig9_lco"] = _save(plot_lco(
             lco.rom, truth=lco.truth, labels=labels,
-            title=f"Fig. 9: LCO of each model {pct:.3g} % above its own flutter speed", **air),
+            title=f"Fig. 9: LCO of each model {pct:.3g} % above its own flutter speed",
+            time_unit=st.time_unit, **air),
             out / "fig9_lco.png")
         if lco.truth_branch is not None and lco.rom_branch is not None:
             files["lco_branches"] = _save(plot_bifurcation_pair(lco.truth_branch,

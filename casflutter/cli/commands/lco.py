@@ -97,6 +97,8 @@ def run(args) -> int:
         try:
             branch = lco_branch(truth, vrange, settings, problem=label)
         except ConfigError as exc:
+            if "degenerate" not in str(exc):
+                raise
             raise ConfigError(f"{exc}{_nonlinearity_hint(truth, args.problem)}") from None
     doc = branch.to_dict()
     fig_path = args.figure if args.figure and args.figure.lower() != "none" else None
@@ -112,7 +114,8 @@ def run(args) -> int:
         print_json(doc)
         return 0 if branch.completed else 3
     h = doc["hopf"]
-    vunit = doc["units"]["V"] if doc["units"]["V"] == "m/s" else f"(speed index {doc['units']['V']})"
+    vunit = (doc["units"]["V"] if doc["units"]["V"] == "m/s"
+             else f"(speed index {doc['units']['V']})")
     funit = "Hz" if branch.time_unit == "s" else f"cycles per time unit {branch.time_unit}"
     print(f"{label}: {doc['kind']} {'Neimark-Sacker' if branch.hopf.discrete else 'Hopf'} point "
           f"at V = {h['V']:.6g} {vunit}, {h['freq_hz']:.5g} {funit}")
