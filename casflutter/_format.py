@@ -116,7 +116,7 @@ def short_value(v) -> str:
         Numbers with 6 significant digits, arrays by shape and range, systems by their
         dimensions, nested results by their scalar fields, long sequences by their length.
     """
-    if v is None or isinstance(v, (bool, Integral)):
+    if v is None or isinstance(v, (bool, np.bool_, Integral)):
         return repr(v) if not isinstance(v, np.generic) else repr(v.item())
     if isinstance(v, (Real, complex)):
         return sig(v, 6)
