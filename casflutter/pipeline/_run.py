@@ -214,8 +214,8 @@ def _wing_setup(cfg: RunConfig, wing: WingProblem) -> tuple[RunConfig, dict]:
                           "set rom.v0_iterations = 1")
     _same_sensors(cfg, wing)
     why = f"needs a truth simulator; the wing file {wing.name!r} has records only"
-    wanted = {"flutter_truth"} | set(cfg.stages) | ({"truth_lco"} if "lco" in cfg.stages
-                                                     else set())
+    lco = "lco" in cfg.stages and not _linear_rom_skips(cfg)     # (else no LCO stage at all)
+    wanted = {"flutter_truth"} | set(cfg.stages) | ({"truth_lco"} if lco else set())
     skipped = {k: f"{v}: {why}" for k, v in _TRUTH_ONLY.items() if k in wanted}
     _log_skipped(skipped)
     return replace(cfg, data=replace(cfg.data, V0=float(wing.V0))), skipped

@@ -71,8 +71,9 @@ def test_lco_stage_on_a_linear_rom_is_skipped_with_its_reason(caplog):
         r = run(cfg, quiet=True, write=False)
     assert r.lco is None and "lco" in r.skipped
     assert "linear" in r.skipped["lco"] and 'rom.method = "hwl"' in r.skipped["lco"]
-    notes = [m for m in caplog.messages if "stage 'lco'" in m]
-    assert len(notes) == 1 and "linear" in notes[0]
+    notes = [m for m in caplog.messages if "lco" in m]
+    assert len(notes) == 1 and "linear" in notes[0] and "has no limit cycle" in notes[0]
+    assert "truth_lco" not in r.skipped              # the whole stage, said once
 
 
 def test_goland_gaf_flutter_through_the_cli_within_one_percent_of_published(capsys):
