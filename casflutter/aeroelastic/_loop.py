@@ -30,6 +30,7 @@ from .._format import result_repr
 from .._linalg import spectral_abscissa
 from ..errors import ConfigError, DimensionError
 from ..structure import ModalStructure
+from ._family import FamilySignals, PlantFamily
 
 __all__ = ["AeroelasticSystem", "AeroelasticLoop", "LoopFamily", "ParametricSystem",
            "ServoSystem", "aeroelastic_loop", "check_servo",
@@ -263,15 +264,62 @@ def check_servo(omega: float, zeta: float, names: tuple = ("servo omega", "zeta"
         raise ConfigError(f"{names[0]} = {omega!r} must be > 0 and {names[1]} = {zeta!r} >= 0")
 
 
-class LoopFamily:
-    """A linear aeroelastic loop at every speed index: the interface that the flutter
-    analysis, the interval design (:func:`casflutter.design.stabilize_interval`,
-    :func:`casflutter.design.reduce_order`) and the verification
-    (:func:`casflutter.verify.speed_family_interval` on ``loop(V).flap_to_sensors()``) take.
+class LoopFamily(PlantFamily):
+    """A linear aeroelastic loop with one flap at every speed index: the
+    :class:`~casflutter.aeroelastic.PlantFamily` of the paper's ΣAE(V) (eq. 8-9).
 
-    A family defines :meth:`loop`; the state matrices follow from it (a family may compute
-    :meth:`state_matrix` more directly).
+    Its plant has the modal disturbances ``w[0] .. w[N-1]`` and the flap ``v`` (or the
+    servo's command) as inputs and the sensors ``zm`` (named after the structure's sensors)
+    as outputs; a controller closes ``v = K zm`` (positive feedback, paper Fig. 3).  A family
+    defines :meth:`loop` and :meth:`modal_structure`; the state matrices follow from
+    :meth:`loop` (a family may compute :meth:`state_matrix` more directly).
     """
+
+    speed_degree = 2    # strip theory: the lags scale with V, the forces with V²
+
+    @property
+    def name(self) -> str:
+        """The class name (for messages)."""
+        return type(self).__name__
+
+    def modal_structure(self) -> ModalStructure:
+        """Σs: the modes, the sensors (their rows, kind and names) and the units.
+
+        Returns
+        -------
+        ModalStructure
+        """
+        raise NotImplementedError
+
+    @property
+    def time_unit(self) -> str:
+        """The structure's unit of time."""
+        return str(self.modal_structure().time_unit)
+
+    @property
+    def signals(self) -> FamilySignals:
+        """Inputs ``w[0] .. w[N-1]`` (disturbances) and ``v`` (the control), outputs the
+        sensors (the measurements)."""
+        s = self.modal_structure()
+        return FamilySignals([f"w[{i}]" for i in range(s.n_modes)] + ["v"],
+                             list(s.sensor_names), controls=("v",),
+                             input_units=("",) * s.n_modes + ("rad",))
+
+    def plant(self, V: float) -> control.StateSpace:
+        """The loop at V as a named plant (:meth:`AeroelasticLoop.statespace`).
+
+        Parameters
+        ----------
+        V : float
+            Speed index.
+
+        Returns
+        -------
+        control.StateSpace
+        """
+        P, sig = self.loop(float(V)).statespace(), self.signals
+        return control.ss(P.A, P.B, P.C, P.D, inputs=list(sig.inputs),
+                          outputs=list(sig.outputs))
 
     def loop(self, V: float) -> AeroelasticLoop:
         """The loop at speed index V.
@@ -500,6 +548,15 @@ class AeroelasticSystem(LoopFamily):
         bot = np.hstack([r * self.Bf @ Cs, r * self.Af])
         return np.vstack([top, bot])
 
+    def modal_structure(self) -> ModalStructure:
+        """Σs (the attribute ``structure``).
+
+        Returns
+        -------
+        ModalStructure
+        """
+        return self.structure
+
     def with_servo(self, omega: float, zeta: float = 0.7) -> "ServoSystem":
         """ΣAE(V) with the flap behind a second-order servo at every speed (what a wind-tunnel
         model has, and :class:`~casflutter.aeroelastic.TruthLoop` puts in front of the truth).
@@ -590,12 +647,22 @@ class ParametricSystem(LoopFamily):
 
     rom: object
     structure: ModalStructure
+    speed_degree = None    # Σf interpolated between the ROMs' speeds
 
     def __post_init__(self):
         N = self.rom.n_modes
         if N != self.structure.n_modes:
             raise DimensionError(f"the ROMs have {N} outputs but Σs has "
                                  f"{self.structure.n_modes} modes; they must be equal")
+
+    def modal_structure(self) -> ModalStructure:
+        """Σs (the attribute ``structure``).
+
+        Returns
+        -------
+        ModalStructure
+        """
+        return self.structure
 
     def system_at(self, V: float) -> AeroelasticSystem:
         """ΣAE with Σf of the interpolated ROM at V (control.StateSpace route).
@@ -678,6 +745,20 @@ class ServoSystem(LoopFamily):
 
     def __post_init__(self):
         check_servo(self.servo_omega, self.servo_zeta, ("servo_omega", "servo_zeta"))
+
+    def modal_structure(self) -> ModalStructure:
+        """Σs of the family behind the servo.
+
+        Returns
+        -------
+        ModalStructure
+        """
+        return self.system.modal_structure()
+
+    @property
+    def speed_degree(self) -> int | None:
+        """The degree in V of the family behind the servo (the servo does not depend on V)."""
+        return self.system.speed_degree
 
     def loop(self, V: float) -> AeroelasticLoop:
         """The family's loop at speed index V, flap behind the servo.

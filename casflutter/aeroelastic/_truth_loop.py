@@ -78,6 +78,15 @@ class TruthLoop(LoopFamily):
         """N."""
         return self.truth.n_modes
 
+    def modal_structure(self) -> ModalStructure:
+        """The sensors' structure (``sensors``, or the truth's own).
+
+        Returns
+        -------
+        ModalStructure
+        """
+        return self.sensors if self.sensors is not None else self.truth.modal_structure()
+
     def loop(self, V: float) -> AeroelasticLoop:
         """The linear loop at speed index V.
 
@@ -95,7 +104,7 @@ class TruthLoop(LoopFamily):
                                   actuator_zeta=self.servo_zeta)
         A, B = np.asarray(P.A, float), np.asarray(P.B, float)
         N = self.n_modes
-        s = self.sensors if self.sensors is not None else self.truth.modal_structure()
+        s = self.modal_structure()
         nx = A.shape[0]
         if s.sensor == "state":
             C2, D2 = np.hstack([s.Hs, np.zeros((s.n_sensors, nx - 2 * N))]), np.zeros_like(B)

@@ -22,11 +22,12 @@ import struct
 import zlib
 from pathlib import Path
 
+import numpy as np
 from scipy.io import loadmat
 
 from ..errors import DataError
 
-__all__ = ["read_mat", "check_mat5_layout"]
+__all__ = ["read_mat", "check_mat5_layout", "mat_strings"]
 
 _MI_MATRIX, _MI_COMPRESSED = 14, 15
 #: numeric/text data types and their item sizes (miINT8 ... miUTF32)
@@ -236,3 +237,34 @@ def read_mat(path) -> dict:
     except Exception as exc:  # noqa: BLE001 - any failure to parse the file is bad data
         raise DataError(f"{path}: cannot be read as a MAT-file ({type(exc).__name__}: {exc}); "
                         f"the file may be truncated or not a MAT-file -- {_FIX}") from None
+
+
+def mat_strings(arr, what: str = "names") -> tuple[str, ...]:
+    """Strings from what :func:`read_mat` returns for a cell array of strings or a char matrix.
+
+    Parameters
+    ----------
+    arr : array_like
+        A ``loadmat`` cell array (object array of char arrays) or char matrix (one string
+        per row).
+    what : str
+        The variable's name, for the message.
+
+    Returns
+    -------
+    tuple of str
+        Stripped of surrounding blanks (a char matrix pads its rows).
+
+    Raises
+    ------
+    DataError
+        Anything else (numbers, structs).
+    """
+    a = np.asarray(arr)
+    if a.dtype == object:
+        return tuple(str(np.asarray(x).ravel()[0]).strip() if np.asarray(x).size else ""
+                     for x in a.ravel())
+    if a.dtype.kind == "U":
+        return tuple(str(s).strip() for s in a.ravel())
+    raise DataError(f"{what} must be a cell array of strings or a char matrix, got "
+                    f"dtype {a.dtype}")

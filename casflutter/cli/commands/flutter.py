@@ -10,6 +10,10 @@ On a GAF wing file (``kind = "gaf"``: modal data and ``Q(ik)``, e.g. ``problems/
 the route is the rational-function approximation instead: the driver with no optional stage
 fits the RFA, finds the flutter of ΣAE(U) in m/s and rad/s and solves p–k on the same table;
 both are printed side by side with the published reference of the file, if any.
+
+On a plant family file (``kind = "plant_family"``: state-space models at a grid of speeds,
+e.g. ``problems/goland_4flaps``) the route is :mod:`._flutter_family`: every open-loop
+crossing of the interpolated grid, in the family's units.
 """
 
 from __future__ import annotations
@@ -33,8 +37,10 @@ def register(subparsers) -> None:
                     "in the problem's unit (speed index for the typical section, m/s for the "
                     "Goland wing).")
     p.add_argument("problem", help="problem name (see `casflutter problems`), rig TOML file, "
-                                   "or GAF wing file (kind = \"gaf\", e.g. "
-                                   "problems/goland_gaf: RFA flutter in m/s with p-k)")
+                                   "GAF wing file (kind = \"gaf\", e.g. "
+                                   "problems/goland_gaf: RFA flutter in m/s with p-k), or "
+                                   "plant family file (kind = \"plant_family\", e.g. "
+                                   "problems/goland_4flaps: every crossing of the grid)")
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="NAME=VALUE",
                    help="change a problem parameter (repeatable)")
     p.add_argument("--vrange", nargs=2, type=float, metavar=("LO", "HI"), default=None,
@@ -290,9 +296,10 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
 
 def run(args) -> int:
     """Handler: run the route, print or write JSON, save the figure."""
-    from ...pipeline import flutter_config, run as run_config
+    from ...data import FamilyFile
     from ...errors import ConfigError
     from ...truth import GAFProblem, WingProblem, load_problem, parse_sets, problem_label
+    from ._flutter_family import run_family
 
     fig_path = None                  # figures only where asked, checked before the work
     if args.figure is not None and args.figure.lower() != "none":
@@ -300,6 +307,8 @@ def run(args) -> int:
     changes = parse_sets(args.sets)
     truth = load_problem(args.problem, changes)
     label = problem_label(args.problem)
+    if isinstance(truth, FamilyFile):
+        return run_family(args, truth, label, fig_path)
     if isinstance(truth, GAFProblem):
         return _run_gaf(args, truth, label, fig_path)
     if isinstance(truth, WingProblem):
@@ -307,6 +316,8 @@ def run(args) -> int:
                           "its flutter speed comes from `casflutter run` with a run "
                           "configuration whose [problem] name is the file (e.g. "
                           "problems/example_wing/run.toml, stages = [] for flutter only)")
+    from ...pipeline import flutter_config, run as run_config
+
     label = problem_label(args.problem)
     _, from_unit, vunit = _speed_conv(truth)
     updates = {"problem.set": changes}

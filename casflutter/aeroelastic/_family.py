@@ -1,0 +1,475 @@
+"""Plant families: a linear plant at every speed of a range, the one concept every analysis takes.
+
+The paper's loop ΣAE(V) (eq. 8-9) is one plant per speed index, with the modal disturbances
+``w`` and the flap ``v`` as inputs and the sensors ``zm`` as outputs.  An aircraft's
+aeroservoelastic model is the same thing in another form: linear state-space models at a grid
+of flight speeds, several control surfaces and sensors.  :class:`PlantFamily` is what both
+are to the analyses (flutter, verification, design, exports):
+
+* :meth:`PlantFamily.plant` — the plant at a speed, a ``control.StateSpace`` whose inputs and
+  outputs are named (:class:`FamilySignals`);
+* the roles of the signals: which inputs a controller drives (``controls``, the rest are
+  disturbances) and which outputs it reads (``measurements``);
+* the speed range, the units of speed and time, and the sign convention with which a
+  controller is applied (``feedback``: ``"positive"``, ``u = +K y``, the paper's ``v = K zm``;
+  ``"negative"``, ``u = −K y``, MATLAB's ``feedback(P, K)``);
+* what the family offers an exact analysis: ``speed_degree``, the degree in V of the plant's
+  matrices between the ``breakpoints`` (2 for strip theory's ΣAE(V), 1 between the grid
+  speeds of a linearly interpolated grid, ``None`` when unknown).
+
+A family is asked for what it offers, never for its class: the analyses read these
+attributes and call :meth:`PlantFamily.plant`.
+"""
+
+from __future__ import annotations
+
+import abc
+import difflib
+import math
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+from ..data import check_grid_speeds, check_stack
+from ..errors import ConfigError, DimensionError
+
+__all__ = ["FEEDBACK_SIGNS", "FamilySignals", "PlantFamily", "GriddedFamily"]
+
+#: The sign ``s`` of ``u = s K y`` for each feedback convention.
+FEEDBACK_SIGNS = {"positive": 1.0, "negative": -1.0}
+
+
+def _names(what: str, names) -> tuple[str, ...]:
+    out = tuple(str(n) for n in names)
+    dup = sorted({n for n in out if out.count(n) > 1})
+    if dup:
+        raise ConfigError(f"{what}: the names {dup} appear more than once; every signal "
+                          "needs its own name")
+    if any(not n.strip() for n in out):
+        raise ConfigError(f"{what}: an empty name; every signal needs a name")
+    return out
+
+
+def _subset(what: str, names: tuple, pool: tuple, pool_what: str) -> None:
+    unknown = [n for n in names if n not in pool]
+    if unknown:
+        hints = {n: difflib.get_close_matches(n, pool, 1) for n in unknown}
+        hint = "; ".join(f"{n!r}: did you mean {h[0]!r}?" for n, h in hints.items() if h)
+        raise ConfigError(f"{what}: {unknown} are not among the {pool_what} {list(pool)}"
+                          + (f" ({hint})" if hint else ""))
+
+
+@dataclass(frozen=True)
+class FamilySignals:
+    """Names, roles and units of a family's inputs and outputs.
+
+    Parameters
+    ----------
+    inputs, outputs : sequence of str
+        Every input and output of the plant, in the plant's order (unique names).
+    controls : sequence of str, optional
+        The inputs a controller drives (control surfaces, or their servo commands); default
+        all inputs.  The other inputs are disturbances.
+    measurements : sequence of str, optional
+        The outputs a controller reads (sensors); default all outputs.
+    input_units, output_units : sequence of str, optional
+        A unit per input and output (``""`` where unknown; default all unknown).
+
+    Raises
+    ------
+    ConfigError
+        Repeated or empty names, roles naming signals the plant does not have, units of the
+        wrong length, or no control input or no measurement.
+    """
+
+    inputs: tuple
+    outputs: tuple
+    controls: tuple | None = None
+    measurements: tuple | None = None
+    input_units: tuple = ()
+    output_units: tuple = ()
+
+    def __post_init__(self):
+        inputs, outputs = _names("inputs", self.inputs), _names("outputs", self.outputs)
+        controls = inputs if self.controls is None else _names("controls", self.controls)
+        measurements = (outputs if self.measurements is None
+                        else _names("measurements", self.measurements))
+        _subset("controls", controls, inputs, "inputs")
+        _subset("measurements", measurements, outputs, "outputs")
+        if not controls or not measurements:
+            raise ConfigError("a plant family needs at least one control input and one "
+                              f"measurement; got controls {list(controls)} and measurements "
+                              f"{list(measurements)}")
+        units = {}
+        for what, given, names in (("input_units", self.input_units, inputs),
+                                   ("output_units", self.output_units, outputs)):
+            given = tuple(str(u) for u in given)
+            if given and len(given) != len(names):
+                raise ConfigError(f"{what} has {len(given)} entries for {len(names)} "
+                                  "signals; give one unit per signal (\"\" where unknown)")
+            units[what] = given or ("",) * len(names)
+        for name, value in (("inputs", inputs), ("outputs", outputs), ("controls", controls),
+                            ("measurements", measurements), *units.items()):
+            object.__setattr__(self, name, value)
+
+    def __repr__(self) -> str:
+        return (f"FamilySignals(controls={list(self.controls)}, "
+                f"disturbances={list(self.disturbances)}, "
+                f"measurements={list(self.measurements)}, "
+                f"other outputs={[o for o in self.outputs if o not in self.measurements]})")
+
+    @property
+    def disturbances(self) -> tuple[str, ...]:
+        """The inputs that are not controls."""
+        return tuple(n for n in self.inputs if n not in self.controls)
+
+    def input_index(self, names=None) -> list[int]:
+        """Positions of inputs in the plant (default: the controls).
+
+        Parameters
+        ----------
+        names : sequence of str, optional
+            Input names.
+
+        Returns
+        -------
+        list of int
+
+        Raises
+        ------
+        ConfigError
+            A name the plant does not have (with the closest one).
+        """
+        names = self.controls if names is None else tuple(names)
+        _subset("inputs asked for", names, self.inputs, "inputs")
+        return [self.inputs.index(n) for n in names]
+
+    def output_index(self, names=None) -> list[int]:
+        """Positions of outputs in the plant (default: the measurements).
+
+        Parameters
+        ----------
+        names : sequence of str, optional
+            Output names.
+
+        Returns
+        -------
+        list of int
+
+        Raises
+        ------
+        ConfigError
+            A name the plant does not have (with the closest one).
+        """
+        names = self.measurements if names is None else tuple(names)
+        _subset("outputs asked for", names, self.outputs, "outputs")
+        return [self.outputs.index(n) for n in names]
+
+
+class PlantFamily(abc.ABC):
+    """A linear plant ``P(V)`` at every speed ``V`` of a range (module docstring).
+
+    A subclass defines :meth:`plant` and :attr:`signals`; it sets the class attributes below
+    where the defaults do not hold (a frozen dataclass may make any of them a field).
+
+    Attributes
+    ----------
+    speed_range : tuple of float
+        ``(lo, hi)``: the speeds at which :meth:`plant` is defined (``hi`` may be ``inf``).
+    speed_unit : str
+        Unit of V (``"speed index"`` for a problem's nondimensional speed, ``"m/s"``, ...).
+    time_unit : str
+        Unit of time of the plant (its frequencies are in rad per this unit).
+    feedback : str
+        How a controller ``K`` of this family is applied: ``"positive"`` (``u = +K y``, the
+        paper's ``v = K zm``) or ``"negative"`` (``u = −K y``).
+    speed_degree : int or None
+        The plant's matrices are polynomials of this degree in V on each piece between
+        :attr:`breakpoints` (``None``: not known to be polynomial).
+    breakpoints : tuple of float
+        Interior speeds where the polynomial pieces meet (``()``: one piece).
+    name : str
+        A name for messages and reports.
+    """
+
+    speed_range: tuple = (0.0, math.inf)
+    speed_unit: str = "speed index"
+    time_unit: str = "s"
+    feedback: str = "positive"
+    speed_degree: int | None = None
+    breakpoints: tuple = ()
+    name: str = "plant family"
+
+    @property
+    @abc.abstractmethod
+    def signals(self) -> FamilySignals:
+        """Names, roles and units of the plant's inputs and outputs."""
+
+    @abc.abstractmethod
+    def plant(self, V: float) -> control.StateSpace:
+        """The linear plant at speed V.
+
+        Parameters
+        ----------
+        V : float
+            Speed, in :attr:`speed_unit`, inside :attr:`speed_range`.
+
+        Returns
+        -------
+        control.StateSpace
+            Continuous, inputs and outputs in the order and with the names of
+            :attr:`signals`; the same states at every speed.
+        """
+
+    # ----------------------------------------------------------------- derived from plant()
+    @property
+    def feedback_sign(self) -> float:
+        """``+1`` or ``−1``: ``u = feedback_sign · K y``."""
+        return FEEDBACK_SIGNS[self.feedback]
+
+    def state_matrix(self, V: float) -> np.ndarray:
+        """The open-loop state matrix at V (what flutter tracking follows).
+
+        Parameters
+        ----------
+        V : float
+            Speed.
+
+        Returns
+        -------
+        ndarray
+        """
+        return np.asarray(self.plant(V).A, dtype=float)
+
+    def control_plant(self, V: float, controls=None, measurements=None) -> control.StateSpace:
+        """The plant at V from (some of) the controls to (some of) the measurements.
+
+        Parameters
+        ----------
+        V : float
+            Speed.
+        controls, measurements : sequence of str, optional
+            Names (default: all controls, all measurements), in the order wanted.
+
+        Returns
+        -------
+        control.StateSpace
+            Named inputs and outputs.
+        """
+        sig = self.signals
+        controls = sig.controls if controls is None else tuple(controls)
+        measurements = sig.measurements if measurements is None else tuple(measurements)
+        i, o = sig.input_index(controls), sig.output_index(measurements)
+        P = self.plant(V)
+        A, B, C, D = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (P.A, P.B, P.C, P.D))
+        return control.ss(A, B[:, i], C[o, :], D[np.ix_(o, i)], inputs=list(controls),
+                          outputs=list(measurements))
+
+    def check_speed(self, V: float, what: str = "V") -> float:
+        """``V`` as a float, or an error naming the range.
+
+        Parameters
+        ----------
+        V : float
+            A speed.
+        what : str
+            Its name in the message.
+
+        Returns
+        -------
+        float
+
+        Raises
+        ------
+        ConfigError
+            ``V`` not a finite number inside :attr:`speed_range`.
+        """
+        lo, hi = self.speed_range
+        try:
+            v = float(V)
+        except (TypeError, ValueError):
+            raise ConfigError(f"{what} = {V!r} is not a number") from None
+        tol = 1e-12 * max(1.0, abs(lo), abs(hi) if math.isfinite(hi) else 1.0)
+        if not (math.isfinite(v) and lo - tol <= v <= hi + tol):
+            raise ConfigError(f"{what} = {V!r} {self.speed_unit} is outside the range "
+                              f"[{lo:g}, {hi:g}] of {self.name}")
+        return min(max(v, lo), hi)
+
+    def speed_grid(self, n: int, lo: float | None = None, hi: float | None = None
+                   ) -> np.ndarray:
+        """``n`` evenly spaced speeds of ``[lo, hi]`` (default the range), with the
+        breakpoints inside it added.
+
+        Parameters
+        ----------
+        n : int
+            Number of evenly spaced speeds (>= 2).
+        lo, hi : float, optional
+            Ends (default :attr:`speed_range`; a finite ``hi`` is needed).
+
+        Returns
+        -------
+        ndarray
+            Sorted, unique.
+        """
+        lo = self.speed_range[0] if lo is None else self.check_speed(lo, "lo")
+        hi = self.speed_range[1] if hi is None else self.check_speed(hi, "hi")
+        if not (math.isfinite(hi) and hi > lo and int(n) >= 2):
+            raise ConfigError(f"a speed grid needs lo < hi (finite) and n >= 2; got "
+                              f"[{lo}, {hi}], n = {n}")
+        inner = [b for b in self.breakpoints if lo < b < hi]
+        return np.unique(np.concatenate([np.linspace(lo, hi, int(n)), inner]))
+
+    @property
+    def n_states(self) -> int:
+        """Number of states (the same at every speed)."""
+        lo, hi = self.speed_range
+        return int(self.plant(0.5 * (lo + hi) if math.isfinite(hi) else max(lo, 1.0)).nstates)
+
+    def describe(self) -> str:
+        """One paragraph: the name, range, states and signals.
+
+        Returns
+        -------
+        str
+        """
+        s, (lo, hi) = self.signals, self.speed_range
+        return (f"{self.name}: {self.n_states} states, speeds [{lo:g}, {hi:g}] "
+                f"{self.speed_unit}, time in {self.time_unit}, {self.feedback} feedback; "
+                f"controls {list(s.controls)}, measurements {list(s.measurements)}"
+                + (f", disturbances {list(s.disturbances)}" if s.disturbances else ""))
+
+
+class GriddedFamily(PlantFamily):
+    """A plant family given at a grid of speeds, linearly interpolated between them.
+
+    The state-space matrices are interpolated elementwise between neighbouring grid speeds,
+    so on each interval between grid speeds the plant is affine in V
+    (``speed_degree = 1``, the grid speeds are the breakpoints): a closed loop's exact
+    stable interval can be certified piece by piece.  The states must mean the same thing at
+    every grid speed (the same realisation), as they do in a model exported on a grid of
+    flight conditions.
+
+    Parameters
+    ----------
+    speeds : array_like, shape (k,)
+        Grid speeds, strictly increasing, k >= 2.
+    A, B, C, D : array_like
+        Shapes ``(k, n, n)``, ``(k, n, m)``, ``(k, p, n)``, ``(k, p, m)``.
+    signals : FamilySignals, optional
+        Names, roles and units (default: inputs ``u1..um``, all controls; outputs
+        ``y1..yp``, all measurements).
+    speed_unit, time_unit, feedback, name : str
+        As :class:`PlantFamily`.
+
+    Raises
+    ------
+    DimensionError
+        Arrays that are ragged, not finite, or of inconsistent sizes (named).
+    ConfigError
+        Speeds not strictly increasing or not finite, an unknown feedback convention, or
+        signals that do not match the sizes.
+    """
+
+    speed_degree = 1
+
+    def __init__(self, speeds, A, B, C, D, signals: FamilySignals | None = None, *,
+                 speed_unit: str = "m/s", time_unit: str = "s", feedback: str = "negative",
+                 name: str = "gridded plant family"):
+        v = check_grid_speeds(speeds)
+        k = v.size
+        A = check_stack("A", A, k, None, None)
+        n = A.shape[1]
+        if A.shape[2] != n:
+            raise DimensionError(f"A has shape {A.shape}; each A must be square (n, n)")
+        B = check_stack("B", B, k, n, None)
+        C = check_stack("C", C, k, None, n)
+        D = check_stack("D", D, k, C.shape[1], B.shape[2])
+        m, p = B.shape[2], C.shape[1]
+        if signals is None:
+            signals = FamilySignals([f"u{i + 1}" for i in range(m)],
+                                    [f"y{j + 1}" for j in range(p)])
+        if len(signals.inputs) != m or len(signals.outputs) != p:
+            raise ConfigError(f"the signals name {len(signals.inputs)} inputs and "
+                              f"{len(signals.outputs)} outputs, the arrays have {m} inputs "
+                              f"(B, D) and {p} outputs (C, D)")
+        if feedback not in FEEDBACK_SIGNS:
+            raise ConfigError(f"feedback = {feedback!r}: 'negative' (u = -K y, MATLAB's "
+                              "feedback()) or 'positive' (u = +K y, the paper's v = K zm)")
+        self.speeds, self._mats, self._signals = v, (A, B, C, D), signals
+        self.speed_unit, self.time_unit = str(speed_unit), str(time_unit)
+        self.feedback, self.name = feedback, str(name)
+        self.speed_range = (float(v[0]), float(v[-1]))
+        self.breakpoints = tuple(float(x) for x in v[1:-1])
+
+    @property
+    def signals(self) -> FamilySignals:
+        """Names, roles and units of the plant's inputs and outputs."""
+        return self._signals
+
+    @property
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(A, B, C, D)`` stacked over the grid (copies)."""
+        return tuple(M.copy() for M in self._mats)
+
+    def _weights(self, V: float) -> tuple[int, float]:
+        v = self.check_speed(V)
+        j = int(min(max(np.searchsorted(self.speeds, v, side="right") - 1, 0),
+                    self.speeds.size - 2))
+        return j, (v - self.speeds[j]) / (self.speeds[j + 1] - self.speeds[j])
+
+    def matrices(self, V: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(A, B, C, D)`` at V, interpolated elementwise.
+
+        Parameters
+        ----------
+        V : float
+            Speed inside the grid's range.
+
+        Returns
+        -------
+        tuple of ndarray
+        """
+        j, t = self._weights(V)
+        return tuple((1.0 - t) * M[j] + t * M[j + 1] for M in self._mats)
+
+    def plant(self, V: float) -> control.StateSpace:
+        """The plant at V (interpolated; see the class docstring).
+
+        Parameters
+        ----------
+        V : float
+            Speed inside the grid's range.
+
+        Returns
+        -------
+        control.StateSpace
+        """
+        s = self.signals
+        return control.ss(*self.matrices(V), inputs=list(s.inputs), outputs=list(s.outputs))
+
+    def state_matrix(self, V: float) -> np.ndarray:
+        """A at V (interpolated).
+
+        Parameters
+        ----------
+        V : float
+            Speed inside the grid's range.
+
+        Returns
+        -------
+        ndarray
+        """
+        return self.matrices(V)[0]
+
+    @property
+    def n_states(self) -> int:
+        """Number of states."""
+        return int(self._mats[0].shape[1])
+
+    def __repr__(self) -> str:
+        s = self.signals
+        return (f"GriddedFamily({self.name!r}: {self.n_states} states, "
+                f"{len(s.inputs)} inputs, {len(s.outputs)} outputs, {self.speeds.size} speeds "
+                f"[{self.speed_range[0]:g}, {self.speed_range[1]:g}] {self.speed_unit})")
