@@ -26,7 +26,7 @@ Brent's method on ``U -> Re s(U)``.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import brentq
@@ -112,7 +112,8 @@ class _PK:
 
     def __init__(self, table: GAFTable, structure: ModalStructure, U_ref: float,
                  tol: float, max_iter: int):
-        self.t, self.s, self.U_ref = table, structure, U_ref
+        self.t, self.s = table, structure
+        self.speed = replace(structure.speed, U_ref=U_ref)   # V = U / U_ref
         self.N = structure.n_modes
         self.tol, self.max_iter = tol, max_iter
         self.dk0 = 1e-9 * max(float(table.k[-1]), 1.0)
@@ -135,7 +136,7 @@ class _PK:
     def roots(self, U: float, k: float, mode: int) -> np.ndarray:
         """All roots ``s`` of the real quadratic problem at ``(U, k)``."""
         s, N = self.s, self.N
-        q = s.alpha * (U / self.U_ref) ** 2
+        q = s.alpha * self.speed.speed_index(U) ** 2
         QR, QIk = self._QR_QIk(k, mode, U)
         K = np.diag(s.omega ** 2) - q * QR
         C = np.diag(2.0 * s.zeta * s.omega) - q * (self.t.b / U) * QIk

@@ -252,8 +252,8 @@ class GAFTable:
         Parameters
         ----------
         truth : object
-            Has ``generalized_aero_forces(k, theodorsen=...)``, ``params.b``, ``params.rho``,
-            ``airspeed(V)`` and ``modal_structure().mode_names``.
+            Has ``generalized_aero_forces(k, theodorsen=...)``, ``params.b`` and
+            ``modal_structure()`` (its mode names and speed convention: ``U_ref``, ``rho``).
         k : array_like
             Reduced frequencies.
         theodorsen : {"exact", "jones"}
@@ -264,9 +264,9 @@ class GAFTable:
         GAFTable
         """
         Q = truth.generalized_aero_forces(k, theodorsen=theodorsen)
-        return cls(np.asarray(k, float), Q, truth.params.b, U_ref=truth.airspeed(1.0),
-                   rho=getattr(truth.params, "rho", None),
-                   mode_names=truth.modal_structure().mode_names,
+        structure = truth.modal_structure()
+        return cls(np.asarray(k, float), Q, truth.params.b, U_ref=structure.speed.U_ref,
+                   rho=structure.speed.rho, mode_names=structure.mode_names,
                    source=f"{type(truth).__name__} strip theory, {theodorsen} Theodorsen C(k)")
 
     @classmethod

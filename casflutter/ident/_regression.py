@@ -23,7 +23,8 @@ import numpy as np
 from .._format import result_repr
 from ..data import IOData
 from ..errors import DataError
-from ._model import HWLModel, HWLStructure
+from ._model import HWLModel
+from ._structure import HWLStructure
 
 __all__ = ["regressor_matrix", "regression_layout", "stage1", "Stage1Result"]
 

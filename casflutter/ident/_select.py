@@ -23,8 +23,9 @@ from .._format import result_repr
 from ..data import IOData
 from ..errors import CasflutterError, ConfigError, DataError
 from ._identify import (IdentificationResult, IdentificationSettings, fit_report, identify)
-from ._model import HWLModel, HWLStructure
+from ._model import HWLModel
 from ._orders import _NAMES, HWLOrders
+from ._structure import HWLStructure
 
 __all__ = ["OrderCandidate", "OrderSelection", "select_orders", "order_grid", "parse_grid"]
 

@@ -34,7 +34,7 @@ from .._threads import single_threaded
 
 from ..data import IOData
 from ._kernels import free_run, sensitivities
-from ._model import HWLStructure
+from ._structure import HWLStructure
 
 __all__ = ["FreeRunProblem", "LMResult", "fit_simulation_error"]
 

@@ -144,7 +144,8 @@ def find_hopf(forms: MultilinearForms, vrange, n_grid: int = 121, *, speed_scale
     Raises
     ------
     ConfigError
-        Unstable at the range start, or no crossing in the range.
+        Unstable at the range start, or no oscillatory eigenvalue crosses the imaginary
+        axis in the range.
     """
     def abscissa(V):
         lam = np.linalg.eigvals(forms.A(V))
@@ -171,7 +172,8 @@ def find_neimark_sacker(forms: MultilinearForms, vrange, n_grid: int = 121, *,
     Raises
     ------
     ConfigError
-        Unstable at the range start, or no crossing in the range.
+        Unstable at the range start, or no complex eigenvalue leaves the unit circle in the
+        range.
     """
     def radius(V):
         lam = np.linalg.eigvals(forms.A(V))

@@ -328,7 +328,7 @@ def _controller_mat(result, doc: dict) -> dict:
         exact = result.rom_stable_V
         mat["exact_V"] = _mat_interval(exact)
         scale = speed_scale(_problem(result))
-        if scale.to_airspeed is not None:
+        if scale.has_airspeed:
             for name, pair in (("small_gain", ver.small_gain_V), ("exact", exact)):
                 iv = interval_values(pair, scale)
                 mat[f"{name}_airspeed_m_s"] = (np.zeros((0, 2)) if iv is None else np.array(

@@ -261,9 +261,7 @@ def realize(model, order: int | str = "auto", *, tol: float = 1e-9,
     Examples
     --------
     >>> import casflutter as cf
-    >>> truth = cf.load_problem("typical_section")
-    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
-    >>> rom = cf.identify_common_denominator(data).model
+    >>> rom = cf.example_rom()
     >>> r = cf.realize(rom)
     >>> r.order, r.sigma_f.isctime()
     (8, True)

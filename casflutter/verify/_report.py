@@ -279,16 +279,7 @@ def verify_controller(P: SystemLike | PlantData, K: SystemLike, nmeas: int | Non
         raise ConfigError(f"nmeas = {nmeas!r}, ncon = {ncon!r}: give the number of "
                           "measurements and controls of the plant (or a PlantData that "
                           "holds them, e.g. load_plant('plant.json'))")
-    if delta_channel is not None:
-        if n_delta is not None and n_delta != delta_channel:
-            raise ConfigError(f"n_delta={n_delta} and delta_channel={delta_channel} differ; "
-                              "give one of them")
-        n_delta = delta_channel
-    if (Vf is None) != (n_delta is None):
-        raise ConfigError("give both Vf and n_delta (size of the ΔV channel, eq. 13-15) "
-                          f"or neither; got Vf={Vf!r}, n_delta={n_delta!r}")
-    if Vf is not None and not Vf >= 0:
-        raise ConfigError(f"Vf must be >= 0, got {Vf!r}")
+    n_delta = _delta_size(Vf, n_delta, delta_channel)
     P = as_statespace(P, "plant P")
     K = as_statespace(K, "controller K")
     cl = lft_closed_loop(P, K, nmeas, ncon)
@@ -301,32 +292,57 @@ def verify_controller(P: SystemLike | PlantData, K: SystemLike, nmeas: int | Non
     notes: list[str] = []
     extra: dict = {}
     if Vf is not None:
-        Ad, Bf, Cf, Dff = delta_family(cl, n_delta)
-        hinf_d = hinf_norm(cl[:n_delta, :n_delta], method=method, tol=tol)
-        extra.update(Vf=float(Vf), n_delta=int(n_delta), hinf_delta=hinf_d)
-        if stable:
-            for key, g in (("", hinf.gamma), ("_delta", hinf_d.gamma)):
-                r = math.inf if g == 0 else 1.0 / g
-                extra["small_gain_dV" + key] = (-r, r)
-                extra["small_gain_V" + key] = small_gain_interval(g, Vf)
-            try:
-                ex = feedback_stability_interval(Ad, Bf, Cf, Dff)
-            except NotHurwitzError as exc:  # pragma: no cover - guarded by `stable`
-                notes.append(str(exc))
-            else:
-                extra.update(exact=ex, exact_V=speed_interval(ex.lower, ex.upper, Vf))
-            if np.any(Dff):
-                notes.append("closed-loop feedthrough D_zf,wf != 0: A(ΔV) is rational in "
-                             "ΔV; the exact interval uses the rational (LFT) pencil")
-        else:
-            notes.append("nominal closed loop is unstable (spectral abscissa "
-                         f"{alpha:.6g} >= 0): gamma is infinite and no ΔV interval around "
-                         "ΔV = 0 exists; the controller does not stabilise the plant at Vf")
+        extra = _delta_intervals(cl, hinf, stable, alpha, Vf, n_delta, method, tol, notes)
     elif not stable:
         notes.append(f"nominal closed loop is unstable (spectral abscissa {alpha:.6g}); "
                      "the H-inf norm is infinite")
     return VerificationReport(closed_loop=cl, poles=poles, stable=stable,
                               spectral_abscissa=alpha, hinf=hinf, notes=tuple(notes), **extra)
+
+
+def _delta_size(Vf, n_delta, delta_channel) -> int | None:
+    """The size of the ΔV channel from ``n_delta`` or its alias ``delta_channel``, checked
+    against ``Vf`` (both or neither)."""
+    if delta_channel is not None:
+        if n_delta is not None and n_delta != delta_channel:
+            raise ConfigError(f"n_delta={n_delta} and delta_channel={delta_channel} differ; "
+                              "give one of them")
+        n_delta = delta_channel
+    if (Vf is None) != (n_delta is None):
+        raise ConfigError("give both Vf and n_delta (size of the ΔV channel, eq. 13-15) "
+                          f"or neither; got Vf={Vf!r}, n_delta={n_delta!r}")
+    if Vf is not None and not Vf >= 0:
+        raise ConfigError(f"Vf must be >= 0, got {Vf!r}")
+    return n_delta
+
+
+def _delta_intervals(cl, hinf: HinfNorm, stable: bool, alpha: float, Vf, n_delta: int,
+                     method: str, tol: float, notes: list) -> dict:
+    """The fields of :class:`VerificationReport` about the ΔV channel: its norm, the
+    small-gain intervals (eq. 16) and the exact interval of the loop ``A(ΔV)``; the reasons
+    for any missing one are appended to ``notes``."""
+    Ad, Bf, Cf, Dff = delta_family(cl, n_delta)
+    hinf_d = hinf_norm(cl[:n_delta, :n_delta], method=method, tol=tol)
+    extra = dict(Vf=float(Vf), n_delta=int(n_delta), hinf_delta=hinf_d)
+    if not stable:
+        notes.append("nominal closed loop is unstable (spectral abscissa "
+                     f"{alpha:.6g} >= 0): gamma is infinite and no ΔV interval around "
+                     "ΔV = 0 exists; the controller does not stabilise the plant at Vf")
+        return extra
+    for key, g in (("", hinf.gamma), ("_delta", hinf_d.gamma)):
+        r = math.inf if g == 0 else 1.0 / g
+        extra["small_gain_dV" + key] = (-r, r)
+        extra["small_gain_V" + key] = small_gain_interval(g, Vf)
+    try:
+        ex = feedback_stability_interval(Ad, Bf, Cf, Dff)
+    except NotHurwitzError as exc:  # pragma: no cover - guarded by `stable`
+        notes.append(str(exc))
+    else:
+        extra.update(exact=ex, exact_V=speed_interval(ex.lower, ex.upper, Vf))
+    if np.any(Dff):
+        notes.append("closed-loop feedthrough D_zf,wf != 0: A(ΔV) is rational in "
+                     "ΔV; the exact interval uses the rational (LFT) pencil")
+    return extra
 
 
 def verify_lft(lft, K: SystemLike, *, method: str = "auto",

@@ -2,7 +2,7 @@
 and the design that puts stability over the interval first (:func:`design_interval_controller`).
 
 Start: the order-8 controller that holds the seed wing over (0, 2.4)
-(``problems/seed_wing/truth_interval_controller_order8.json``, certified in
+(``tests/witnesses/truth_interval_controller_order8.json``, certified in
 ``tests/verify/test_truth_witness.py``).  Truth used: the verification layer's exact stable
 interval of the wing's own linearisation (:func:`casflutter.verify.speed_family_interval`,
 python-control closing the loop), which shares no code with the optimiser.
@@ -10,16 +10,20 @@ python-control closing the loop), which shares no code with the optimiser.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import control
 import numpy as np
 import pytest
 
-from casflutter._resources import problems_dir
 from casflutter.aeroelastic import TruthLoop
 from casflutter.design import design_interval_controller, reduce_order
 from casflutter.errors import ConfigError, DimensionError
 from casflutter.truth import SeedWing
 from casflutter.verify import load_controller, speed_family_interval
+
+#: the test witnesses (tests/witnesses/README.md): inputs of the tests, each certified here
+WITNESS_DIR = Path(__file__).resolve().parents[1] / "witnesses"
 
 INTERVAL = (0.05, 1.6)
 
@@ -31,7 +35,7 @@ def wing():
 
 @pytest.fixture(scope="module")
 def witness():
-    return load_controller(problems_dir() / "seed_wing" / "truth_interval_controller_order8.json")
+    return load_controller(WITNESS_DIR / "truth_interval_controller_order8.json")
 
 
 def test_lower_orders_hold_the_interval_and_the_verification_certifies_them(wing, witness):

@@ -1,4 +1,4 @@
-"""Order selection by held-out free-run error (issue 13, item 3)."""
+"""Order selection by held-out free-run error."""
 
 import pytest
 

@@ -29,7 +29,9 @@ NOT_RESULTS = {"IdentificationSettings", "HWLOrders", "HWLStructure", "RFASettin
                "SuppressionSettings", "SpeedScale", "Outputs", "Parameter", "Study",
                "Evaluator", "GolandParams", "SeedWingParams", "TypicalSectionParams",
                "PitchPlungeParams", "FlapCoefficients", "StripCoefficients", "AeroMatrices",
-               "WingProblem", "GAFProblem"}
+               "WingProblem", "GAFProblem",
+               # conventions and small values of the structure (a few numbers each)
+               "SpeedConvention", "ModalLayout", "ModalState"}
 
 
 def _public_frozen_dataclasses():

@@ -19,6 +19,7 @@ import math
 from pathlib import Path
 
 from ...errors import ConfigError
+from .. import _verify_family
 
 __all__ = ["register", "run", "verdict"]
 
@@ -49,6 +50,7 @@ def register(subparsers) -> None:
                    help="speed-index range over which the loop must stay stable (exact "
                         "interval, eq. 10-15); not covered -> exit code 1")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
+    _verify_family.add_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -151,6 +153,8 @@ def _speed_scale(pdoc: dict) -> float | None:
 def run(args) -> int:
     """Handler of ``casflutter verify``: 0 when the verdict passes, 1 when the loop is not
     stable or not robust over ``--require-v``."""
+    if _verify_family.is_family(args.plant):
+        return _verify_family.run(args)
     from ...verify import load_controller, load_plant, verify_controller
 
     pdoc = _peek(args.plant)
