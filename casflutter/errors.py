@@ -16,6 +16,7 @@ __all__ = [
     "SynthesisError",
     "OutputError",
     "StoreLockedError",
+    "DataWarning",
 ]
 
 
@@ -26,6 +27,12 @@ class CasflutterError(Exception):
 class DataError(CasflutterError, ValueError):
     """Input--output data that cannot be used (NaN/inf, length mismatch, too short,
     not exciting enough)."""
+
+
+class DataWarning(UserWarning):
+    """Data that can be used but probably not as meant: a column of a record file that no
+    channel names, records whose chirp band or length miss the problem's lowest structural
+    mode (e.g. settings in seconds applied to a problem in nondimensional time)."""
 
 
 class OrderError(CasflutterError, ValueError):

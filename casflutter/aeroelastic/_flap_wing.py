@@ -38,6 +38,7 @@ from functools import cached_property
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError
 from ..truth import JONES_A, GolandParams, GolandWing
 from ..truth._goland import _bending_shapes
@@ -102,6 +103,8 @@ class FlapWingFamily(PlantFamily):
     >>> P.nstates, P.ninputs, P.noutputs
     (50, 4, 8)
     """
+
+    __repr__ = result_repr
 
     params: GolandParams = field(default_factory=_default_params)
     flap_segments: tuple = ((0.2, 0.4), (0.4, 0.6), (0.6, 0.8), (0.8, 1.0))

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq, linear_sum_assignment
 
+from .._format import result_repr
 from ..errors import ConfigError
 from ._tracking import (EigenTracking, as_matrix_fn, eig_sorted_by_reference,
                         track_eigenvalues)
@@ -53,6 +54,8 @@ class Crossing:
     bracket : tuple of float
         Grid interval that contained the sign change.
     """
+
+    __repr__ = result_repr
 
     V: float
     eigenvalue: complex
@@ -103,6 +106,8 @@ class FlutterResult:
     message : str
         Human-readable summary.
     """
+
+    __repr__ = result_repr
 
     status: str
     Vf: float | None
@@ -324,10 +329,10 @@ def _status_message(flut, div, tr: EigenTracking) -> tuple[str, str]:
     """The status of :class:`FlutterResult` and its one-line summary."""
     if flut is not None:
         return "flutter", (
-            f"flutter at V = {flut.V:.10g}, {flut.omega:.6g} rad/s ({flut.frequency_hz:.6g} Hz), "
+            f"flutter at V = {flut.V:.6g}, {flut.omega:.6g} rad/s ({flut.frequency_hz:.6g} Hz), "
             + (f"structural mode {flut.origin_mode + 1} (numbered from 1)"
                if flut.origin_mode >= 0 else f"branch {flut.branch} (not a structural mode)"))
     if div is not None:
-        return "divergence", f"no flutter; static divergence at V = {div.V:.10g}"
+        return "divergence", f"no flutter; static divergence at V = {div.V:.6g}"
     return "no_crossing", (f"no eigenvalue crosses the imaginary axis for V in [{tr.V[0]:g}, "
                            f"{tr.V[-1]:g}]; no flutter speed in this range (extend the range)")

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError
 from ._loop import AeroelasticSystem
 
@@ -57,6 +58,8 @@ class AeroelasticLFT:
     sensor : str
         Sensor kind of Σs (see :mod:`casflutter.structure`).
     """
+
+    __repr__ = result_repr
 
     Vf: float
     A: np.ndarray

@@ -31,6 +31,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import brentq
 
+from .._format import result_repr
 from ..data import GAFTable
 from ..errors import ConfigError, ConvergenceError, DataError, DimensionError
 from ..structure import ModalStructure
@@ -71,6 +72,8 @@ class PKResult:
     message : str
         Summary.
     """
+
+    __repr__ = result_repr
 
     U: np.ndarray
     modes: tuple[int, ...]
@@ -125,7 +128,7 @@ class _PK:
                 QIk = Q.imag / k
         except DataError:
             raise DataError(
-                f"p-k: mode {mode} ({self.t.mode_names[mode]!r}) at U = {U:g} m/s needs "
+                f"p-k: mode {mode + 1} ({self.t.mode_names[mode]!r}) at U = {U:g} m/s needs "
                 f"k = {k:.4g}, outside the table's k = [{self.t.k[0]:g}, {self.t.k[-1]:g}]; "
                 "extend the table or track fewer modes (modes=...)") from None
         return Q.real, QIk
@@ -155,7 +158,7 @@ class _PK:
                 return s_cur, it
             k = k_new
         raise ConvergenceError(
-            f"p-k did not converge for mode {mode} ({self.t.mode_names[mode]!r}) at "
+            f"p-k did not converge for mode {mode + 1} ({self.t.mode_names[mode]!r}) at "
             f"U = {U:g} m/s after {self.max_iter} iterations (last k = {k:.6g}); use finer "
             "speed steps or raise max_iter")
 
@@ -253,7 +256,7 @@ def pk_flutter(table: GAFTable, structure: ModalStructure, speeds, *, U_ref: flo
         return PKResult(U, modes, names, lam, kk, its, False, None, None, None, None, msg)
     Uf, sf, m = best
     kf = sf.imag * table.b / Uf
-    msg = (f"p-k flutter at U = {Uf:.6g} m/s, {sf.imag:.6g} rad/s (k = {kf:.4g}), mode {m} "
-           f"({table.mode_names[m]!r})")
-    log.info(msg)
+    msg = (f"p-k flutter at U = {Uf:.6g} m/s, {sf.imag:.6g} rad/s (k = {kf:.4g}), mode "
+           f"{m + 1} ({table.mode_names[m]!r})")
+    log.debug(msg)
     return PKResult(U, modes, names, lam, kk, its, True, Uf, float(sf.imag), float(kf), m, msg)

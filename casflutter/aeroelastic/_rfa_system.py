@@ -36,6 +36,7 @@ from functools import cached_property
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError, DimensionError
 from ..realize import RationalApproximation
 from ..structure import AirspeedMixin, ModalStructure, SpeedConvention
@@ -63,6 +64,8 @@ class RFASystem(AirspeedMixin):
     ConfigError
         ``U_ref`` not positive.
     """
+
+    __repr__ = result_repr
 
     rfa: RationalApproximation
     structure: ModalStructure

@@ -32,6 +32,7 @@ import control
 import numpy as np
 from scipy.linalg import expm
 
+from .._format import result_repr
 from ..data import ResponseAnalysis, analyze_response
 from ..errors import ConfigError, DimensionError
 from ..structure import ModalStructure
@@ -66,6 +67,8 @@ class LoopSimulation:
     sensors : ResponseAnalysis or None
         The same for the sensors.
     """
+
+    __repr__ = result_repr
 
     timepts: np.ndarray
     xs: np.ndarray

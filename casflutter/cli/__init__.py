@@ -32,6 +32,7 @@ from .. import __version__
 from .._interrupt import Terminated, sigterm_raises
 from .._logging import PACKAGE_LOGGER, configure_cli_logging, remove_cli_logging
 from .._threads import single_threaded
+from ._help import plain_help
 from ..errors import CasflutterError
 
 __all__ = ["main", "build_parser", "EXIT_ERROR", "EXIT_INTERRUPTED", "EXIT_TERMINATED",
@@ -111,6 +112,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench.set_defaults(func=lambda args: (bench.print_help(), 2)[1])
     for p in [*sub.choices.values(), *bench_sub.choices.values()]:
         _add_global_flags(p, top=False)
+    plain_help(parser)       # the docstrings' reST markup as plain text
     return parser
 
 

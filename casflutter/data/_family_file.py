@@ -60,6 +60,7 @@ from typing import Mapping
 import numpy as np
 from scipy.io import savemat
 
+from .._format import result_repr
 from .._outputs import atomic_file, check_output_path
 from .._resources import read_toml
 from ..errors import ConfigError, DataError, DimensionError
@@ -136,6 +137,8 @@ class FamilyFile:
     ConfigError
         Speeds not strictly increasing, an unknown feedback convention or interpolation.
     """
+
+    __repr__ = result_repr
 
     speeds: np.ndarray
     A: np.ndarray

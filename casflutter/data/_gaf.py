@@ -47,6 +47,7 @@ import numpy as np
 from scipy.interpolate import make_interp_spline
 from scipy.io import savemat
 
+from .._format import result_repr
 from ..errors import DataError
 from ._matfile import mat_strings, read_mat
 
@@ -103,6 +104,8 @@ class GAFTable:
         Non-increasing, negative or non-finite ``k``; real, non-finite or mis-shaped ``Q``;
         non-positive ``b``; ``mode_names`` of the wrong length.
     """
+
+    __repr__ = result_repr
 
     k: np.ndarray
     Q: np.ndarray

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._format import result_repr
 from ..errors import DataError
 
 __all__ = ["Record"]
@@ -81,6 +82,8 @@ class Record:
     name : str
         Label used in messages and reports.
     """
+
+    __repr__ = result_repr
 
     y: np.ndarray
     u: np.ndarray | None = None

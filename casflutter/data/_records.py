@@ -10,13 +10,15 @@ from __future__ import annotations
 
 import csv
 import logging
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Sequence
 
 import numpy as np
 
-from ..errors import DataError
+from .._format import result_repr
+from ..errors import DataError, DataWarning
 from ._matfile import _mat_matrix, read_mat
 from ._record import Record
 
@@ -52,6 +54,8 @@ class IOData:
     >>> d.n_modes, d.has_u, d.has_v
     (2, True, False)
     """
+
+    __repr__ = result_repr
 
     records: tuple[Record, ...]
     dt: float
@@ -226,6 +230,12 @@ class IOData:
         IOData
             One record named after the file, the channels named after the columns.
 
+        Warns
+        -----
+        DataWarning
+            A column that is neither an output, an input, the flap nor the time column
+            (named): the fit goes on without it, which is wrong when it is an input.
+
         Raises
         ------
         DataError
@@ -291,6 +301,15 @@ class IOData:
             if not np.allclose(steps, dt, rtol=1e-6, atol=1e-12):
                 raise DataError(f"{path}: time column {time!r} is not uniformly sampled "
                                 f"(steps from {steps.min():g} to {steps.max():g}); resample first")
+        unused = [c for c in header if c not in want and c != time]
+        if unused:
+            # a record's unnamed column is most often an input the fit needs (the flap, a
+            # modal displacement): without it the ROM fits the forces wrongly, with no error
+            warnings.warn(f"{path}: column(s) {unused} are not used: they are not among the "
+                          f"outputs y = {list(y)}, the modal inputs u = {list(u or [])} or the "
+                          f"flap v = {v!r}; if one is an input of the record, name it (u=, v=; "
+                          "--u/--v on the command line), else drop it from the file",
+                          DataWarning, stacklevel=2)
         Y = np.column_stack([col[c] for c in y])
         U = np.column_stack([col[c] for c in u]) if u else None
         V = col[v] if v else None

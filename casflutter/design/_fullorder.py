@@ -99,14 +99,15 @@ def full_order_controller(P: Partition, gamma_factor: float = 1.1
                              A, B, C, D, job=1)[0])
         out = sb10ad(n, m, p, nu, ny, gamma_factor * g_opt, A, B, C, D, job=4)
     except Exception as exc:  # noqa: BLE001 - SLICOT refuses with several exception types
+        # the whole reason on one line (SLICOT's messages span several)
         log.info("full-order start: SLICOT refused the problem (%s), skipped",
-                 str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__)
+                 " ".join(str(exc).split()) or type(exc).__name__)
         return None
     Ak, Bk, Ck, Dk = (np.asarray(M, float) for M in out[1:5])
     if not all(np.all(np.isfinite(M)) for M in (Ak, Bk, Ck, Dk)):
         return None
-    log.info("full-order start: gamma_opt %.6g, central controller at %.6g", g_opt,
-             gamma_factor * g_opt)
+    log.debug("full-order start: gamma_opt %.6g, central controller at %.6g", g_opt,
+              gamma_factor * g_opt)
     return control.ss(Ak, Bk, Ck, Dk), g_opt
 
 
@@ -162,14 +163,14 @@ def reduced_controllers(K: control.StateSpace, order: int) -> list[control.State
     for method in ("truncate", "matchdc"):
         if unstable > order:
             # balred keeps the whole unstable part: the result would exceed the order
-            log.info("full-order start: no balanced reduction to order %d (%d unstable "
-                     "controller poles)", order, unstable)
+            log.debug("full-order start: no balanced reduction to order %d (%d unstable "
+                      "controller poles)", order, unstable)
             break
         try:
             Kr = control.balred(K, order, method=method)
         except Exception as exc:  # noqa: BLE001 - SLICOT errors of several types
-            log.info("full-order start: %s reduction to order %d failed (%s)", method, order,
-                     type(exc).__name__)
+            log.debug("full-order start: %s reduction to order %d failed (%s)", method, order,
+                      type(exc).__name__)
             continue
         mats = [np.asarray(M, float) for M in (Kr.A, Kr.B, Kr.C, Kr.D)]
         if Kr.nstates <= order and all(np.all(np.isfinite(M)) for M in mats):

@@ -22,6 +22,7 @@ import control
 import numpy as np
 import scipy.linalg
 
+from .._format import result_repr
 from .._settings import finite_numbers
 from .._threads import single_threaded
 from ..errors import ConfigError
@@ -58,6 +59,8 @@ class RandomStartSearch:
     frequency_band : tuple of float
         The band (rad/s) the resonators' frequencies were drawn from.
     """
+
+    __repr__ = result_repr
 
     anchor: str
     order: int
@@ -209,12 +212,12 @@ def search_random_starts(system, interval, order: int, *, anchor: str = "high",
             K = _random_start(rng, int(order), models.n_sensors, band)
             K, worst = _polish(models, K, band_speeds, max_iter, -2 * decay, free, stable)
             if not worst < -decay:
-                log.info("%s-end start %d: the anchor band does not decay (worst %.4g)",
-                         anchor, i, worst)
+                log.debug("%s-end start %d: the anchor band does not decay (worst %.4g)",
+                          anchor, i, worst)
                 continue
             reach = stabilize_interval(models, K, (lo, hi), anchor=anchor, decay=decay,
                                        max_iter=max_iter, **continuation)
-            log.info("%s-end start %d: reached [%.4g, %.4g]", anchor, i, *reach.reached)
+            log.debug("%s-end start %d: reached [%.4g, %.4g]", anchor, i, *reach.reached)
             reaches.append(reach)
             indices.append(i)
     return RandomStartSearch(anchor, int(order), int(starts), int(seed), tuple(reaches),

@@ -56,6 +56,7 @@ from typing import Any, Mapping, Sequence
 import control
 import numpy as np
 
+from .._format import result_repr
 from .._threads import single_threaded
 from ..errors import CasflutterError, ConfigError, DataError, DimensionError, SynthesisError
 from ._fullorder import full_order_controller, reduced_controllers
@@ -200,6 +201,8 @@ class StartRecord:
         Why the start did not converge (empty when it did).
     """
 
+    __repr__ = result_repr
+
     start: int
     kind: str
     stabilized: bool
@@ -256,6 +259,8 @@ class SynthesisResult:
     norm_method : str
         What computed γ.
     """
+
+    __repr__ = result_repr
 
     controller: control.StateSpace
     gamma: float
@@ -438,11 +443,11 @@ class _Phase:
                     history_at[-1] >= it - 1 and _stalled(history, history_at, it,
                                                           opts.stall_window,
                                                           min(opts.stall_tol, 10 * opts.tol)):
-                log.info("%s: stalled at gamma %.6g (less than %.1e relative decrease in %d "
-                         "iterations)", label, f, opts.stall_tol, opts.stall_window)
+                log.debug("%s: stalled at gamma %.6g (less than %.1e relative decrease in %d "
+                          "iterations)", label, f, opts.stall_tol, opts.stall_window)
                 break
             if it > opts.abandon_after and f > self.abandon_above:
-                log.info("%s: abandoned at gamma %.6g (another start is far better)", label, f)
+                log.debug("%s: abandoned at gamma %.6g (another start is far better)", label, f)
                 break
             if cuts_cache is None:
                 cuts_cache = self.cuts(K, f, info, delta, memory)
@@ -511,8 +516,8 @@ class _Phase:
                     delta = min(2.0 * delta, opts.max_trust_region * max(1.0, np.max(np.abs(K))))
                 elif ratio < 0.25:
                     delta = 0.5 * dmax
-                log.info("%s %s it %d: %s %.6g (ratio %.2f, radius %.3g)", label, self.kind, it,
-                         "gamma" if self.kind == "hinf" else "abscissa", f, ratio, delta)
+                log.debug("%s %s it %d: %s %.6g (ratio %.2f, radius %.3g)", label, self.kind, it,
+                          "gamma" if self.kind == "hinf" else "abscissa", f, ratio, delta)
             else:
                 delta = 0.5 * dmax
                 if self.kind == "hinf" and info_n is not None:
@@ -526,7 +531,7 @@ class _Phase:
                     cuts_cache = None
                 else:
                     cuts_cache = None
-                log.info("%s %s it %d: rejected (ratio %.3g), radius %.3g", label, self.kind,
+                log.debug("%s %s it %d: rejected (ratio %.3g), radius %.3g", label, self.kind,
                           it, ratio, delta)
                 if delta < 1e-10 * max(1.0, float(np.max(np.abs(K)))):
                     break
@@ -673,15 +678,15 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
             full = full_order_controller(parts[0], opts.full_order_gamma_factor)
             reduced = [] if full is None else reduced_controllers(full[0], order)
         except _NUMERICAL_FAILURES as exc:
-            log.info("full-order start: failed (%s), skipped", _reason(exc))
+            log.debug("full-order start: failed (%s), skipped", _reason(exc))
             reduced = []
         # (a static reduction that is zero would only repeat the zero start)
         plan += [("full-order-reduced", Kr) for Kr in reduced
                  if Kr.nstates or np.any(np.asarray(Kr.D) != 0)]
     records, gains = [], []
     best_alpha = np.inf
-    log.info("synthesis: order %d, %d H-inf plant(s) (%d states), %d stability plant(s), "
-             "%d start(s)", order, len(parts), parts[0].nx, len(sparts), len(plan))
+    log.debug("synthesis: order %d, %d H-inf plant(s) (%d states), %d stability plant(s), "
+              "%d start(s)", order, len(parts), parts[0].nx, len(sparts), len(plan))
     for s, (kind, g) in enumerate(plan):
         t0 = time.perf_counter()
         K0 = _initial_gain(prob, kind, rng, g)
@@ -692,7 +697,7 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
             raise
         except _NUMERICAL_FAILURES as exc:
             # a numerical failure ends this start only (module docstring)
-            log.info("start %d (%s): failed (%s: %s)", s, kind, type(exc).__name__, exc)
+            log.debug("start %d (%s): failed (%s: %s)", s, kind, type(exc).__name__, exc)
             rec = StartRecord(start=s, kind=kind, stabilized=False, spectral_abscissa=np.nan,
                               gamma=np.inf, gamma_history=(), model_decrease=np.inf,
                               statuses=tuple(statuses), stab_iterations=0, outer_iterations=0,
@@ -716,7 +721,7 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
         except CasflutterError:
             raise
         except _NUMERICAL_FAILURES as exc:
-            log.info("start %d: its controller failed the final check (%s)", best.start,
+            log.debug("start %d: its controller failed the final check (%s)", best.start,
                      _reason(exc))
             records[best.start] = replace(best, status="failed",
                                           reason="final check: " + _reason(exc))
@@ -733,8 +738,9 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
     gammas = tuple(float(c[0]) for c in checks)
     gamma = max(gammas)
     alpha_v = max(float(c[2]) for c in checks)
-    log.info("synthesis: best start %d, gamma %.6g, %.1f s", best.start, gamma,
-             time.perf_counter() - t_start)
+    log.info("synthesis: order %d, best of %d starts (start %d): gamma %.6g, the largest "
+             "H-inf norm over the %d design plant(s), %.1f s", order, len(records), best.start,
+             gamma, len(sys_list), time.perf_counter() - t_start)
     return SynthesisResult(
         controller=controller, gamma=gamma, gammas=gammas,
         delta_bound=float(1.0 / gamma) if np.isfinite(gamma) and gamma > 0 else 0.0,
@@ -773,7 +779,7 @@ def _run_start(prob: Problem, qp: CutQP, opts: SynthesisOptions, s: int, kind: s
         # loop is no more unstable than with the zero controller (deterministic)
         K1 = _shrunk(prob, K0)
         if K1 is not None:
-            log.info("%s: stabilisation failed (abscissa %.4g rad/s); retried from the "
+            log.debug("%s: stabilisation failed (abscissa %.4g rad/s); retried from the "
                      "random gain shrunk towards zero", label, a_h)
             r1b = stab.run(K1, label, opts.max_stab_rounds)
             K, phi = r1b["K"], r1b["f"]
@@ -781,7 +787,7 @@ def _run_start(prob: Problem, qp: CutQP, opts: SynthesisOptions, s: int, kind: s
             a_h = float(np.max(prob.alphas(K)[0])) * prob.w0
             best_alpha = min(best_alpha, a_h)
             ok = prob.feasible(K) and (phi <= 0.0 or (a_h < 0 and np.isfinite(phi)))
-    log.info("%s: stabilisation %s after %d iterations (abscissa %.4g rad/s)", label,
+    log.debug("%s: stabilisation %s after %d iterations (abscissa %.4g rad/s)", label,
              "reached the decay rates" if ok else "failed", r1["iterations"], a_h)
     status, reason = "not-stabilized", "the stabilisation phase ended with an unstable or " \
         "ill-posed loop"
@@ -797,7 +803,7 @@ def _run_start(prob: Problem, qp: CutQP, opts: SynthesisOptions, s: int, kind: s
         hist, conv, outer, pred = tuple(r2["history"]), r2["converged"], r2["iterations"], \
             r2["pred"]
         a_h = float(np.max(prob.alphas(K)[0])) * prob.w0
-        log.info("%s: gamma %.6g after %d H-inf iterations (%s)", label, gam, outer,
+        log.debug("%s: gamma %.6g after %d H-inf iterations (%s)", label, gam, outer,
                  "converged" if conv else "budget spent")
         status, reason = ("converged", "") if conv else (
             "stopped", "iteration or time budget spent, stalled or abandoned")

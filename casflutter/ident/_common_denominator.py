@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._format import result_repr
 from ..data import IOData
 from ..errors import ConfigError, DataError
 from ._model import HWLModel
@@ -52,6 +53,8 @@ class CommonDenominatorResult:
     wall_time : float
         Seconds.
     """
+
+    __repr__ = result_repr
 
     model: HWLModel
     a: np.ndarray

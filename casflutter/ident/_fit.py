@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._format import result_repr
 from ..data import IOData
 from ..errors import ConfigError
 from ._model import HWLModel
@@ -31,6 +32,8 @@ class FitReport:
     skip : int
         Leading samples of each record excluded from the scores.
     """
+
+    __repr__ = result_repr
 
     mode: str
     error_percent: np.ndarray

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from .._format import result_repr
 from .._nlp import NLPResult
 from .._threads import single_threaded
 from ..data import IOData, Record
@@ -87,6 +88,8 @@ class IdentificationResult:
     solver : str
         ``"ipopt"``, ``"gauss-newton"`` or ``"none"``.
     """
+
+    __repr__ = result_repr
 
     model: HWLModel
     initial_model: HWLModel

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from .._format import result_repr
 from ..errors import DataError, DimensionError
 from ._kernels import free_run
 from ._orders import HWLOrders
@@ -52,6 +53,8 @@ class HWLModel:
     v_name : str
         Name of the flap input.
     """
+
+    __repr__ = result_repr
 
     structure: HWLStructure
     theta: np.ndarray

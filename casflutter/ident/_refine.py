@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from .._format import result_repr
 from .._nlp import NLPResult, make_solver
 from ..data import IOData
 from ..errors import ConfigError
@@ -50,6 +51,8 @@ class RefinementResult:
         both are free runs evaluated outside the NLP (from the measured initial outputs of
         every record), so they compare like with like.
     """
+
+    __repr__ = result_repr
 
     theta: np.ndarray
     nlp: NLPResult

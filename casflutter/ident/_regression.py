@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._format import result_repr
 from ..data import IOData
 from ..errors import DataError
 from ._model import HWLModel
@@ -119,6 +120,8 @@ class Stage1Result:
     n_rows : int
         Number of regression equations.
     """
+
+    __repr__ = result_repr
 
     model: HWLModel
     theta_over: np.ndarray

@@ -22,6 +22,7 @@ from typing import Any, Iterable, Mapping
 
 import numpy as np
 
+from .._format import result_repr
 from ..data import IOData
 from ..errors import CasflutterError, ConfigError, DataError
 from ._identify import (IdentificationResult, IdentificationSettings, fit_report, identify)
@@ -62,6 +63,8 @@ class OrderCandidate:
     model : HWLModel or None
     """
 
+    __repr__ = result_repr
+
     orders: HWLOrders
     n_params: int
     score: float
@@ -93,6 +96,8 @@ class OrderSelection:
     skip : int
         Leading held-out samples not scored.
     """
+
+    __repr__ = result_repr
 
     candidates: tuple
     best: OrderCandidate

@@ -36,6 +36,7 @@ import casadi as ca
 import numpy as np
 from scipy.optimize import brentq
 
+from .._format import result_repr
 from ..errors import ConfigError
 
 __all__ = ["MultilinearForms", "CriticalPair", "find_hopf", "find_neimark_sacker",
@@ -96,6 +97,8 @@ class CriticalPair:
     eigenvectors (``<q, q> = <p, q> = 1``); ``crossing_rate`` (``d Re lambda/dV`` or
     ``d|mu|/dV``); ``A`` the Jacobian there.
     """
+
+    __repr__ = result_repr
 
     V: float
     eigenvalue: complex

@@ -25,6 +25,7 @@ import control
 import numpy as np
 from scipy.signal import cont2discrete
 
+from .._format import result_repr
 from ..errors import DimensionError, OrderError
 
 __all__ = ["Realization", "era", "inverse_tustin", "tustin_to_continuous", "continuous_to_tustin",
@@ -202,6 +203,8 @@ class Realization:
     markov : ndarray
         The Markov parameters realised.
     """
+
+    __repr__ = result_repr
 
     sigma_f: control.StateSpace
     discrete: control.StateSpace

@@ -41,6 +41,7 @@ from dataclasses import dataclass, field, replace
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError, DimensionError
 from ._speed import SpeedConvention
 from ._state import ModalLayout, ModalStates
@@ -150,6 +151,8 @@ class ModalStructure(ModalStates):
     ConfigError
         Non-positive or non-finite frequencies, negative damping, unknown sensor kind.
     """
+
+    __repr__ = result_repr
 
     omega: np.ndarray
     zeta: np.ndarray

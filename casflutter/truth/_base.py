@@ -31,6 +31,7 @@ from scipy.integrate import solve_ivp
 from scipy.interpolate import make_interp_spline
 from scipy.linalg import eigh
 
+from .._format import result_repr
 from ..errors import ConfigError, DataError, DimensionError
 from ..structure import ModalLayout, ModalStates, ModalStructure, SpeedConvention
 from ._aero import JONES_A, check_timepts, integrate_lags, sample_derivatives
@@ -85,6 +86,8 @@ class SimulationResult:
     nfev : int
         Right-hand-side evaluations.
     """
+
+    __repr__ = result_repr
 
     timepts: np.ndarray
     states: np.ndarray

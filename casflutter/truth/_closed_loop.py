@@ -21,6 +21,7 @@ import control
 import numpy as np
 from scipy.optimize import brentq
 
+from .._format import result_repr
 from .._linalg import spectral_abscissa
 from ..errors import CasflutterError, ConfigError
 
@@ -49,6 +50,8 @@ class TruthLoopSimulation:
     gain : ndarray, shape (K,)
         Gain schedule ``g(t_k)``.
     """
+
+    __repr__ = result_repr
 
     timepts: np.ndarray
     zm: np.ndarray
@@ -335,6 +338,8 @@ class SuppressionResult:
         The sensor with the largest open-loop RMS.
     """
 
+    __repr__ = result_repr
+
     V: float
     simulation: TruthLoopSimulation
     attenuation_percent: float | None
@@ -516,6 +521,8 @@ class TruthLoopSweep:
         root bracketing; a grid end is reported where the loop is still stable); ``None``
         when the closed loop is unstable there.
     """
+
+    __repr__ = result_repr
 
     V: np.ndarray
     open_abscissa: np.ndarray

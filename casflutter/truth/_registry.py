@@ -12,6 +12,8 @@ family), or by the name of a folder of ``problems/`` whose ``problem.toml`` is s
 
 from __future__ import annotations
 
+import difflib
+
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
@@ -106,8 +108,10 @@ def _cls(name: str) -> type[AeroelasticTruth]:
         return PROBLEMS[name]
     except KeyError:
         avail = list(PROBLEMS) + file_problem_names()
-        raise ConfigError(f"unknown problem {name!r}; available: {', '.join(avail)}, or a "
-                          "problem TOML file (kind = \"pitch_plunge\")") from None
+        close = difflib.get_close_matches(name, avail, n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise ConfigError(f"unknown problem {name!r}{hint}; available: {', '.join(avail)}, or "
+                          "a problem TOML file (kind = \"pitch_plunge\")") from None
 
 
 def load_problem_file(path, sets=()) -> AeroelasticTruth | WingProblem | GAFProblem | FamilyFile:

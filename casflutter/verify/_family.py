@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError
 from ._common import spectral_abscissa, ssdata
 from ._family_controller import FamilyController, match_controller
@@ -65,6 +66,8 @@ class ClosedLoopCrossing:
     kind : str
         ``"flutter"`` (complex pair) or ``"divergence"`` (real eigenvalue).
     """
+
+    __repr__ = result_repr
 
     speed: float
     omega: float
@@ -115,6 +118,8 @@ class FamilyVerification:
     wall_time : dict
         Seconds per stage: ``interval``, ``margins``, ``crossings``, ``total``.
     """
+
+    __repr__ = result_repr
 
     family: str
     speed_unit: str

@@ -21,6 +21,7 @@ from dataclasses import dataclass, replace
 
 import control
 
+from .._format import result_repr
 from ..aeroelastic import FEEDBACK_SIGNS
 from ..errors import ConfigError, DataError, DimensionError
 from ._common import as_statespace, check_continuous, ssdata
@@ -49,6 +50,8 @@ class FamilyController:
     notes : tuple of str
         How the match was made (an assumed order, a convention taken from the file).
     """
+
+    __repr__ = result_repr
 
     K: control.StateSpace
     controls: tuple

@@ -52,6 +52,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError
 from ._common import as_statespace, is_hurwitz, spectral_abscissa, ssdata
 from ._interval import _pencil_roots, _pick_ends, bialternate_sum
@@ -90,6 +91,8 @@ class PieceCertificate:
     wall_time : float
         Seconds spent on the piece.
     """
+
+    __repr__ = result_repr
 
     lower: float
     upper: float
@@ -138,6 +141,8 @@ class CertifiedInterval:
     wall_time : float
         Seconds.
     """
+
+    __repr__ = result_repr
 
     lower: float | None
     upper: float | None

@@ -43,6 +43,7 @@ import control
 import numpy as np
 import scipy.linalg as sla
 
+from .._format import result_repr
 from ._common import ssdata
 from ._hinf import _hamiltonian
 
@@ -72,6 +73,8 @@ class LoopMargins:
     omega_phase : float
         Frequency of the limiting gain crossover (``nan`` when none).
     """
+
+    __repr__ = result_repr
 
     gain_increase: float
     gain_decrease: float
@@ -313,6 +316,8 @@ class MarginTable:
     disk_alpha, disk_gain_db, disk_phase_deg : ndarray, shape (k,), or None
         The multi-loop disk margin, when asked for.
     """
+
+    __repr__ = result_repr
 
     side: str
     loops: tuple

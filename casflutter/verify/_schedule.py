@@ -23,6 +23,7 @@ from typing import Callable
 import numpy as np
 import scipy.signal
 
+from .._format import result_repr
 from .._settings import finite_numbers
 from ..errors import ConfigError
 from ._common import as_statespace, ssdata
@@ -53,6 +54,8 @@ class ScheduledResponse:
         The time the plant's state norm passed ``state_limit`` (the run stops there, to keep
         the numbers finite; by then the loop has long been unstable); None if it did not.
     """
+
+    __repr__ = result_repr
 
     t: np.ndarray
     V: np.ndarray

@@ -251,14 +251,18 @@ def test_bench_streams_records_after_each_order(tmp_path, monkeypatch):
 
 
 def test_progress_is_logged(caplog):
+    """The starts and their iterations at DEBUG (--verbose); one INFO line, the result."""
     P, nmeas, ncon, _ = load_compleib(COMPLEIB / "AC4.json")
-    with caplog.at_level("INFO", logger="casflutter.design"):
+    with caplog.at_level("DEBUG", logger="casflutter.design"):
         r = synthesize(P, nmeas, ncon, 0, starts=2, seed=0, options=SynthesisOptions(max_outer=5))
-    msgs = [rec.getMessage() for rec in caplog.records if rec.name == "casflutter.design"]
+    recs = [rec for rec in caplog.records if rec.name == "casflutter.design"]
+    msgs = [rec.getMessage() for rec in recs]
     for s in r.starts:
         assert any(m.startswith(f"start {s.start} ") and "gamma" in m and "H-inf iterations" in m
                    for m in msgs)
     assert sum(" hinf it " in m for m in msgs) >= 1
+    info = [rec.getMessage() for rec in recs if rec.levelname == "INFO"]
+    assert len(info) == 1 and info[0].startswith("synthesis: order 0, best of 2 starts")
 
 
 
