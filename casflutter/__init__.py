@@ -52,7 +52,7 @@ _LAZY = {
     # identification
     "identify": "ident", "IdentificationSettings": "ident", "IdentificationResult": "ident",
     "identify_common_denominator": "ident", "HWLModel": "ident", "HWLOrders": "ident",
-    "fit_report": "ident",
+    "fit_report": "ident", "example_rom": "ident",
     # realisation
     "realize": "realize", "Realization": "realize", "canonical_realization": "realize",
     "ParametricROM": "realize",

@@ -14,6 +14,10 @@ folder cannot be written, nor leave a folder that mixes two runs:
   With ``overwrite`` the old folder is replaced as a whole (no stale file of the old run
   stays beside the new ones).
 - :func:`atomic_file` does the same for one file (write to a temporary name, then rename).
+  Both create their temporary folder or file with the ordinary modes (``0o777`` for a
+  folder, ``0o666`` for a file, less the umask: 0755 and 0644 under umask 022), not the
+  private 0700/0600 of :func:`tempfile.mkdtemp`/:func:`tempfile.mkstemp`, so the outputs
+  are readable by whoever may read the user's other files.
 - :func:`provenance` and :func:`write_manifest` record what produced a folder: the package
   version, the configuration's hash, the seed, the thread settings (BLAS environment
   variables and the thread pools threadpoolctl sees), the completed stages, start and end
@@ -26,6 +30,7 @@ import hashlib
 import json
 import os
 import platform
+import secrets
 import shutil
 import sys
 import tempfile
@@ -167,6 +172,26 @@ def check_figure_path(path: str | os.PathLike, *, what: str = "--figure",
 
 
 # ---------------------------------------------------------------------- atomic writing
+def _create_unique(folder: Path, prefix: str, suffix: str, *, directory: bool) -> Path:
+    """Create a new folder or empty file ``folder/PREFIX<random>SUFFIX`` and return its path.
+
+    Like :func:`tempfile.mkdtemp`/:func:`tempfile.mkstemp` (a random name, created
+    exclusively, retried on a clash), but with the modes any other folder or file gets:
+    ``0o777``/``0o666`` less the process umask.
+    """
+    for _ in range(100):
+        path = folder / f"{prefix}{secrets.token_hex(4)}{suffix}"
+        try:
+            if directory:
+                os.mkdir(path, 0o777)
+            else:
+                os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+        except FileExistsError:
+            continue
+        return path
+    raise FileExistsError(f"no free name {prefix}XXXXXXXX{suffix} in {folder}")
+
+
 def check_output_folder(path: str | os.PathLike, *, overwrite: bool = False,
                         what: str = "output folder") -> Path:
     """Check, before any work, that :func:`atomic_folder` can write ``path``.
@@ -236,7 +261,7 @@ def atomic_folder(target: str | os.PathLike, *, overwrite: bool = False,
     target = check_output_folder(target, what=what, overwrite=overwrite)
     target.parent.mkdir(parents=True, exist_ok=True)
     try:
-        tmp = Path(tempfile.mkdtemp(prefix=target.name + INCOMPLETE_TAG, dir=target.parent))
+        tmp = _create_unique(target.parent, target.name + INCOMPLETE_TAG, "", directory=True)
     except OSError as exc:
         raise OutputError(f"{what} {target}: cannot create a folder in {target.parent} "
                           f"({exc.strerror or exc}); choose a writable location") from None
@@ -291,10 +316,8 @@ def atomic_file(target: str | os.PathLike) -> Iterator[Path]:
         raises.
     """
     target = Path(target)
-    fd, name = tempfile.mkstemp(prefix=target.stem + INCOMPLETE_TAG, suffix=target.suffix,
-                                dir=target.parent if str(target.parent) else ".")
-    os.close(fd)
-    tmp = Path(name)
+    tmp = _create_unique(target.parent, target.stem + INCOMPLETE_TAG, target.suffix,
+                         directory=False)
     try:
         yield tmp
     except BaseException:

@@ -16,6 +16,7 @@ __all__ = [
     "SynthesisError",
     "OutputError",
     "StoreLockedError",
+    "DataWarning",
 ]
 
 
@@ -26,6 +27,12 @@ class CasflutterError(Exception):
 class DataError(CasflutterError, ValueError):
     """Input--output data that cannot be used (NaN/inf, length mismatch, too short,
     not exciting enough)."""
+
+
+class DataWarning(UserWarning):
+    """Data that can be used but probably not as meant: a column of a record file that no
+    channel names, records whose chirp band or length miss the problem's lowest structural
+    mode (e.g. settings in seconds applied to a problem in nondimensional time)."""
 
 
 class OrderError(CasflutterError, ValueError):
@@ -56,13 +63,16 @@ class SynthesisError(CasflutterError, RuntimeError):
     """Fixed-order synthesis found no stabilising controller.
 
     ``.best_spectral_abscissa`` holds the smallest closed-loop spectral abscissa
-    reached over all starts.
+    reached over all starts, ``.starts`` the record of every start (with its status and
+    why it failed).
     """
 
-    def __init__(self, message: str, best_spectral_abscissa: float | None = None, result=None):
+    def __init__(self, message: str, best_spectral_abscissa: float | None = None, result=None,
+                 starts: tuple = ()):
         super().__init__(message)
         self.best_spectral_abscissa = best_spectral_abscissa
         self.result = result
+        self.starts = tuple(starts)
 
 
 class OutputError(CasflutterError, OSError):

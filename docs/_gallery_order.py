@@ -14,6 +14,7 @@ ORDER = (
     "plot_seed_wing_control_models.py",
     "plot_flutter_mode_residues.py",
     "plot_two_controllers.py",
+    "plot_family_verification.py",
     "plot_wing_file.py",
     "plot_sweep.py",
     "plot_sensitivity.py",

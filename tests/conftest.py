@@ -42,11 +42,11 @@ def numpy_global_seed():
 @pytest.fixture(scope="session")
 def default_rom_loop():
     """``(ΣAE, Vf)``: the seed wing's default run's ROM loop (seed 0), the frozen loop of eq. 8
-    kept in ``problems/seed_wing/rom_loop_seed0.npz``; immutable, so shared by the session."""
+    kept in ``problems/seed_wing_rom/rom_loop_seed0.npz``; immutable, so shared by the session."""
     from casflutter._resources import problems_dir
     from casflutter.aeroelastic import load_rom_loop
 
-    return load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
+    return load_rom_loop(problems_dir() / "seed_wing_rom" / "rom_loop_seed0.npz")
 
 
 @pytest.fixture(scope="session")

@@ -9,9 +9,15 @@
   :class:`PlantFamily` — any linear plant over a speed range (named inputs and outputs,
   controls and measurements, units, feedback convention), of which every loop family is one;
   :class:`GriddedFamily` — state-space models at a grid of speeds, interpolated;
+  :func:`load_family` / :func:`write_family` — a gridded family from / to a family file
+  (``kind = "plant_family"``: a TOML file and an ``.npz`` or MATLAB ``.mat`` data file);
+  :class:`FlapWingFamily` — the Goland wing with flap segments behind actuators, rate gyros
+  and accelerometers (a 50-state, 4-input, 8-output family);
   :func:`load_rom_loop` — a ROM loop kept in an ``.npz`` file.
 - :func:`track_eigenvalues`, :func:`find_flutter` — branch tracking by eigenvector
-  continuity, V–g / V–f data, flutter (Hopf) and divergence speeds.
+  continuity, V–g / V–f data, flutter (Hopf) and divergence speeds;
+  :func:`family_flutter` — every crossing of a plant family, exact derivatives on its
+  polynomial pieces.
 - :func:`mode_residues` — a mode's residues in the flap-to-sensor loop along V: the flap's
   grip on the flutter mode and the phase a controller needs to damp it.
 - :func:`simulate_loop` — the nonlinear discrete ROM in feedback with Σs (paper Fig. 9).
@@ -21,6 +27,9 @@
 """
 
 from ._family import FEEDBACK_SIGNS, FamilySignals, GriddedFamily, PlantFamily
+from ._family_flutter import family_flutter
+from ._family_io import family_record, load_family, write_family
+from ._flap_wing import FlapWingFamily
 from ._flutter import Crossing, FlutterResult, find_flutter, origin_modes
 from ._lft import AeroelasticLFT, build_lft
 from ._loop import (AeroelasticLoop, AeroelasticSystem, LoopFamily, ParametricSystem,
@@ -35,6 +44,7 @@ from ._truth_loop import TruthLoop
 
 __all__ = [
     "PlantFamily", "FamilySignals", "GriddedFamily", "FEEDBACK_SIGNS",
+    "load_family", "write_family", "family_record", "FlapWingFamily", "family_flutter",
     "AeroelasticSystem", "AeroelasticLoop", "LoopFamily", "ParametricSystem", "ServoSystem",
     "aeroelastic_loop",
     "split_sigma_f",

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
+from ..data import check_grid_speeds, check_stack
 from ..errors import ConfigError, DimensionError
 
 __all__ = ["FEEDBACK_SIGNS", "FamilySignals", "PlantFamily", "GriddedFamily"]
@@ -340,27 +341,6 @@ class PlantFamily(abc.ABC):
                 + (f", disturbances {list(s.disturbances)}" if s.disturbances else ""))
 
 
-def _stack(name: str, M, k: int, rows: int | None, cols: int | None) -> np.ndarray:
-    """``M`` as a finite float array of shape ``(k, rows, cols)`` (None: any size)."""
-    try:
-        M = np.asarray(M, dtype=float)
-    except (TypeError, ValueError):
-        raise DimensionError(f"{name} is not a numeric array (ragged or not numbers); give "
-                             f"a ({k}, rows, cols) array, one matrix per grid speed") from None
-    if M.ndim != 3 or M.shape[0] != k or (rows is not None and M.shape[1] != rows) or \
-            (cols is not None and M.shape[2] != cols):
-        want = f"({k}, {rows if rows is not None else 'rows'}, " \
-               f"{cols if cols is not None else 'cols'})"
-        raise DimensionError(f"{name} has shape {M.shape}; it must be {want}: one matrix per "
-                             "grid speed, the same size at every speed")
-    bad = np.argwhere(~np.isfinite(M))
-    if bad.size:
-        j = tuple(int(x) for x in bad[0])
-        raise DimensionError(f"{name}{list(j)} is {M[j]} (not finite); {len(bad)} entries of "
-                             f"{name} are not finite")
-    return M
-
-
 class GriddedFamily(PlantFamily):
     """A plant family given at a grid of speeds, linearly interpolated between them.
 
@@ -397,21 +377,15 @@ class GriddedFamily(PlantFamily):
     def __init__(self, speeds, A, B, C, D, signals: FamilySignals | None = None, *,
                  speed_unit: str = "m/s", time_unit: str = "s", feedback: str = "negative",
                  name: str = "gridded plant family"):
-        try:
-            v = np.asarray(speeds, dtype=float).ravel()
-        except (TypeError, ValueError):
-            raise ConfigError("speeds is not a list of numbers") from None
-        if v.size < 2 or not np.all(np.isfinite(v)) or np.any(np.diff(v) <= 0):
-            raise ConfigError(f"speeds must be finite and strictly increasing, at least two; "
-                              f"got {v.tolist()[:8]}{' ...' if v.size > 8 else ''}")
+        v = check_grid_speeds(speeds)
         k = v.size
-        A = _stack("A", A, k, None, None)
+        A = check_stack("A", A, k, None, None)
         n = A.shape[1]
         if A.shape[2] != n:
             raise DimensionError(f"A has shape {A.shape}; each A must be square (n, n)")
-        B = _stack("B", B, k, n, None)
-        C = _stack("C", C, k, None, n)
-        D = _stack("D", D, k, C.shape[1], B.shape[2])
+        B = check_stack("B", B, k, n, None)
+        C = check_stack("C", C, k, None, n)
+        D = check_stack("D", D, k, C.shape[1], B.shape[2])
         m, p = B.shape[2], C.shape[1]
         if signals is None:
             signals = FamilySignals([f"u{i + 1}" for i in range(m)],

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq, linear_sum_assignment
 
+from .._format import result_repr
 from ..errors import ConfigError
 from ._tracking import (EigenTracking, as_matrix_fn, eig_sorted_by_reference,
                         track_eigenvalues)
@@ -53,6 +54,8 @@ class Crossing:
     bracket : tuple of float
         Grid interval that contained the sign change.
     """
+
+    __repr__ = result_repr
 
     V: float
     eigenvalue: complex
@@ -103,6 +106,8 @@ class FlutterResult:
     message : str
         Human-readable summary.
     """
+
+    __repr__ = result_repr
 
     status: str
     Vf: float | None
@@ -242,27 +247,62 @@ def find_flutter(system, V_range=None, *, V_grid=None, n_grid: int = 101, mode_s
     ('flutter', 2.1704, 0.6443)
     """
     fn = as_matrix_fn(system)
-    if V_grid is None:
-        if V_range is None or len(V_range) != 2 or not V_range[0] < V_range[1]:
-            raise ConfigError("give V_range=(V_low, V_high) with V_low < V_high, or V_grid")
-        if n_grid < 2:
-            raise ConfigError(f"n_grid must be >= 2, got {n_grid}")
-        V_grid = np.linspace(float(V_range[0]), float(V_range[1]), int(n_grid))
-    if mode_states is None:
-        mode_states = getattr(system, "mode_states", None)
-    if omega is None and hasattr(system, "structure"):
-        omega = system.structure.omega
-    elif omega is None and hasattr(system, "modal_structure"):  # a truth simulator
-        omega = system.modal_structure().omega
+    V_grid = _speed_grid(V_range, V_grid, n_grid)
+    mode_states, omega = _origin_information(system, mode_states, omega)
     tr = track_eigenvalues(fn, V_grid, min_score=min_score, max_refine=max_refine)
     origin = origin_modes(tr, mode_states=mode_states, omega=omega)
     lam = tr.eigenvalues
     scale = max(float(np.max(np.abs(lam))), 1.0)
     sa0 = float(np.max(lam[0].real))
     unstable0 = sa0 > 1e-12 * scale
+    crossings = _crossings(fn, tr, origin, scale, xtol_rel)
+    flut = next((c for c in crossings if c.kind == "flutter" and c.direction == "destabilizing"), None)
+    div = next((c for c in crossings if c.kind == "divergence" and c.direction == "destabilizing"), None)
+    status, msg = _status_message(flut, div, tr)
+    if unstable0:
+        msg += (f"; WARNING: unstable already at V = {tr.V[0]:g} (spectral abscissa {sa0:.3g}), "
+                "e.g. an unstable ROM: crossings are not instability onsets")
+        warnings.warn(msg, RuntimeWarning, stacklevel=2)
+    if any(not c.converged for c in crossings):
+        msg += "; some crossings were not refined to tolerance (see Crossing.converged)"
+    return FlutterResult(
+        status=status, Vf=None if flut is None else flut.V,
+        omega_f=None if flut is None else flut.omega,
+        frequency_hz=None if flut is None else flut.frequency_hz,
+        flutter_mode=None if flut is None else flut.origin_mode, flutter=flut, divergence=div,
+        crossings=tuple(crossings), unstable_at_start=unstable0, spectral_abscissa_start=sa0,
+        tracking=tr, origin=origin, message=msg)
 
+
+def _speed_grid(V_range, V_grid, n_grid: int) -> np.ndarray:
+    """The speed grid of :func:`find_flutter`: ``V_grid`` or ``n_grid`` points on
+    ``V_range``."""
+    if V_grid is not None:
+        return V_grid
+    if V_range is None or len(V_range) != 2 or not V_range[0] < V_range[1]:
+        raise ConfigError("give V_range=(V_low, V_high) with V_low < V_high, or V_grid")
+    if n_grid < 2:
+        raise ConfigError(f"n_grid must be >= 2, got {n_grid}")
+    return np.linspace(float(V_range[0]), float(V_range[1]), int(n_grid))
+
+
+def _origin_information(system, mode_states, omega):
+    """``mode_states`` and ``omega`` for :func:`origin_modes`: the given ones, else the
+    system's (``mode_states``, ``structure.omega`` or a truth's ``modal_structure().omega``)."""
+    if mode_states is None:
+        mode_states = getattr(system, "mode_states", None)
+    if omega is None and hasattr(system, "structure"):
+        omega = system.structure.omega
+    elif omega is None and hasattr(system, "modal_structure"):  # a truth simulator
+        omega = system.modal_structure().omega
+    return mode_states, omega
+
+
+def _crossings(fn, tr: EigenTracking, origin, scale: float, xtol_rel: float) -> list:
+    """Every imaginary-axis crossing of the tracked branches, refined by Brent's method and
+    sorted by speed (one per conjugate pair)."""
     crossings = []
-    re = lam.real
+    re = tr.eigenvalues.real
     for b in range(tr.n_branches):
         s = np.sign(re[:, b])
         for k in np.flatnonzero(s[:-1] * s[1:] < 0):
@@ -282,29 +322,17 @@ def find_flutter(system, V_range=None, *, V_grid=None, n_grid: int = 101, mode_s
                 direction="destabilizing" if re[k + 1, b] > re[k, b] else "stabilizing",
                 slope=float(slope), converged=ok, bracket=(float(tr.V[k]), float(tr.V[k + 1]))))
     crossings.sort(key=lambda c: c.V)
-    flut = next((c for c in crossings if c.kind == "flutter" and c.direction == "destabilizing"), None)
-    div = next((c for c in crossings if c.kind == "divergence" and c.direction == "destabilizing"), None)
+    return crossings
+
+
+def _status_message(flut, div, tr: EigenTracking) -> tuple[str, str]:
+    """The status of :class:`FlutterResult` and its one-line summary."""
     if flut is not None:
-        status = "flutter"
-        msg = (f"flutter at V = {flut.V:.10g}, {flut.omega:.6g} rad/s ({flut.frequency_hz:.6g} Hz), "
-               + (f"structural mode {flut.origin_mode + 1} (numbered from 1)"
-                  if flut.origin_mode >= 0 else f"branch {flut.branch} (not a structural mode)"))
-    elif div is not None:
-        status, msg = "divergence", f"no flutter; static divergence at V = {div.V:.10g}"
-    else:
-        status = "no_crossing"
-        msg = (f"no eigenvalue crosses the imaginary axis for V in [{tr.V[0]:g}, {tr.V[-1]:g}]; "
-               "no flutter speed in this range (extend the range)")
-    if unstable0:
-        msg += (f"; WARNING: unstable already at V = {tr.V[0]:g} (spectral abscissa {sa0:.3g}), "
-                "e.g. an unstable ROM: crossings are not instability onsets")
-        warnings.warn(msg, RuntimeWarning, stacklevel=2)
-    if any(not c.converged for c in crossings):
-        msg += "; some crossings were not refined to tolerance (see Crossing.converged)"
-    return FlutterResult(
-        status=status, Vf=None if flut is None else flut.V,
-        omega_f=None if flut is None else flut.omega,
-        frequency_hz=None if flut is None else flut.frequency_hz,
-        flutter_mode=None if flut is None else flut.origin_mode, flutter=flut, divergence=div,
-        crossings=tuple(crossings), unstable_at_start=unstable0, spectral_abscissa_start=sa0,
-        tracking=tr, origin=origin, message=msg)
+        return "flutter", (
+            f"flutter at V = {flut.V:.6g}, {flut.omega:.6g} rad/s ({flut.frequency_hz:.6g} Hz), "
+            + (f"structural mode {flut.origin_mode + 1} (numbered from 1)"
+               if flut.origin_mode >= 0 else f"branch {flut.branch} (not a structural mode)"))
+    if div is not None:
+        return "divergence", f"no flutter; static divergence at V = {div.V:.6g}"
+    return "no_crossing", (f"no eigenvalue crosses the imaginary axis for V in [{tr.V[0]:g}, "
+                           f"{tr.V[-1]:g}]; no flutter speed in this range (extend the range)")

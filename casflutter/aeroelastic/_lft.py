@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError
 from ._loop import AeroelasticSystem
 
@@ -57,6 +58,8 @@ class AeroelasticLFT:
     sensor : str
         Sensor kind of Σs (see :mod:`casflutter.structure`).
     """
+
+    __repr__ = result_repr
 
     Vf: float
     A: np.ndarray
@@ -172,9 +175,7 @@ def build_lft(system: AeroelasticSystem, Vf: float) -> AeroelasticLFT:
     Examples
     --------
     >>> import casflutter as cf
-    >>> truth = cf.load_problem("typical_section")
-    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
-    >>> rom = cf.identify_common_denominator(data).model
+    >>> truth, rom = cf.load_problem("typical_section"), cf.example_rom()
     >>> system = cf.AeroelasticSystem.from_parts(cf.realize(rom).sigma_f, truth.modal_structure())
     >>> lft = cf.build_lft(system, cf.find_flutter(system, (0.5, 3.0)).Vf)
     >>> lft.nmeas, lft.ncon, lft.n_delta

@@ -26,6 +26,7 @@ from dataclasses import dataclass, replace
 import control
 import numpy as np
 
+from .._format import result_repr
 from .._linalg import spectral_abscissa
 from ..errors import ConfigError, DimensionError
 from ..structure import ModalStructure
@@ -95,6 +96,8 @@ class AeroelasticLoop:
     n_modes, n_f : int
         N and the order of Σf; the state is ``x = (x_s, x_f)``.
     """
+
+    __repr__ = result_repr
 
     V: float
     A: np.ndarray
@@ -396,6 +399,8 @@ class AeroelasticSystem(LoopFamily):
     ``B̂2(V) = [V² Bs df; (V/V0) bf]``.
     """
 
+    __repr__ = result_repr
+
     structure: ModalStructure
     Af: np.ndarray
     Bf: np.ndarray
@@ -638,6 +643,8 @@ class ParametricSystem(LoopFamily):
         The ROMs' outputs do not match Σs's modes (both named).
     """
 
+    __repr__ = result_repr
+
     rom: object
     structure: ModalStructure
     speed_degree = None    # Σf interpolated between the ROMs' speeds
@@ -729,6 +736,8 @@ class ServoSystem(LoopFamily):
     ConfigError
         A frequency or damping out of range.
     """
+
+    __repr__ = result_repr
 
     system: object
     servo_omega: float

@@ -26,11 +26,12 @@ Brent's method on ``U -> Re s(U)``.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import brentq
 
+from .._format import result_repr
 from ..data import GAFTable
 from ..errors import ConfigError, ConvergenceError, DataError, DimensionError
 from ..structure import ModalStructure
@@ -72,6 +73,8 @@ class PKResult:
         Summary.
     """
 
+    __repr__ = result_repr
+
     U: np.ndarray
     modes: tuple[int, ...]
     mode_names: tuple[str, ...]
@@ -109,7 +112,8 @@ class _PK:
 
     def __init__(self, table: GAFTable, structure: ModalStructure, U_ref: float,
                  tol: float, max_iter: int):
-        self.t, self.s, self.U_ref = table, structure, U_ref
+        self.t, self.s = table, structure
+        self.speed = replace(structure.speed, U_ref=U_ref)   # V = U / U_ref
         self.N = structure.n_modes
         self.tol, self.max_iter = tol, max_iter
         self.dk0 = 1e-9 * max(float(table.k[-1]), 1.0)
@@ -124,7 +128,7 @@ class _PK:
                 QIk = Q.imag / k
         except DataError:
             raise DataError(
-                f"p-k: mode {mode} ({self.t.mode_names[mode]!r}) at U = {U:g} m/s needs "
+                f"p-k: mode {mode + 1} ({self.t.mode_names[mode]!r}) at U = {U:g} m/s needs "
                 f"k = {k:.4g}, outside the table's k = [{self.t.k[0]:g}, {self.t.k[-1]:g}]; "
                 "extend the table or track fewer modes (modes=...)") from None
         return Q.real, QIk
@@ -132,7 +136,7 @@ class _PK:
     def roots(self, U: float, k: float, mode: int) -> np.ndarray:
         """All roots ``s`` of the real quadratic problem at ``(U, k)``."""
         s, N = self.s, self.N
-        q = s.alpha * (U / self.U_ref) ** 2
+        q = s.alpha * self.speed.speed_index(U) ** 2
         QR, QIk = self._QR_QIk(k, mode, U)
         K = np.diag(s.omega ** 2) - q * QR
         C = np.diag(2.0 * s.zeta * s.omega) - q * (self.t.b / U) * QIk
@@ -154,7 +158,7 @@ class _PK:
                 return s_cur, it
             k = k_new
         raise ConvergenceError(
-            f"p-k did not converge for mode {mode} ({self.t.mode_names[mode]!r}) at "
+            f"p-k did not converge for mode {mode + 1} ({self.t.mode_names[mode]!r}) at "
             f"U = {U:g} m/s after {self.max_iter} iterations (last k = {k:.6g}); use finer "
             "speed steps or raise max_iter")
 
@@ -252,7 +256,7 @@ def pk_flutter(table: GAFTable, structure: ModalStructure, speeds, *, U_ref: flo
         return PKResult(U, modes, names, lam, kk, its, False, None, None, None, None, msg)
     Uf, sf, m = best
     kf = sf.imag * table.b / Uf
-    msg = (f"p-k flutter at U = {Uf:.6g} m/s, {sf.imag:.6g} rad/s (k = {kf:.4g}), mode {m} "
-           f"({table.mode_names[m]!r})")
-    log.info(msg)
+    msg = (f"p-k flutter at U = {Uf:.6g} m/s, {sf.imag:.6g} rad/s (k = {kf:.4g}), mode "
+           f"{m + 1} ({table.mode_names[m]!r})")
+    log.debug(msg)
     return PKResult(U, modes, names, lam, kk, its, True, Uf, float(sf.imag), float(kf), m, msg)

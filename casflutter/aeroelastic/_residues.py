@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError
 from ._tracking import _eig
 
@@ -47,6 +48,8 @@ class ModeResidues:
         was followed without doubt; below the call's ``min_score``: a step still ambiguous
         after ``max_refine`` bisections, e.g. where two modes veer).
     """
+
+    __repr__ = result_repr
 
     V: np.ndarray
     eigenvalue: np.ndarray

@@ -31,19 +31,21 @@ terms then carry the aerodynamic damping and apparent mass).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError, DimensionError
 from ..realize import RationalApproximation
-from ..structure import ModalStructure
+from ..structure import AirspeedMixin, ModalStructure, SpeedConvention
 
 __all__ = ["RFASystem"]
 
 
 @dataclass(frozen=True)
-class RFASystem:
+class RFASystem(AirspeedMixin):
     """The aeroelastic system of an RFA and a modal structure, in the airspeed ``U``.
 
     Parameters
@@ -62,6 +64,8 @@ class RFASystem:
     ConfigError
         ``U_ref`` not positive.
     """
+
+    __repr__ = result_repr
 
     rfa: RationalApproximation
     structure: ModalStructure
@@ -93,16 +97,19 @@ class RFASystem:
 
     @property
     def mode_states(self) -> list[np.ndarray]:
-        """State indices ``[u_i, u_i']`` of each mode (for :func:`find_flutter`)."""
-        return [np.array([2 * i, 2 * i + 1]) for i in range(self.n_modes)]
+        """State indices ``[u_i, u_i']`` of each mode (for :func:`find_flutter`): the
+        structure's layout, its states first."""
+        return self.structure.mode_states
 
-    def speed_index(self, U: float) -> float:
-        """``V = U / U_ref``."""
-        return float(U) / self.U_ref
-
-    def airspeed(self, V: float) -> float:
-        """``U = V U_ref`` [m/s]."""
-        return float(V) * self.U_ref
+    @cached_property
+    def speed(self) -> SpeedConvention:
+        """The speed convention ``V = U / U_ref``: the structure's when it has this
+        ``U_ref``, else one with the structure's unit of time."""
+        own = self.structure.speed
+        if own.U_ref == self.U_ref:
+            return own
+        return SpeedConvention(f"V = U / U_ref, U_ref = {self.U_ref:g} m/s", own.time_unit,
+                               U_ref=self.U_ref)
 
     def _check_U(self, U) -> float:
         U = float(U)
@@ -115,7 +122,7 @@ class RFASystem:
         U = self._check_U(U)
         r, s = self.rfa, self.structure
         N, b = self.n_modes, r.b
-        q = s.alpha * (U / self.U_ref) ** 2
+        q = s.alpha * self.speed_index(U) ** 2
         bu = b / U
         A0, A1, A2 = r.A
         Minv = np.linalg.inv(np.eye(N) - q * bu * bu * A2[:, :N])
@@ -134,7 +141,8 @@ class RFASystem:
         Parameters
         ----------
         U : float
-            Airspeed [m/s].
+            Airspeed [m/s] (> 0): the lag rates ``gamma U / b`` and the forcing
+            ``alpha (U / U_ref)^2`` follow it.
 
         Returns
         -------
@@ -159,7 +167,7 @@ class RFASystem:
         Parameters
         ----------
         U : float
-            Airspeed [m/s].
+            Airspeed [m/s] (> 0), as in :meth:`state_matrix`.
 
         Returns
         -------

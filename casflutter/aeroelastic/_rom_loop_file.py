@@ -1,7 +1,7 @@
 """ΣAE(V) kept in a file: Σf, the modal structure and the loop's flutter speed (eq. 5-9).
 
 A run's ROM loop is rebuilt from the identified model in seconds, but benchmarks, tests and
-examples that study one fixed loop (e.g. the default run's, ``problems/seed_wing/
+examples that study one fixed loop (e.g. the default run's, ``problems/seed_wing_rom/
 rom_loop_seed0.npz``) read it from an ``.npz`` so that they do not depend on the
 identification's last digits.
 """
@@ -54,7 +54,7 @@ def load_rom_loop(path: str | os.PathLike) -> tuple[AeroelasticSystem, float]:
     missing = [k for k in _KEYS if k not in d]
     if missing:
         raise DataError(f"{path}: missing {missing}; the file needs {list(_KEYS)} "
-                        "(see problems/seed_wing/rom_loop_seed0.npz)")
+                        "(see problems/seed_wing_rom/rom_loop_seed0.npz)")
     s = ModalStructure(omega=d["omega"], zeta=d["zeta"], alpha=float(d["alpha"]), Hs=d["Hs"],
                        sensor=str(d["sensor"]))
     return (AeroelasticSystem(s, d["Af"], d["Bf"], d["bf"], d["Cf"], d["Df"], d["df"]),

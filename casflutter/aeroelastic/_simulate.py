@@ -32,6 +32,7 @@ import control
 import numpy as np
 from scipy.linalg import expm
 
+from .._format import result_repr
 from ..data import ResponseAnalysis, analyze_response
 from ..errors import ConfigError, DimensionError
 from ..structure import ModalStructure
@@ -66,6 +67,8 @@ class LoopSimulation:
     sensors : ResponseAnalysis or None
         The same for the sensors.
     """
+
+    __repr__ = result_repr
 
     timepts: np.ndarray
     xs: np.ndarray
@@ -131,10 +134,12 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
         Speed index (forcing ``V² y``).
     n_steps : int
         Number of ROM samples.
-    xs0 : array_like (2N,), optional
-        Initial structural state ``[u_1, u̇_1, ...]`` (zero by default).  The ROM's past
-        inputs are the initial displacements held constant (the wing is held deflected and
-        released at t = 0); its past outputs and flap inputs are zero.
+    xs0 : ModalState or array_like (2N,), optional
+        Initial structural state: a :class:`~casflutter.structure.ModalState` (e.g.
+        ``structure.displaced_state(mode, deflection)``) or Σs's own state
+        ``[u_1, u̇_1, ...]`` (zero by default).  The ROM's past inputs are the initial
+        displacements held constant (the wing is held deflected and released at t = 0); its
+        past outputs and flap inputs are zero.
     w : None, callable t -> (N,), or array (n_steps, N)
         Disturbance added to ``V² y`` (eq. 7).
     v : None, callable t -> float, or array (n_steps,)
@@ -160,9 +165,7 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
     Examples
     --------
     >>> import casflutter as cf
-    >>> truth = cf.load_problem("typical_section")
-    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
-    >>> rom = cf.identify_common_denominator(data).model
+    >>> truth, rom = cf.load_problem("typical_section"), cf.example_rom()
     >>> structure = truth.modal_structure()
     >>> sim = cf.simulate_loop(rom, structure, 1.5, 500, xs0=structure.displaced_state(1, 0.01))
     >>> sim.zm.shape, bool(abs(sim.zm[-50:]).max() < 0.1 * abs(sim.zm[:50]).max())
@@ -173,39 +176,66 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
     _check_rom(rom, N)
     if n_steps < 2:
         raise ConfigError(f"n_steps must be >= 2, got {n_steps}")
-    dt, L = float(rom.dt), int(rom.max_lag)
-    V2 = float(V) ** 2
+    dt = float(rom.dt)
+    W = _signal(w, n_steps, dt, N, "w")
+    Vext = _signal(v, n_steps, dt, None, "v")
+    Kd = None if controller is None else _discrete_controller(controller, m, dt)
+    g = (lambda t: 1.0) if gain is None else gain
+    xs = s.layout.initial(xs0, s.n_states)
+    rec, stopped = _run_loop(rom, s, float(V), xs, W, Vext, Kd, g, n_steps, blowup)
+    n = len(rec["u"])
+    tpts = dt * np.arange(n)
+    U = np.asarray(rec["u"])
+    Z = np.asarray(rec["zm"]).reshape(n, m)
+    modes = analyze_response(tpts, U, window=window, tol=tol, blowup=blowup)
+    sens = analyze_response(tpts, Z, window=window, tol=tol, blowup=np.inf) if m else None
+    if stopped:
+        modes = ResponseAnalysis("divergence", modes.growth_rate, modes.amplitude, modes.frequency_hz,
+                                 modes.omega, modes.dominant, modes.spectrum_freq_hz, modes.spectrum,
+                                 modes.window)
+    return LoopSimulation(tpts, np.asarray(rec["xs"]), U, np.asarray(rec["y"]), Z,
+                          np.asarray(rec["v"], dtype=float), W[:n], np.asarray(rec["g"], dtype=float),
+                          float(V), dt, stopped, modes, sens)
+
+
+def _discrete_controller(controller: control.StateSpace, m: int, dt: float):
+    """The controller's ``(A, B, C, D)`` sampled with a zero-order hold at the ROM's ``dt``
+    (as given when it is already discrete at that ``dt``)."""
+    if controller.ninputs != m or controller.noutputs != 1:
+        raise DimensionError(f"the controller has {controller.ninputs} inputs and "
+                             f"{controller.noutputs} outputs; it needs {m} inputs (sensors) and 1 output (flap)")
+    if controller.dt not in (0, None) and not np.isclose(controller.dt, dt):
+        raise ConfigError(f"the discrete controller has dt={controller.dt} but the ROM has "
+                          f"dt={dt}; give a continuous controller or one sampled at the ROM's dt")
+    Kd = control.sample_system(controller, dt, method="zoh") if controller.dt == 0 else controller
+    return tuple(np.atleast_2d(np.asarray(M, dtype=float)) for M in (Kd.A, Kd.B, Kd.C, Kd.D))
+
+
+def _run_loop(rom, s: ModalStructure, V: float, xs, W, Vext, Kd, g, n_steps: int,
+              blowup: float):
+    """The sample-by-sample recursion of the module docstring (steps 1-5) from the
+    structural state ``xs``: the records per key and whether the run blew up."""
+    N, L, dt = s.n_modes, int(rom.max_lag), float(rom.dt)
+    V2 = V ** 2
     nx = s.n_states
     E = expm(np.block([[s.As, s.Bs], [np.zeros((N, nx + N))]]) * dt)
     Ad, Bd = E[:nx, :nx], E[:nx, nx:]
     Hx, Hf = s.sensor_matrices()
     Cs = s.Cs
-    W = _signal(w, n_steps, dt, N, "w")
-    Vext = _signal(v, n_steps, dt, None, "v")
-    if controller is not None:
-        if controller.ninputs != m or controller.noutputs != 1:
-            raise DimensionError(f"the controller has {controller.ninputs} inputs and "
-                                 f"{controller.noutputs} outputs; it needs {m} inputs (sensors) and 1 output (flap)")
-        if controller.dt not in (0, None) and not np.isclose(controller.dt, dt):
-            raise ConfigError(f"the discrete controller has dt={controller.dt} but the ROM has "
-                              f"dt={dt}; give a continuous controller or one sampled at the ROM's dt")
-        Kd = control.sample_system(controller, dt, method="zoh") if controller.dt == 0 else controller
-        Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (Kd.A, Kd.B, Kd.C, Kd.D))
+    if Kd is not None:
+        Ak, Bk, Ck, Dk = Kd
         xk = np.zeros(Ak.shape[0])
-        g = (lambda t: 1.0) if gain is None else gain
-    xs = np.zeros(nx) if xs0 is None else np.asarray(xs0, dtype=float).reshape(nx)
     y_hist, v_hist = np.zeros((L + 1, N)), np.zeros(L + 1)
     u_hist = np.tile(Cs @ xs, (L + 1, 1))  # held at the initial deflection before release
     F_prev = np.zeros(N)
     rec = {k: [] for k in ("xs", "u", "y", "zm", "v", "g")}
-    stopped = False
     for k in range(n_steps):
         t = k * dt
         uk = Cs @ xs
         zk = Hx @ xs + Hf @ F_prev
         vk = Vext[k]
         gk = 0.0
-        if controller is not None:
+        if Kd is not None:
             gk = float(g(t))
             vk = vk + gk * float((Ck @ xk + Dk @ zk)[0])
             xk = Ak @ xk + Bk @ zk
@@ -220,20 +250,7 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
         for key, val in (("xs", xs), ("u", uk), ("y", yk), ("zm", zk), ("v", vk), ("g", gk)):
             rec[key].append(val)
         if not (np.all(np.isfinite(yk)) and np.all(np.abs(uk) < blowup)):
-            stopped = True
-            break
+            return rec, True
         F_prev = V2 * yk + W[k]
         xs = Ad @ xs + Bd @ F_prev
-    n = len(rec["u"])
-    tpts = dt * np.arange(n)
-    U = np.asarray(rec["u"])
-    Z = np.asarray(rec["zm"]).reshape(n, m)
-    modes = analyze_response(tpts, U, window=window, tol=tol, blowup=blowup)
-    sens = analyze_response(tpts, Z, window=window, tol=tol, blowup=np.inf) if m else None
-    if stopped:
-        modes = ResponseAnalysis("divergence", modes.growth_rate, modes.amplitude, modes.frequency_hz,
-                                 modes.omega, modes.dominant, modes.spectrum_freq_hz, modes.spectrum,
-                                 modes.window)
-    return LoopSimulation(tpts, np.asarray(rec["xs"]), U, np.asarray(rec["y"]), Z,
-                          np.asarray(rec["v"], dtype=float), W[:n], np.asarray(rec["g"], dtype=float),
-                          float(V), dt, stopped, modes, sens)
+    return rec, False

@@ -21,6 +21,7 @@ from typing import Callable
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from .._format import result_repr
 from ..errors import ConfigError
 
 __all__ = ["EigenTracking", "track_eigenvalues", "eig_sorted_by_reference", "as_matrix_fn"]
@@ -105,6 +106,8 @@ class EigenTracking:
         Steps still below ``min_score`` after ``max_refine`` bisections (typically at an
         exceptional point where two eigenvectors coalesce).
     """
+
+    __repr__ = result_repr
 
     V: np.ndarray
     eigenvalues: np.ndarray

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError
 from ..structure import ModalStructure
 from ..truth import AeroelasticTruth
@@ -54,6 +55,8 @@ class TruthLoop(LoopFamily):
     ``Hs u'`` or ``Hs u''`` (the acceleration with its exact feed-through from the command
     and the disturbances) as the truth's sensor kind says.
     """
+
+    __repr__ = result_repr
 
     truth: AeroelasticTruth
     servo_omega: float

@@ -32,6 +32,7 @@ from .. import __version__
 from .._interrupt import Terminated, sigterm_raises
 from .._logging import PACKAGE_LOGGER, configure_cli_logging, remove_cli_logging
 from .._threads import single_threaded
+from ._help import plain_help
 from ..errors import CasflutterError
 
 __all__ = ["main", "build_parser", "EXIT_ERROR", "EXIT_INTERRUPTED", "EXIT_TERMINATED",
@@ -77,9 +78,27 @@ def _add_global_flags(parser: argparse.ArgumentParser, *, top: bool) -> None:
         parser.add_argument(*flags, **kw)
 
 
+class _Parser(argparse.ArgumentParser):
+    """An :class:`argparse.ArgumentParser` that matches options only by their full name.
+
+    With argparse's default prefix matching, an option a sub-command documents can be taken
+    by another parser: ``identify --v v`` (the flap column) was read by the top-level parser
+    as an ambiguous prefix of ``--version`` and ``--verbose``.  Sub-command parsers are made
+    by this class too (``add_subparsers`` builds them with the class of their parent), so a
+    new command gets the rule without asking for it.
+    """
+
+    def __init__(self, *args, **kwargs):
+        kwargs["allow_abbrev"] = False
+        super().__init__(*args, **kwargs)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    """The full argument parser (all discovered sub-commands)."""
-    parser = argparse.ArgumentParser(
+    """The full argument parser (all discovered sub-commands).
+
+    Every parser in it (top level, sub-commands, ``bench`` sub-commands) takes options only
+    by their full name (no prefix abbreviations, :class:`_Parser`)."""
+    parser = _Parser(
         prog="casflutter",
         description="Nonlinear aerodynamic ROMs, flutter analysis and fixed-order robust "
                     "flutter suppression (after Lum et al., ACC 2016).")
@@ -93,6 +112,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench.set_defaults(func=lambda args: (bench.print_help(), 2)[1])
     for p in [*sub.choices.values(), *bench_sub.choices.values()]:
         _add_global_flags(p, top=False)
+    plain_help(parser)       # the docstrings' reST markup as plain text
     return parser
 
 

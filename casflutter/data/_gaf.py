@@ -47,8 +47,9 @@ import numpy as np
 from scipy.interpolate import make_interp_spline
 from scipy.io import savemat
 
+from .._format import result_repr
 from ..errors import DataError
-from ._matfile import read_mat
+from ._matfile import mat_strings, read_mat
 
 __all__ = ["GAFTable", "load_gaf"]
 
@@ -103,6 +104,8 @@ class GAFTable:
         Non-increasing, negative or non-finite ``k``; real, non-finite or mis-shaped ``Q``;
         non-positive ``b``; ``mode_names`` of the wrong length.
     """
+
+    __repr__ = result_repr
 
     k: np.ndarray
     Q: np.ndarray
@@ -249,8 +252,8 @@ class GAFTable:
         Parameters
         ----------
         truth : object
-            Has ``generalized_aero_forces(k, theodorsen=...)``, ``params.b``, ``params.rho``,
-            ``airspeed(V)`` and ``modal_structure().mode_names``.
+            Has ``generalized_aero_forces(k, theodorsen=...)``, ``params.b`` and
+            ``modal_structure()`` (its mode names and speed convention: ``U_ref``, ``rho``).
         k : array_like
             Reduced frequencies.
         theodorsen : {"exact", "jones"}
@@ -261,9 +264,9 @@ class GAFTable:
         GAFTable
         """
         Q = truth.generalized_aero_forces(k, theodorsen=theodorsen)
-        return cls(np.asarray(k, float), Q, truth.params.b, U_ref=truth.airspeed(1.0),
-                   rho=getattr(truth.params, "rho", None),
-                   mode_names=truth.modal_structure().mode_names,
+        structure = truth.modal_structure()
+        return cls(np.asarray(k, float), Q, truth.params.b, U_ref=structure.speed.U_ref,
+                   rho=structure.speed.rho, mode_names=structure.mode_names,
                    source=f"{type(truth).__name__} strip theory, {theodorsen} Theodorsen C(k)")
 
     @classmethod
@@ -489,22 +492,10 @@ class GAFTable:
                             f"with nk = {k.size} (one N x M page per k); permute Q in MATLAB "
                             "(permute(Q, [2 3 1]) for an nk x N x M array)")
         opt = {key: mat[key] for key in ("U_ref", "rho") if key in mat}
-        names = _mat_strings(mat["mode_names"]) if "mode_names" in mat else ()
-        source = " ".join(_mat_strings(mat["source"])) if "source" in mat else path.name
+        names = mat_strings(mat["mode_names"], "mode_names") if "mode_names" in mat else ()
+        source = " ".join(mat_strings(mat["source"], "source")) if "source" in mat else path.name
         return _from_file(path, k, np.transpose(Q, (2, 0, 1)), mat["b"], names=names,
                           source=source, **opt)
-
-
-def _mat_strings(arr) -> tuple[str, ...]:
-    """Strings from a loadmat cell array or char matrix."""
-    a = np.asarray(arr)
-    if a.dtype == object:
-        return tuple(str(np.asarray(x).ravel()[0]).strip() if np.asarray(x).size else ""
-                     for x in a.ravel())
-    if a.dtype.kind == "U":
-        return tuple(str(s).strip() for s in a.ravel())
-    raise DataError(f"mode_names must be a cell array of strings or a char matrix, got "
-                    f"dtype {a.dtype}")
 
 
 def _from_file(path: Path, k, Q, b, *, names, source, **opt) -> GAFTable:

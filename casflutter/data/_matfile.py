@@ -14,6 +14,9 @@ elements, each an 8-byte tag ``(data type, number of bytes)`` -- or a 4-byte "sm
 whose upper 16 bits hold the size (at most 4 bytes of data) -- padded to 8 bytes; a
 ``miMATRIX`` element holds sub-elements (array flags, dimensions, name, data), and a
 ``miCOMPRESSED`` element holds zlib-compressed elements.
+
+:func:`_mat_matrix` turns one variable into the samples-by-channels float matrix the records
+need, or a DataError that says what the variable is instead.
 """
 
 from __future__ import annotations
@@ -22,11 +25,12 @@ import struct
 import zlib
 from pathlib import Path
 
+import numpy as np
 from scipy.io import loadmat
 
 from ..errors import DataError
 
-__all__ = ["read_mat", "check_mat5_layout"]
+__all__ = ["read_mat", "check_mat5_layout", "mat_strings"]
 
 _MI_MATRIX, _MI_COMPRESSED = 14, 15
 #: numeric/text data types and their item sizes (miINT8 ... miUTF32)
@@ -236,3 +240,68 @@ def read_mat(path) -> dict:
     except Exception as exc:  # noqa: BLE001 - any failure to parse the file is bad data
         raise DataError(f"{path}: cannot be read as a MAT-file ({type(exc).__name__}: {exc}); "
                         f"the file may be truncated or not a MAT-file -- {_FIX}") from None
+
+
+def mat_strings(arr, what: str = "names") -> tuple[str, ...]:
+    """Strings from what :func:`read_mat` returns for a cell array of strings or a char matrix.
+
+    Parameters
+    ----------
+    arr : array_like
+        A ``loadmat`` cell array (object array of char arrays) or char matrix (one string
+        per row).
+    what : str
+        The variable's name, for the message.
+
+    Returns
+    -------
+    tuple of str
+        Stripped of surrounding blanks (a char matrix pads its rows).
+
+    Raises
+    ------
+    DataError
+        Anything else (numbers, structs).
+    """
+    a = np.asarray(arr)
+    if a.dtype == object:
+        return tuple(str(np.asarray(x).ravel()[0]).strip() if np.asarray(x).size else ""
+                     for x in a.ravel())
+    if a.dtype.kind == "U":
+        return tuple(str(s).strip() for s in a.ravel())
+    raise DataError(f"{what} must be a cell array of strings or a char matrix, got "
+                    f"dtype {a.dtype}")
+
+
+def _mat_matrix(path: Path, name: str, value) -> np.ndarray:
+    """A numeric MATLAB variable as a float array, samples along the first axis."""
+    import scipy.sparse
+
+    if scipy.sparse.issparse(value):
+        value = value.toarray()
+    arr = np.asarray(value)
+    if arr.dtype.names:
+        raise DataError(f"{path}: variable {name!r} is a struct (fields "
+                        f"{list(arr.dtype.names)}); save the numeric field as its own variable "
+                        "and name that one")
+    if arr.dtype.kind in "USa":
+        raise DataError(f"{path}: variable {name!r} holds text, not numbers; name a numeric "
+                        "matrix")
+    if arr.dtype.kind == "O":
+        raise DataError(f"{path}: variable {name!r} is a cell array or an object; save the "
+                        "numbers as a plain matrix (cell2mat in MATLAB) and name that one")
+    if arr.dtype.kind == "c":
+        raise DataError(f"{path}: variable {name!r} is complex; the records are real time "
+                        "series -- save real(...) if the imaginary part is rounding noise")
+    if arr.dtype.kind not in "biuf":
+        raise DataError(f"{path}: variable {name!r} has MATLAB type {arr.dtype}, not a "
+                        "numeric matrix")
+    if arr.size == 0:
+        raise DataError(f"{path}: variable {name!r} is empty (size {arr.shape})")
+    if arr.ndim > 2:
+        raise DataError(f"{path}: variable {name!r} is {arr.ndim}-D (size {arr.shape}); give "
+                        "a samples-by-channels matrix")
+    arr = arr.astype(float)
+    if arr.ndim == 2 and arr.shape[0] < arr.shape[1]:
+        arr = arr.T
+    return arr

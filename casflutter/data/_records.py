@@ -10,140 +10,21 @@ from __future__ import annotations
 
 import csv
 import logging
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Sequence
 
 import numpy as np
 
-from ..errors import DataError
-from ._matfile import read_mat
+from .._format import result_repr
+from ..errors import DataError, DataWarning
+from ._matfile import _mat_matrix, read_mat
+from ._record import Record
 
 __all__ = ["Record", "IOData"]
 
 _log = logging.getLogger(__name__)
-
-
-def _check_finite(name: str, arr: np.ndarray, record: str) -> None:
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        idx = np.argwhere(bad)[0]
-        raise DataError(f"record {record!r}: signal {name} has {int(bad.sum())} NaN/inf "
-                        f"value(s), first at sample {int(idx[0])}; remove or interpolate them")
-
-
-def _real_array(name: str, value, record: str) -> np.ndarray:
-    """``value`` as a float array, refusing what would silently change its meaning: ragged
-    nesting, text, objects, complex numbers, dates, no samples."""
-    try:
-        arr = np.asarray(value)
-    except (ValueError, TypeError) as exc:  # ragged nesting (NumPy >= 1.24 refuses it)
-        raise DataError(f"record {record!r}: signal {name} is not a rectangular array "
-                        f"({exc}); give a (samples, channels) array with rows of equal "
-                        "length") from None
-    kind = arr.dtype.kind
-    if kind == "O":
-        try:
-            arr = arr.astype(float)
-        except (ValueError, TypeError):
-            try:
-                arr = arr.astype(complex)
-            except (ValueError, TypeError):
-                raise DataError(f"record {record!r}: signal {name} holds Python objects "
-                                "(ragged rows, text or None) that are not numbers; give a "
-                                "numeric (samples, channels) array") from None
-        kind = arr.dtype.kind
-    if kind == "c":
-        raise DataError(f"record {record!r}: signal {name} is complex; the records are real "
-                        "time series -- pass the real part (np.real) if the imaginary part "
-                        "is rounding noise")
-    if kind in "USV":
-        raise DataError(f"record {record!r}: signal {name} holds text (dtype {arr.dtype}), "
-                        "not numbers; convert it, e.g. np.asarray(x, dtype=float)")
-    if kind in "mM":
-        raise DataError(f"record {record!r}: signal {name} holds dates or durations (dtype "
-                        f"{arr.dtype}); give the sampled values, with the sampling time as dt")
-    if kind not in "biuf":
-        raise DataError(f"record {record!r}: signal {name} has dtype {arr.dtype}, not a "
-                        "number type")
-    arr = arr.astype(float)
-    if arr.ndim == 0:
-        raise DataError(f"record {record!r}: signal {name} is a single number; give one "
-                        "value per sample")
-    if arr.shape[0] == 0:
-        raise DataError(f"record {record!r}: signal {name} has no samples (shape "
-                        f"{arr.shape}); give at least one sample per channel")
-    return arr
-
-
-@dataclass(frozen=True)
-class Record:
-    """One input--output experiment sampled at a constant rate.
-
-    Attributes
-    ----------
-    y : ndarray, shape (K, N)
-        Outputs (generalised aerodynamic forces, or measured responses).
-    u : ndarray, shape (K, N) or None
-        Modal-displacement inputs (absent for e.g. shaker tests).
-    v : ndarray, shape (K,) or None
-        Scalar flap / actuator input (absent for e.g. CFD runs without flap).
-    name : str
-        Label used in messages and reports.
-    """
-
-    y: np.ndarray
-    u: np.ndarray | None = None
-    v: np.ndarray | None = None
-    name: str = "record"
-
-    def __post_init__(self):
-        y = _real_array("y", self.y, self.name)
-        if y.ndim == 1:
-            y = y[:, None]
-        if y.ndim != 2 or y.shape[1] == 0:
-            raise DataError(f"record {self.name!r}: y must be (samples, outputs) with at least "
-                            f"one output, got shape {y.shape}")
-        K = y.shape[0]
-        _check_finite("y", y, self.name)
-        object.__setattr__(self, "y", y)
-        if self.u is not None:
-            u = _real_array("u", self.u, self.name)
-            u = u[:, None] if u.ndim == 1 else u
-            if u.ndim != 2:
-                raise DataError(f"record {self.name!r}: u must be (samples, modal inputs), got "
-                                f"shape {u.shape}; reshape it to 2-D (e.g. u.reshape(len(u), "
-                                "-1)) if the extra axes are singletons")
-            if u.shape[0] != K:
-                raise DataError(f"record {self.name!r}: length mismatch, u has {u.shape[0]} "
-                                f"samples and y has {K}; trim them to a common length")
-            if u.shape[1] != y.shape[1]:
-                raise DataError(f"record {self.name!r}: u has {u.shape[1]} channels but y has "
-                                f"{y.shape[1]}; the HWL ROM maps N modal displacements to N "
-                                "generalised forces")
-            _check_finite("u", u, self.name)
-            object.__setattr__(self, "u", u)
-        if self.v is not None:
-            v = _real_array("v", self.v, self.name)
-            if v.ndim == 2 and 1 in v.shape:
-                v = v.ravel()
-            if v.ndim != 1:
-                raise DataError(f"record {self.name!r}: v must be one channel, got shape {v.shape}")
-            if v.shape[0] != K:
-                raise DataError(f"record {self.name!r}: length mismatch, v has {v.shape[0]} "
-                                f"samples and y has {K}; trim them to a common length")
-            _check_finite("v", v, self.name)
-            object.__setattr__(self, "v", v)
-        if self.u is None and self.v is None:
-            raise DataError(f"record {self.name!r} has no input: give u and/or v")
-
-    @property
-    def n_samples(self) -> int:
-        return int(self.y.shape[0])
-
-    @property
-    def n_outputs(self) -> int:
-        return int(self.y.shape[1])
 
 
 @dataclass(frozen=True)
@@ -173,6 +54,8 @@ class IOData:
     >>> d.n_modes, d.has_u, d.has_v
     (2, True, False)
     """
+
+    __repr__ = result_repr
 
     records: tuple[Record, ...]
     dt: float
@@ -247,6 +130,7 @@ class IOData:
         Returns
         -------
         IOData
+            One record of the arrays.
 
         Raises
         ------
@@ -346,6 +230,12 @@ class IOData:
         IOData
             One record named after the file, the channels named after the columns.
 
+        Warns
+        -----
+        DataWarning
+            A column that is neither an output, an input, the flap nor the time column
+            (named): the fit goes on without it, which is wrong when it is an input.
+
         Raises
         ------
         DataError
@@ -411,6 +301,15 @@ class IOData:
             if not np.allclose(steps, dt, rtol=1e-6, atol=1e-12):
                 raise DataError(f"{path}: time column {time!r} is not uniformly sampled "
                                 f"(steps from {steps.min():g} to {steps.max():g}); resample first")
+        unused = [c for c in header if c not in want and c != time]
+        if unused:
+            # a record's unnamed column is most often an input the fit needs (the flap, a
+            # modal displacement): without it the ROM fits the forces wrongly, with no error
+            warnings.warn(f"{path}: column(s) {unused} are not used: they are not among the "
+                          f"outputs y = {list(y)}, the modal inputs u = {list(u or [])} or the "
+                          f"flap v = {v!r}; if one is an input of the record, name it (u=, v=; "
+                          "--u/--v on the command line), else drop it from the file",
+                          DataWarning, stacklevel=2)
         Y = np.column_stack([col[c] for c in y])
         U = np.column_stack([col[c] for c in u]) if u else None
         V = col[v] if v else None
@@ -572,6 +471,7 @@ class IOData:
         Returns
         -------
         IOData
+            The same records at ``dt * factor``.
 
         Raises
         ------
@@ -687,37 +587,3 @@ def _read_npz(path: Path) -> dict[str, np.ndarray]:
                         f"{exc}); the file may be truncated or corrupt -- write it again "
                         "with np.savez") from None
     return arrays
-
-
-def _mat_matrix(path: Path, name: str, value) -> np.ndarray:
-    """A numeric MATLAB variable as a float array, samples along the first axis."""
-    import scipy.sparse
-
-    if scipy.sparse.issparse(value):
-        value = value.toarray()
-    arr = np.asarray(value)
-    if arr.dtype.names:
-        raise DataError(f"{path}: variable {name!r} is a struct (fields "
-                        f"{list(arr.dtype.names)}); save the numeric field as its own variable "
-                        "and name that one")
-    if arr.dtype.kind in "USa":
-        raise DataError(f"{path}: variable {name!r} holds text, not numbers; name a numeric "
-                        "matrix")
-    if arr.dtype.kind == "O":
-        raise DataError(f"{path}: variable {name!r} is a cell array or an object; save the "
-                        "numbers as a plain matrix (cell2mat in MATLAB) and name that one")
-    if arr.dtype.kind == "c":
-        raise DataError(f"{path}: variable {name!r} is complex; the records are real time "
-                        "series -- save real(...) if the imaginary part is rounding noise")
-    if arr.dtype.kind not in "biuf":
-        raise DataError(f"{path}: variable {name!r} has MATLAB type {arr.dtype}, not a "
-                        "numeric matrix")
-    if arr.size == 0:
-        raise DataError(f"{path}: variable {name!r} is empty (size {arr.shape})")
-    if arr.ndim > 2:
-        raise DataError(f"{path}: variable {name!r} is {arr.ndim}-D (size {arr.shape}); give "
-                        "a samples-by-channels matrix")
-    arr = arr.astype(float)
-    if arr.ndim == 2 and arr.shape[0] < arr.shape[1]:
-        arr = arr.T
-    return arr

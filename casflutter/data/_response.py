@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import find_peaks
 
+from .._format import result_repr
 from ..errors import ConfigError
 
 __all__ = ["ResponseAnalysis", "analyze_response", "envelope_growth_rate", "dominant_frequency"]
@@ -46,6 +47,8 @@ class ResponseAnalysis:
     window : tuple of float
         Start and end time of the analysed window.
     """
+
+    __repr__ = result_repr
 
     kind: str
     growth_rate: float

@@ -34,6 +34,7 @@ from typing import Any, Mapping
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..aeroelastic import AeroelasticLFT, AeroelasticSystem, build_lft
 from ..errors import ConfigError, SynthesisError
 from ._synthesis import SynthesisOptions, SynthesisResult, synthesize
@@ -69,6 +70,8 @@ class FlutterDesign:
     met : bool
         True when ``reached`` is the target.
     """
+
+    __repr__ = result_repr
 
     controller: control.StateSpace
     synthesis: SynthesisResult
@@ -250,7 +253,7 @@ def design_flutter_controller(system: AeroelasticSystem, Vf: float, order: int =
             e_new = edge(trial.controller)
         except SynthesisError:
             trial, e_new = None, e
-        log.info("interval design: target V = %.4g -> decays up to %.4g", top, e_new)
+        log.debug("interval design: target V = %.4g -> decays up to %.4g", top, e_new)
         if trial is not None and e_new > e:
             K, e, dV = trial.controller, e_new, 1.5 * dV
             best = (trial, e)

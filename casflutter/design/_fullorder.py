@@ -38,6 +38,9 @@ __all__ = ["full_order_controller", "reduced_controllers"]
 log = logging.getLogger("casflutter.design")
 
 _RANK_TOL = 1e-8
+_AXIS_TOL = 1e-9
+"""Relative distance to the imaginary axis within which a controller pole counts as
+unstable (:func:`reduced_controllers`): the count then does not hinge on rounding."""
 
 
 def _full_rank(M: np.ndarray, rows: bool) -> bool:
@@ -96,14 +99,15 @@ def full_order_controller(P: Partition, gamma_factor: float = 1.1
                              A, B, C, D, job=1)[0])
         out = sb10ad(n, m, p, nu, ny, gamma_factor * g_opt, A, B, C, D, job=4)
     except Exception as exc:  # noqa: BLE001 - SLICOT refuses with several exception types
+        # the whole reason on one line (SLICOT's messages span several)
         log.info("full-order start: SLICOT refused the problem (%s), skipped",
-                 str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__)
+                 " ".join(str(exc).split()) or type(exc).__name__)
         return None
     Ak, Bk, Ck, Dk = (np.asarray(M, float) for M in out[1:5])
     if not all(np.all(np.isfinite(M)) for M in (Ak, Bk, Ck, Dk)):
         return None
-    log.info("full-order start: gamma_opt %.6g, central controller at %.6g", g_opt,
-             gamma_factor * g_opt)
+    log.debug("full-order start: gamma_opt %.6g, central controller at %.6g", g_opt,
+              gamma_factor * g_opt)
     return control.ss(Ak, Bk, Ck, Dk), g_opt
 
 
@@ -152,18 +156,21 @@ def reduced_controllers(K: control.StateSpace, order: int) -> list[control.State
     Km = slow_modal(K, order)
     if Km is not None:
         out.append(Km)
-    unstable = int(np.sum(np.linalg.eigvals(np.asarray(K.A, float)).real >= 0))
+    # poles within _AXIS_TOL of the imaginary axis (an integrator of the central controller)
+    # count as unstable whatever the sign of their rounded real part
+    lam = np.linalg.eigvals(np.asarray(K.A, float))
+    unstable = int(np.sum(lam.real >= -_AXIS_TOL * np.maximum(np.abs(lam), 1.0)))
     for method in ("truncate", "matchdc"):
         if unstable > order:
             # balred keeps the whole unstable part: the result would exceed the order
-            log.info("full-order start: no balanced reduction to order %d (%d unstable "
-                     "controller poles)", order, unstable)
+            log.debug("full-order start: no balanced reduction to order %d (%d unstable "
+                      "controller poles)", order, unstable)
             break
         try:
             Kr = control.balred(K, order, method=method)
         except Exception as exc:  # noqa: BLE001 - SLICOT errors of several types
-            log.info("full-order start: %s reduction to order %d failed (%s)", method, order,
-                     type(exc).__name__)
+            log.debug("full-order start: %s reduction to order %d failed (%s)", method, order,
+                      type(exc).__name__)
             continue
         mats = [np.asarray(M, float) for M in (Kr.A, Kr.B, Kr.C, Kr.D)]
         if Kr.nstates <= order and all(np.all(np.isfinite(M)) for M in mats):

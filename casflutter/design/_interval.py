@@ -43,6 +43,7 @@ import numpy as np
 import scipy.linalg
 from scipy.optimize import minimize
 
+from .._format import result_repr
 from .._linalg import spectral_abscissa
 from .._settings import finite_numbers
 from .._threads import single_threaded
@@ -78,6 +79,8 @@ class IntervalReach:
     met : bool
         True when ``reached`` is the target.
     """
+
+    __repr__ = result_repr
 
     controller: control.StateSpace
     reached: tuple
@@ -405,8 +408,8 @@ def stabilize_interval(system, controller, interval, *,
         cur = (lo, edge) if anchor == "low" else (edge, hi)
         p = _pack(K, free_feedthrough)
         step, history = float(first_step), []
-        log.info("interval continuation (%s end, order %d): the start decays on [%.4g, %.4g]",
-                 anchor, order, *cur)
+        log.debug("interval continuation (%s end, order %d): the start decays on [%.4g, %.4g]",
+                  anchor, order, *cur)
         rounds = 0
         while cur != (lo, hi) and step >= min_step and rounds < max_rounds:
             rounds += 1
@@ -429,8 +432,8 @@ def stabilize_interval(system, controller, interval, *,
                     break
                 speeds = np.union1d(speeds, scan[_peaks(values, decay)])
             history.append((trial[0], trial[1], worst))
-            log.info("interval continuation: [%.4g, %.4g] worst abscissa %.4g -> %s", *trial,
-                     worst, "kept" if ok else f"step {step / 2:.3g}")
+            log.debug("interval continuation: [%.4g, %.4g] worst abscissa %.4g -> %s", *trial,
+                      worst, "kept" if ok else f"step {step / 2:.3g}")
             if ok:
                 p, cur, step = q, trial, 1.5 * step
             else:
@@ -505,6 +508,8 @@ class OrderStep:
         low end (:func:`stabilize_interval`).
     """
 
+    __repr__ = result_repr
+
     order: int
     controller: control.StateSpace
     worst_abscissa: float
@@ -526,6 +531,8 @@ class OrderReduction:
         The orders held, highest first (with the half-way orders of split steps), and last
         the first order that missed, if one did.
     """
+
+    __repr__ = result_repr
 
     interval: tuple
     decay: float
@@ -616,15 +623,15 @@ def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
             try:
                 Kr = control.balred(K, n, method="truncate")
             except ValueError as exc:       # more unstable modes than n
-                log.info("order reduction: order %d not reached (%s)", n, exc)
+                log.debug("order reduction: order %d not reached (%s)", n, exc)
                 break
             Kn, worst = _truncation_polished(system, Kr, K.D, speeds, lo, hi, decay,
                                              n_speeds, max_iter, free_feedthrough)
             p = K.nstates
             if worst > -decay and p - n > 1:
                 # a smaller step first: the order half-way
-                log.info("order reduction: %d -> %d missed (worst abscissa %.4g); via %d", p,
-                         n, worst, (p + n) // 2)
+                log.debug("order reduction: %d -> %d missed (worst abscissa %.4g); via %d", p,
+                          n, worst, (p + n) // 2)
                 queue.insert(0, (p + n) // 2)
                 continue
             continued = False
@@ -637,9 +644,9 @@ def reduce_order(system, controller, interval, orders, *, decay: float = 0.05,
                 if reach.met:
                     Kn, worst = reach.controller, reach.worst_abscissa
             met = bool(worst <= -decay)
-            log.info("order reduction: order %d worst abscissa %.4g on [%.4g, %.4g]%s -> %s",
-                     n, worst, lo, hi, " (continued)" if continued else "",
-                     "held" if met else "missed")
+            log.debug("order reduction: order %d worst abscissa %.4g on [%.4g, %.4g]%s -> %s",
+                      n, worst, lo, hi, " (continued)" if continued else "",
+                      "held" if met else "missed")
             steps.append(OrderStep(n, Kn, float(worst), met, continued))
             if not met:
                 break
@@ -667,6 +674,8 @@ class IntervalDesign:
     met : bool
         ``controller`` has the requested order and holds the interval.
     """
+
+    __repr__ = result_repr
 
     controller: control.StateSpace
     order: int

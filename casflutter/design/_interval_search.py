@@ -22,6 +22,7 @@ import control
 import numpy as np
 import scipy.linalg
 
+from .._format import result_repr
 from .._settings import finite_numbers
 from .._threads import single_threaded
 from ..errors import ConfigError
@@ -30,6 +31,11 @@ from ._interval import IntervalReach, _Models, _polish, _speed_interval, stabili
 __all__ = ["RandomStartSearch", "search_random_starts"]
 
 log = logging.getLogger("casflutter.design")
+
+REACH_TIE = 1e-9
+"""Relative difference of two reached interval ends below which they tie
+(:attr:`RandomStartSearch.best` keeps the earlier start); far below the continuation's
+smallest step (``min_step``, 2.5e-3 by default)."""
 
 
 @dataclass(frozen=True)
@@ -54,6 +60,8 @@ class RandomStartSearch:
         The band (rad/s) the resonators' frequencies were drawn from.
     """
 
+    __repr__ = result_repr
+
     anchor: str
     order: int
     starts: int
@@ -65,10 +73,14 @@ class RandomStartSearch:
     @property
     def best(self) -> IntervalReach | None:
         """The continuation that reached farthest from the anchor (``None`` when no start
-        held the anchor band)."""
-        if self.anchor == "high":
-            return min(self.reaches, key=lambda r: r.reached[0], default=None)
-        return max(self.reaches, key=lambda r: r.reached[1], default=None)
+        held the anchor band); of ends within ``REACH_TIE`` of each other (sums of
+        continuation steps that differ only in rounding), the earlier start's."""
+        best = None
+        for r in self.reaches:
+            far = r.reached[0] if self.anchor == "high" else -r.reached[1]
+            if best is None or far < best[0] - REACH_TIE * max(1.0, abs(best[0])):
+                best = (far, r)
+        return None if best is None else best[1]
 
     @property
     def met(self) -> bool:
@@ -200,12 +212,12 @@ def search_random_starts(system, interval, order: int, *, anchor: str = "high",
             K = _random_start(rng, int(order), models.n_sensors, band)
             K, worst = _polish(models, K, band_speeds, max_iter, -2 * decay, free, stable)
             if not worst < -decay:
-                log.info("%s-end start %d: the anchor band does not decay (worst %.4g)",
-                         anchor, i, worst)
+                log.debug("%s-end start %d: the anchor band does not decay (worst %.4g)",
+                          anchor, i, worst)
                 continue
             reach = stabilize_interval(models, K, (lo, hi), anchor=anchor, decay=decay,
                                        max_iter=max_iter, **continuation)
-            log.info("%s-end start %d: reached [%.4g, %.4g]", anchor, i, *reach.reached)
+            log.debug("%s-end start %d: reached [%.4g, %.4g]", anchor, i, *reach.reached)
             reaches.append(reach)
             indices.append(i)
     return RandomStartSearch(anchor, int(order), int(starts), int(seed), tuple(reaches),

@@ -115,9 +115,18 @@ def level_crossings(A, B, C, D, level: float, im_tol: float = 1e-2) -> np.ndarra
     frequency only costs one more evaluation of σ_max in the callers, whereas a crossing
     missed through rounding would end the level iteration below the norm."""
     sD = float(np.linalg.norm(D, 2)) if D.size else 0.0
+    ev = None
     if level > 1.05 * sD:
-        ev = np.linalg.eigvals(_hamiltonian(A, B, C, D, level))
-    else:   # close to σ_max(D) the Hamiltonian is ill-conditioned: use the pencil
+        try:
+            with np.errstate(all="ignore"):
+                H = _hamiltonian(A, B, C, D, level)
+        except np.linalg.LinAlgError:       # DᵀD − level²I singular in floating point
+            H = None
+        if H is not None and np.all(np.isfinite(H)):
+            ev = np.linalg.eigvals(H)
+    if ev is None:
+        # close to σ_max(D) the Hamiltonian is ill-conditioned, and with entries far from one
+        # its products overflow: the pencil holds the plant's own entries, no inverse
         M, N = _level_pencil(A, B, C, D, level)
         with np.errstate(divide="ignore", invalid="ignore"):
             ev = sla.eigvals(M, N)
@@ -144,11 +153,19 @@ def hinf_norm(A, B, C, D, *, tol: float = 1e-9, max_iter: int = 60) -> tuple[flo
     Returns
     -------
     gamma : float
-        The norm (``inf`` when ``A`` is not Hurwitz).
+        The norm (``inf`` when ``A`` is not Hurwitz or an entry is not finite).
     omega : float
         Peak frequency in rad/s (``inf`` when the peak is the feedthrough ``σ_max(D)``).
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        When no eigenvalue or singular value solver converges on the system (the synthesis
+        records such a start as failed).
     """
     A, B, C, D = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (A, B, C, D))
+    if not all(np.all(np.isfinite(M)) for M in (A, B, C, D)):
+        return np.inf, np.nan      # a loop whose entries overflowed has no finite norm
     n = A.shape[0]
     sD = float(np.linalg.norm(D, 2)) if D.size else 0.0
     if n == 0:
@@ -170,6 +187,8 @@ def hinf_norm(A, B, C, D, *, tol: float = 1e-9, max_iter: int = 60) -> tuple[flo
         lb, wpk = sD, np.inf
     if lb == 0.0:
         return 0.0, 0.0
+    if not np.isfinite(lb):
+        return np.inf, wpk         # a pole so close to the axis that σ_max overflows
     for _ in range(max_iter):
         g = lb * (1.0 + 2.0 * tol)
         w = level_crossings(A, B, C, D, g)
@@ -182,6 +201,8 @@ def hinf_norm(A, B, C, D, *, tol: float = 1e-9, max_iter: int = 60) -> tuple[flo
         sv = ev_(mids)
         j = int(np.argmax(sv))
         sv[j] = sigma_max(A, B, C, D, [mids[j]])[0]
+        if not np.isfinite(sv[j]):
+            return np.inf, float(mids[j])
         if not sv[j] > lb * (1.0 + tol):
             break          # crossings found but no higher value between them: converged
         lb, wpk = float(sv[j]), float(mids[j])

@@ -45,6 +45,7 @@ import control
 import numpy as np
 from scipy.optimize import minimize, minimize_scalar
 
+from .._format import result_repr
 from ..errors import ConfigError, DimensionError
 from . import _exact
 from ._plant import Partition, partition
@@ -81,6 +82,8 @@ class OrderBound:
         (``k >= min(ncon, nmeas)`` with one frequency, ``k >= max(ncon, nmeas)`` with more):
         the value is then only the best each frequency allows on its own.
     """
+
+    __repr__ = result_repr
 
     order: int
     frequencies: tuple
@@ -257,8 +260,8 @@ def order_relaxation(plant: control.StateSpace | Partition, nmeas: int, ncon: in
                 x = r.x
         v = max(float(sv[0]) for sv in rel.sigmas(x))
         values.append(v)
-        log.info("order relaxation (order %d, %d frequencies): start %d ends at %.6g", order,
-                 len(freqs), s, v)
+        log.debug("order relaxation (order %d, %d frequencies): start %d ends at %.6g", order,
+                  len(freqs), s, v)
         if v < best:
             best, best_x = v, x
     sv = rel.sigmas(best_x)
@@ -319,6 +322,8 @@ class StaticDirectionBound:
         The bound each frequency gives on its own for any controller, ``‖Π⊥ P11(jω)‖`` with
         Π⊥ the projector off the range of ``P12(jω)``: ``value`` is at least their maximum.
     """
+
+    __repr__ = result_repr
 
     value: float
     estimate: float
@@ -610,8 +615,8 @@ def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, nc
 
     value, _, t_val, lam_val = largest(certified)
     estimate, upper, _, _ = largest(lambda g, t, lam, w: lam > 0)
-    log.info("static-direction bound (%s side, order <= %d, ω = %s): γ >= %.8g certified%s "
-             "(without margin %.8g)", side, k, freqs, value, " exactly" if exact else "",
+    log.info("static-direction bound (%s side, order <= %d, ω = %s): γ >= %.6g certified%s "
+             "(without margin %.6g)", side, k, freqs, value, " exactly" if exact else "",
              estimate)
     return StaticDirectionBound(value=float(value), estimate=float(estimate),
                                 upper=float(upper), side=side, order=k, directions=m,

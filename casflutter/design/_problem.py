@@ -137,6 +137,16 @@ def _cluster_samples(r: int) -> list[np.ndarray]:
     return out
 
 
+def _abscissa(P: Partition, K: np.ndarray) -> float:
+    """Spectral abscissa of ``P`` closed by the static ``K``; ``inf`` when the loop is
+    singular (``I − K D22``), has non-finite entries, or its eigenvalues do not converge."""
+    try:
+        A = P.closed_loop(K)[0]
+        return spectral_abscissa(A) if np.all(np.isfinite(A)) else np.inf
+    except np.linalg.LinAlgError:
+        return np.inf
+
+
 def _eig_lr(A: np.ndarray):
     w, vl, vr = sla.eig(A, left=True, right=True)
     return w, vl, vr
@@ -189,9 +199,10 @@ class Problem:
         return bool(np.all(self.dets(K) >= self.min_det * (1.0 - 1e-6)))
 
     def alphas(self, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Spectral abscissae of the H∞ plants and of the stability plants (scaled time)."""
-        a = np.array([spectral_abscissa(P.closed_loop(K)[0]) for P in self.aug])
-        b = np.array([spectral_abscissa(P.closed_loop(K)[0]) for P in self.stab])
+        """Spectral abscissae of the H∞ plants and of the stability plants (scaled time);
+        ``inf`` for a loop that cannot be closed or whose entries overflowed."""
+        a = np.array([_abscissa(P, K) for P in self.aug])
+        b = np.array([_abscissa(P, K) for P in self.stab])
         return a, b
 
     def stab_objective(self, K: np.ndarray, margin: float) -> float:
@@ -218,7 +229,10 @@ class Problem:
         """Worst-case exact γ, per-plant γ and peak frequencies (γ = inf if unstable)."""
         gams, peaks = [], []
         for P in self.aug:
-            g, w = hinf_norm(*P.closed_loop(K))
+            try:
+                g, w = hinf_norm(*P.closed_loop(K))
+            except np.linalg.LinAlgError:    # a singular loop, or no solver converged on it
+                g, w = np.inf, np.nan
             if not np.isfinite(g):
                 return np.inf, [], []
             gams.append(g)

@@ -79,7 +79,17 @@ class CutQP:
 
     def solve(self, H: np.ndarray, f: np.ndarray, G: np.ndarray, c: np.ndarray,
               Hc: np.ndarray, delta: np.ndarray | float) -> QPStep:
-        """Solve the subproblem (module docstring); ``d = 0`` must be feasible (``c <= 0``)."""
+        """Solve the subproblem (module docstring); ``d = 0`` must be feasible (``c <= 0``).
+
+        Raises
+        ------
+        FloatingPointError
+            A cut value or gradient that is not finite (a loop whose sensitivities
+            overflowed), or no finite step from the solver; the synthesis records the start
+            as failed.
+        """
+        if not all(np.all(np.isfinite(M)) for M in (H, f, G, c, Hc)):
+            raise FloatingPointError("the local model has non-finite cut values or gradients")
         n = self.n
         no, nc = f.size, c.size
         mo = _SLOT * max(1, -(-no // _SLOT))
@@ -103,6 +113,8 @@ class CutQP:
         res = self._solver(mo, mc)(x0, lbx=lbx, ubx=ubx, lbg=-np.inf, ubg=ubg, p=p,
                                    accept_acceptable=True)
         d = res.x[:n]
+        if not np.all(np.isfinite(res.x)):
+            raise FloatingPointError(f"the QP returned a non-finite step ({res.return_status})")
         t = float(res.x[n])
         model = float(np.max(f + G @ d)) + 0.5 * float(d @ H @ d)
         return QPStep(d=d, model=model, t=t, mu=np.maximum(res.lam_g[:no], 0.0),

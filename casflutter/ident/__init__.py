@@ -12,11 +12,12 @@ denominator by variable projection (for aerodynamics linear in the motion).
 from ._common_denominator import CommonDenominatorResult, identify_common_denominator
 from ._identify import (FitReport, IdentificationResult, IdentificationSettings,
                         IdentificationWarning, fit_report, identify)
-from ._model import HWLModel, HWLStructure, UnstableModelWarning, paper_parameter_count
+from ._model import HWLModel, UnstableModelWarning
 from ._orders import HWLOrders
 from ._regression import Stage1Result, stage1
 from ._select import OrderCandidate, OrderSelection, order_grid, parse_grid, select_orders
-from ._synthetic import duffing_data, random_hwl_model, synthetic_data
+from ._structure import HWLStructure, paper_parameter_count
+from ._synthetic import duffing_data, example_rom, random_hwl_model, synthetic_data
 from ._twins import hwl_predict_function, hwl_simulate_function
 
 __all__ = ["identify", "IdentificationSettings", "IdentificationResult", "IdentificationWarning",
@@ -24,4 +25,5 @@ __all__ = ["identify", "IdentificationSettings", "IdentificationResult", "Identi
            "UnstableModelWarning", "paper_parameter_count", "Stage1Result", "stage1",
            "select_orders", "OrderCandidate", "OrderSelection", "order_grid", "parse_grid",
            "identify_common_denominator", "CommonDenominatorResult", "synthetic_data",
-           "random_hwl_model", "duffing_data", "hwl_predict_function", "hwl_simulate_function"]
+           "random_hwl_model", "duffing_data", "example_rom", "hwl_predict_function",
+           "hwl_simulate_function"]

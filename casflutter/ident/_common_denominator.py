@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._format import result_repr
 from ..data import IOData
 from ..errors import ConfigError, DataError
 from ._model import HWLModel
@@ -52,6 +53,8 @@ class CommonDenominatorResult:
     wall_time : float
         Seconds.
     """
+
+    __repr__ = result_repr
 
     model: HWLModel
     a: np.ndarray
@@ -97,8 +100,8 @@ def identify_common_denominator(data: IOData, na: int = 2,
     Examples
     --------
     >>> import casflutter as cf
-    >>> truth = cf.load_problem("typical_section")
-    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
+    >>> data = cf.truth_records(cf.load_problem("typical_section"), V0=1.8, dt=0.1,
+    ...                         duration=60.0, band=(0.002, 1.0))
     >>> cd = cf.identify_common_denominator(data, na=2, nb=6)
     >>> cd.stable, bool(cd.relative_residual < 1e-6)
     (True, True)

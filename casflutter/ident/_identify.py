@@ -1,33 +1,41 @@
-"""Two-stage identification of the HWL ROM: the public entry point :func:`identify`."""
+"""Two-stage identification of the HWL ROM: the public entry point :func:`identify`.
+
+The work is done in the identification's own coordinates (:class:`_Coordinates`: channels
+centred when an offset is fitted, scaled to unit RMS), where stage 1 gives the start and
+stage 2 (:func:`_stage2`) refines it; the model is then mapped back to physical units, scored
+on the records (:func:`_score`) and its status turned into a return, a warning or an error
+(:func:`_checked`).
+"""
 
 from __future__ import annotations
 
 import logging
 import time
 import warnings
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from .._threads import single_threaded
 
-from .._nlp import DEFAULT_IPOPT_OPTIONS, NLPResult
+from .._format import result_repr
+from .._nlp import NLPResult
+from .._threads import single_threaded
 from ..data import IOData, Record
 from ..errors import ConfigError, ConvergenceError, DataError, OrderError
-from ._model import HWLModel, HWLStructure, UnstableModelWarning
+from ._fit import FitReport, fit_report
+from ._model import HWLModel, UnstableModelWarning
 from ._orders import HWLOrders
 from ._refine import refine
 from ._regression import stage1
+from ._settings import IdentificationSettings, IdentificationWarning
 from ._simfit import FreeRunProblem, fit_simulation_error
+from ._structure import HWLStructure
 
 __all__ = ["IdentificationSettings", "IdentificationResult", "IdentificationWarning",
            "FitReport", "identify", "fit_report"]
 
-_CRITERIA = ("prediction", "simulation")
 log = logging.getLogger("casflutter.ident")
 
-
-_SOLVERS = ("auto", "gauss-newton", "ipopt")
 #: statuses returned as converged
 _CONVERGED = {"Solve_Succeeded", "not run"}
 _ACCEPTABLE = {"Solved_To_Acceptable_Level"}
@@ -35,252 +43,6 @@ _TIMEOUT = {"Maximum_WallTime_Exceeded"}
 #: a simulation fit whose cost from the measured initial outputs exceeds this many times its
 #: cost from the estimated ones is refitted with the initial outputs fixed
 HIDDEN_MODE_FACTOR = 10.0
-
-
-class IdentificationWarning(UserWarning):
-    """An identification returned a result that is not fully converged (acceptable level,
-    time limit); the result's ``return_status`` says which."""
-
-
-def _is_bool(x) -> bool:
-    return isinstance(x, (bool, np.bool_))
-
-
-def _is_real(x) -> bool:
-    return isinstance(x, (int, float, np.integer, np.floating)) and not _is_bool(x)
-
-
-@dataclass(frozen=True)
-class IdentificationSettings:
-    """Choices of the two-stage identification (every field checked on construction).
-
-    Attributes
-    ----------
-    criterion : {"prediction", "simulation"}
-        Stage-2 criterion: mu-step-ahead prediction error (default; the criterion of the
-        paper's two-stage method, fast) or free-run simulation error (the criterion to use
-        when the model will run free: flutter loop, LCO, suppression).
-    solver : {"auto", "gauss-newton", "ipopt"}
-        Stage-2 solver for the simulation criterion: Levenberg--Marquardt with exact forward
-        sensitivities (``"gauss-newton"``, what ``"auto"`` picks) or Ipopt on a
-        multiple-shooting NLP (``"ipopt"``).  The prediction criterion always uses Ipopt.
-    refine : bool
-        Run stage 2.  ``False`` returns the stage-1 model.
-    shooting_interval : int
-        Samples per shooting interval of the Ipopt simulation NLP.
-    regularization : float
-        Weight of ``||theta - theta_start||^2 / n_params`` added to the stage-2 cost
-        (0: none; finite and >= 0).
-    scale_data : bool
-        Identify on unit-RMS channels and transform the model back (exact: the HWL class
-        is closed under scaling); improves conditioning of both stages.
-    offset : bool
-        Give the model a constant term and identify on centred data (the means of every
-        channel removed, then put back into the model exactly: :meth:`HWLModel.shifted`).
-        Use it for data with offsets (raw sensor records); the paper's model has none.
-    max_condition : float
-        Largest condition number of the stage-1 regression accepted before the input is
-        declared non-exciting.
-    accept_acceptable : bool
-        Return a stage 2 that stopped at the *acceptable* level
-        (``Solved_To_Acceptable_Level``) with an :class:`IdentificationWarning` (default);
-        ``False`` raises :class:`~casflutter.errors.ConvergenceError` instead.
-    max_iter : int or None
-        Stage-2 iterations (Ipopt iterations or Jacobian evaluations); ``None`` takes the
-        package default ``casflutter._nlp.DEFAULT_IPOPT_OPTIONS["ipopt.max_iter"]`` for both
-        solvers.  An ``"ipopt.max_iter"`` in ``ipopt_options`` wins for Ipopt.
-    max_time : float or None
-        Wall-time budget of stage 2 in seconds: the best iterate so far is returned with
-        status ``Maximum_WallTime_Exceeded`` and an :class:`IdentificationWarning`.
-    tol : float
-        Relative tolerance of the Gauss--Newton solver (cost decrease, step, gradient).
-    estimate_initial : bool
-        Estimate the initial outputs of each record with the parameters (Gauss--Newton
-        solver); ``False`` starts every record from its measured outputs.
-    ipopt_options : dict
-        Flat CasADi/Ipopt options, e.g. ``{"ipopt.tol": 1e-10}`` (defaults in
-        ``casflutter._nlp.DEFAULT_IPOPT_OPTIONS``, the one place they are set).
-    """
-
-    criterion: str = "prediction"
-    solver: str = "auto"
-    refine: bool = True
-    shooting_interval: int = 50
-    regularization: float = 0.0
-    scale_data: bool = True
-    offset: bool = False
-    max_condition: float = 1e10
-    accept_acceptable: bool = True
-    max_iter: int | None = None
-    max_time: float | None = None
-    tol: float = 1e-8
-    estimate_initial: bool = True
-    ipopt_options: dict = field(default_factory=dict)
-
-    def __post_init__(self):
-        def bad(name, allowed):
-            raise ConfigError(f"identification setting {name}={getattr(self, name)!r} is not "
-                              f"allowed: {allowed}")
-
-        if self.criterion not in _CRITERIA:
-            bad("criterion", f"use one of {_CRITERIA}")
-        if self.solver not in _SOLVERS:
-            bad("solver", f"use one of {_SOLVERS}")
-        for name in ("refine", "scale_data", "offset", "accept_acceptable", "estimate_initial"):
-            if not _is_bool(getattr(self, name)):
-                bad(name, "give True or False")
-        if not (isinstance(self.shooting_interval, (int, np.integer))
-                and not _is_bool(self.shooting_interval) and self.shooting_interval >= 1):
-            bad("shooting_interval", "give an integer >= 1")
-        if not (_is_real(self.regularization) and np.isfinite(self.regularization)
-                and self.regularization >= 0):
-            bad("regularization", "give a finite number >= 0 (0: no regularisation)")
-        if not (_is_real(self.max_condition) and self.max_condition > 1):
-            bad("max_condition", "give a number > 1")
-        if self.max_iter is not None and not (isinstance(self.max_iter, (int, np.integer))
-                                              and not _is_bool(self.max_iter)
-                                              and self.max_iter >= 0):
-            bad("max_iter", "give an integer >= 0 or None (package default)")
-        if self.max_time is not None and not (_is_real(self.max_time)
-                                              and np.isfinite(self.max_time)
-                                              and self.max_time > 0):
-            bad("max_time", "give a positive number of seconds or None (no limit)")
-        if not (_is_real(self.tol) and 0 < self.tol < 1):
-            bad("tol", "give a number in (0, 1)")
-        if not (isinstance(self.ipopt_options, dict)
-                and all(isinstance(k, str) for k in self.ipopt_options)):
-            bad("ipopt_options", "give a dict of option names (str) to values, e.g. "
-                "{'ipopt.tol': 1e-10}")
-
-    @property
-    def iteration_limit(self) -> int:
-        """``max_iter`` or the package default."""
-        return int(DEFAULT_IPOPT_OPTIONS["ipopt.max_iter"] if self.max_iter is None
-                   else self.max_iter)
-
-    @classmethod
-    def build(cls, settings=None, **kwargs) -> "IdentificationSettings":
-        """Settings from an instance and/or keyword overrides; unknown keys are a
-        :class:`~casflutter.errors.ConfigError` listing the known ones.
-
-        Parameters
-        ----------
-        settings : IdentificationSettings, optional
-            Settings to start from (default: the defaults).
-        **kwargs
-            Fields to replace, by name.
-
-        Returns
-        -------
-        IdentificationSettings
-        """
-        names = [f.name for f in fields(cls)]
-        unknown = sorted(set(kwargs) - set(names))
-        if unknown:
-            raise ConfigError(f"unknown identification setting(s) {unknown}: the settings are "
-                              f"{names}")
-        if settings is None:
-            return cls(**kwargs)
-        if not isinstance(settings, cls):
-            raise ConfigError(f"settings must be an IdentificationSettings, got "
-                              f"{type(settings).__name__}")
-        return replace(settings, **kwargs) if kwargs else settings
-
-
-@dataclass(frozen=True)
-class FitReport:
-    """Per-output goodness of fit.
-
-    Attributes
-    ----------
-    mode : str
-        ``"simulation"`` (free run) or ``"prediction"`` (mu steps ahead).
-    error_percent : ndarray (N,)
-        ``100 ||y - yhat|| / ||y||`` per output, as the error of the paper's Fig. 7.
-    nrmse : ndarray (N,)
-        ``RMS(y - yhat) / std(y)`` per output (1 is no better than the mean).
-    rms_error : ndarray (N,)
-        ``RMS(y - yhat)`` per output, in the output's units.
-    skip : int
-        Leading samples of each record excluded from the scores.
-    """
-
-    mode: str
-    error_percent: np.ndarray
-    nrmse: np.ndarray
-    rms_error: np.ndarray
-    skip: int
-
-    def table(self, names=None) -> str:
-        """A small text table."""
-        names = names or [f"y{i + 1}" for i in range(len(self.error_percent))]
-        lines = [f"{'output':>10} {'error %':>10} {'NRMSE':>10} {'RMS error':>12}"]
-        for n, e, r, s in zip(names, self.error_percent, self.nrmse, self.rms_error):
-            lines.append(f"{n:>10} {e:10.4f} {r:10.5f} {s:12.4e}")
-        return "\n".join(lines)
-
-
-def fit_report(model: HWLModel, data: IOData, mode: str = "simulation",
-               skip: int | None = None) -> FitReport:
-    """Score ``model`` on ``data`` by free-run simulation or mu-step prediction.
-
-    Simulation (eq. 3 with the model's own past outputs fed back) starts from the measured
-    first ``max_lag`` outputs of each record; prediction feeds the measured outputs back
-    (the mu-step predictor of eq. 4).
-
-    Parameters
-    ----------
-    model : HWLModel
-        The identified model.
-    data : IOData
-        Records to score it on (the same channels as the model).
-    mode : {"simulation", "prediction"}
-        Free run or mu-step prediction.
-    skip : int, optional
-        Samples excluded at the start of each record (default and minimum ``max_lag``).
-
-    Returns
-    -------
-    FitReport
-        Per-output error percentage (the paper's Fig. 7), NRMSE and RMS error.
-
-    Raises
-    ------
-    ConfigError
-        ``mode`` is neither ``"simulation"`` nor ``"prediction"``.
-
-    See Also
-    --------
-    identify : the identification whose result carries this report.
-
-    Examples
-    --------
-    >>> import casflutter as cf
-    >>> truth = cf.load_problem("typical_section")
-    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
-    >>> rom = cf.identify_common_denominator(data).model
-    >>> fit = cf.fit_report(rom, data)
-    >>> bool(fit.error_percent.max() < 1.0)
-    True
-    """
-    if mode not in ("simulation", "prediction"):
-        raise ConfigError(f"fit_report mode={mode!r} is not allowed: use 'simulation' or "
-                          "'prediction'")
-    skip = model.max_lag if skip is None else max(int(skip), model.max_lag)
-    err, ref = [], []
-    for rec in data.records:
-        if mode == "simulation":
-            yhat = model.simulate(rec.u, rec.v, y0=rec.y[:model.max_lag])
-        else:
-            yhat = model.predict(rec.y, rec.u, rec.v)
-        err.append(rec.y[skip:] - yhat[skip:])
-        ref.append(rec.y[skip:])
-    e = np.vstack(err)
-    y = np.vstack(ref)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        pct = 100 * np.linalg.norm(e, axis=0) / np.linalg.norm(y, axis=0)
-        nrmse = np.sqrt(np.mean(e ** 2, axis=0)) / np.std(y, axis=0)
-    return FitReport(mode, pct, nrmse, np.sqrt(np.mean(e ** 2, axis=0)), skip)
 
 
 @dataclass(frozen=True)
@@ -326,6 +88,8 @@ class IdentificationResult:
     solver : str
         ``"ipopt"``, ``"gauss-newton"`` or ``"none"``.
     """
+
+    __repr__ = result_repr
 
     model: HWLModel
     initial_model: HWLModel
@@ -463,8 +227,9 @@ def _simulation_start(problem: FreeRunProblem, structure, work, theta0, settings
     opts = {"ipopt.max_iter": settings.iteration_limit}
     if settings.max_time is not None:
         opts["ipopt.max_wall_time"] = float(settings.max_time) / 4
-    theta_p, res, *_ = refine(structure, work, theta0, criterion="prediction",
-                              regularization=settings.regularization, options=opts)
+    pred = refine(structure, work, theta0, criterion="prediction",
+                  regularization=settings.regularization, options=opts)
+    theta_p, res = pred.theta, pred.nlp
     if not np.all(np.isfinite(theta_p)):
         return theta0
     cost_p = problem.cost(problem.x0(theta_p))
@@ -543,6 +308,149 @@ def identify(data: IOData, orders=(3, 1, 1, 1, 2, 2), *,
     with single_threaded():
         return _identify(data, orders, settings, initial)
 
+@dataclass(frozen=True)
+class _Coordinates:
+    """The identification's working coordinates and the maps between them and physical units.
+
+    The records are centred when an offset is fitted (``means``) and scaled to unit RMS
+    (``sy, su, sv``, ones without ``scale_data``); the HWL class is closed under both, so a
+    model maps exactly between the two (:meth:`HWLModel.rescaled`, :meth:`HWLModel.shifted`).
+    """
+
+    structure: HWLStructure
+    dt: float
+    names: dict
+    sy: np.ndarray
+    su: np.ndarray | None
+    sv: float | None
+    means: tuple | None    # (my, mu, mv) when an offset is fitted
+
+    @classmethod
+    def of(cls, data: IOData, structure: HWLStructure, settings: IdentificationSettings):
+        """The coordinates of ``data`` and the records in them."""
+        means = _means(data) if settings.offset else None
+        centred = data if means is None else _shifted_data(data, *means)
+        if settings.scale_data:
+            sy, su, sv = centred.scales()
+        else:
+            N = data.n_modes
+            sy, su, sv = (np.ones(N), (np.ones(N) if data.has_u else None),
+                          (1.0 if data.has_v else None))
+        names = dict(output_names=data.output_names, u_names=data.u_names, v_name=data.v_name)
+        return cls(structure, data.dt, names, sy, su, sv, means), centred.scaled(sy, su, sv)
+
+    def to_physical(self, theta) -> HWLModel:
+        """The model of working parameters ``theta`` in physical units."""
+        inv = lambda s: None if s is None else 1.0 / np.asarray(s)  # noqa: E731
+        phys = HWLModel(self.structure, theta, self.dt).rescaled(inv(self.sy), inv(self.su),
+                                                                 inv(self.sv))
+        if self.means is not None:
+            my, mu, mv = self.means
+            phys = phys.shifted(-my, None if mu is None else -mu, None if mv is None else -mv)
+        return HWLModel(self.structure, phys.theta, self.dt, **self.names)
+
+    def to_work(self, model: HWLModel) -> np.ndarray:
+        """The working parameters of a model in physical units."""
+        if self.means is not None:
+            model = model.shifted(*self.means)
+        return model.rescaled(self.sy, self.su, self.sv).theta
+
+    def outputs(self, initial_outputs) -> tuple:
+        """Initial outputs of the records in physical units."""
+        shift = self.means[0] if self.means is not None else 0.0
+        return tuple(ic * self.sy + shift for ic in initial_outputs)
+
+
+@dataclass(frozen=True)
+class _Stage2:
+    """Outcome of stage 2 in working coordinates (see :class:`IdentificationResult`)."""
+
+    theta: np.ndarray
+    success: bool
+    status: str
+    iterations: int
+    cost_initial: float
+    cost: float
+    solver: str = "none"
+    initial_outputs: tuple = ()
+    nlp: NLPResult | None = None
+
+
+def _start(structure, work, coords: _Coordinates, start_model, settings):
+    """Stage 1 (or the given start): working parameters, regression condition number and the
+    starting model in physical units."""
+    if start_model is not None:
+        initial = HWLModel(structure, start_model.theta, coords.dt, **coords.names)
+        return coords.to_work(start_model), float("nan"), initial
+    try:
+        s1 = stage1(structure, work, max_condition=settings.max_condition)
+    except np.linalg.LinAlgError as exc:
+        raise DataError(f"the stage-1 regression could not be solved ({exc}); check that "
+                        "the data are finite, scaled and exciting") from None
+    return s1.model.theta, s1.condition_number, coords.to_physical(s1.model.theta)
+
+
+def _stage2_gauss_newton(structure, work, theta0, settings, given_start: bool) -> _Stage2:
+    """Free-run fit by Levenberg--Marquardt (initial outputs estimated unless told not to),
+    refitted with the measured initial outputs when the estimated ones hide a mode."""
+    problem = FreeRunProblem(structure, work, settings.regularization, theta0,
+                             estimate_initial=settings.estimate_initial)
+    start = (theta0 if given_start
+             else _simulation_start(problem, structure, work, theta0, settings))
+    lm = fit_simulation_error(problem, start, max_iter=settings.iteration_limit,
+                              tol=settings.tol, max_time=settings.max_time)
+    if settings.estimate_initial and (lm.success or lm.return_status in _ACCEPTABLE):
+        # estimated initial outputs can hide an unstable or badly damped mode that the
+        # input does not excite: from the measured outputs such a model runs far worse
+        measured = problem.cost(problem.x0(lm.theta))
+        if not measured <= HIDDEN_MODE_FACTOR * lm.cost + 1e-300:
+            log.info("simulation fit: from the measured initial outputs the cost is %.4e "
+                     "(estimated: %.4e); refitting with them fixed", measured, lm.cost)
+            fixed = FreeRunProblem(structure, work, settings.regularization, theta0,
+                                   estimate_initial=False)
+            lm2 = fit_simulation_error(fixed, lm.theta, max_iter=settings.iteration_limit,
+                                       tol=settings.tol, max_time=settings.max_time)
+            lm = replace(lm2, iterations=lm.iterations + lm2.iterations)
+    cost0 = problem.cost(problem.x0(theta0))
+    return _Stage2(lm.theta, lm.success, lm.return_status, lm.iterations, cost0, lm.cost,
+                   "gauss-newton", tuple(lm.initial_outputs))
+
+
+def _stage2_ipopt(structure, work, theta0, settings) -> _Stage2:
+    """Ipopt on the prediction-error NLP or the multiple-shooting simulation NLP."""
+    opts = dict(settings.ipopt_options)
+    if settings.max_iter is not None:
+        opts.setdefault("ipopt.max_iter", int(settings.max_iter))
+    if settings.max_time is not None:
+        opts.setdefault("ipopt.max_wall_time", float(settings.max_time))
+    r = refine(structure, work, theta0, criterion=settings.criterion,
+               shooting_interval=settings.shooting_interval,
+               regularization=settings.regularization, options=opts)
+    return _Stage2(r.theta, r.nlp.success, r.nlp.return_status, r.nlp.iterations,
+                   r.cost_initial, r.cost, "ipopt", nlp=r.nlp)
+
+
+def _stage2(structure, work, theta0, settings, given_start: bool) -> _Stage2:
+    """Stage 2 by the solver the settings choose (none when ``refine`` is off)."""
+    if not settings.refine:
+        return _Stage2(theta0, True, "not run", 0, float("nan"), float("nan"))
+    if settings.criterion == "simulation" and settings.solver in ("auto", "gauss-newton"):
+        return _stage2_gauss_newton(structure, work, theta0, settings, given_start)
+    return _stage2_ipopt(structure, work, theta0, settings)
+
+
+def _score(model: HWLModel, data: IOData):
+    """Free-run and prediction fits of the identified model, where its free run diverges
+    (``None`` when it does not) and the outputs whose fit is not a finite number."""
+    where = _free_run_failure(model, data)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UnstableModelWarning)
+        fit = fit_report(model, data, "simulation")
+    pfit = fit_report(model, data, "prediction")
+    non_finite = [name for name, e, r in zip(model.output_names, fit.error_percent, fit.nrmse)
+                  if not (np.isfinite(e) and np.isfinite(r))]
+    return fit, pfit, where, non_finite
+
 
 def _identify(data, orders, settings: IdentificationSettings, initial) -> IdentificationResult:
     if not isinstance(data, IOData):
@@ -554,110 +462,39 @@ def _identify(data, orders, settings: IdentificationSettings, initial) -> Identi
     structure = HWLStructure(o, data.n_modes, data.has_u, data.has_v, constant)
     _check_compatible(data, structure)
     start_model = None if initial is None else _initial_theta(initial, structure, data)
-    if settings.offset:
-        my, mu, mv = _means(data)
-        centred = _shifted_data(data, my, mu, mv)
-    else:
+    if not settings.offset:
         _warn_offsets(data)
-        centred = data
-    if settings.scale_data:
-        sy, su, sv = centred.scales()
-    else:
-        N = data.n_modes
-        sy, su, sv = np.ones(N), (np.ones(N) if data.has_u else None), (1.0 if data.has_v else None)
-    work = centred.scaled(sy, su, sv)
-    names = dict(output_names=data.output_names, u_names=data.u_names, v_name=data.v_name)
-    inv = lambda s: None if s is None else 1.0 / np.asarray(s)  # noqa: E731
-
-    def to_physical(theta) -> HWLModel:
-        phys = HWLModel(structure, theta, data.dt).rescaled(inv(sy), inv(su), inv(sv))
-        if settings.offset:
-            phys = phys.shifted(-my, None if mu is None else -mu, None if mv is None else -mv)
-        return HWLModel(structure, phys.theta, data.dt, **names)
-
-    def to_work(model: HWLModel) -> np.ndarray:
-        if settings.offset:
-            model = model.shifted(my, mu, mv)
-        return model.rescaled(sy, su, sv).theta
-
+    coords, work = _Coordinates.of(data, structure, settings)
     t0 = time.perf_counter()
-    if start_model is None:
-        try:
-            s1 = stage1(structure, work, max_condition=settings.max_condition)
-        except np.linalg.LinAlgError as exc:
-            raise DataError(f"the stage-1 regression could not be solved ({exc}); check that "
-                            "the data are finite, scaled and exciting") from None
-        theta0, cond = s1.model.theta, s1.condition_number
-        initial_model = to_physical(theta0)
-    else:
-        theta0, cond = to_work(start_model), float("nan")
-        initial_model = HWLModel(structure, start_model.theta, data.dt, **names)
+    theta0, cond, initial_model = _start(structure, work, coords, start_model, settings)
     t_stage1 = time.perf_counter() - t0
-    nlp_result, ics, solver = None, (), "none"
     t0 = time.perf_counter()
-    if not settings.refine:
-        theta, success, status, iters = theta0, True, "not run", 0
-        cost0 = cost = float("nan")
-    elif settings.criterion == "simulation" and settings.solver in ("auto", "gauss-newton"):
-        solver = "gauss-newton"
-        problem = FreeRunProblem(structure, work, settings.regularization, theta0,
-                                 estimate_initial=settings.estimate_initial)
-        start = (theta0 if start_model is not None
-                 else _simulation_start(problem, structure, work, theta0, settings))
-        lm = fit_simulation_error(problem, start, max_iter=settings.iteration_limit,
-                                  tol=settings.tol, max_time=settings.max_time)
-        if settings.estimate_initial and (lm.success or lm.return_status in _ACCEPTABLE):
-            # estimated initial outputs can hide an unstable or badly damped mode that the
-            # input does not excite: from the measured outputs such a model runs far worse
-            measured = problem.cost(problem.x0(lm.theta))
-            if not measured <= HIDDEN_MODE_FACTOR * lm.cost + 1e-300:
-                log.info("simulation fit: from the measured initial outputs the cost is %.4e "
-                         "(estimated: %.4e); refitting with them fixed", measured, lm.cost)
-                fixed = FreeRunProblem(structure, work, settings.regularization, theta0,
-                                       estimate_initial=False)
-                lm2 = fit_simulation_error(fixed, lm.theta, max_iter=settings.iteration_limit,
-                                           tol=settings.tol, max_time=settings.max_time)
-                lm = replace(lm2, iterations=lm.iterations + lm2.iterations)
-        lm = replace(lm, cost_initial=problem.cost(problem.x0(theta0)))
-        theta, success, status, iters = lm.theta, lm.success, lm.return_status, lm.iterations
-        cost0, cost = lm.cost_initial, lm.cost
-        ics = tuple(ic * sy + (my if settings.offset else 0.0) for ic in lm.initial_outputs)
-    else:
-        solver = "ipopt"
-        opts = dict(settings.ipopt_options)
-        if settings.max_iter is not None:
-            opts.setdefault("ipopt.max_iter", int(settings.max_iter))
-        if settings.max_time is not None:
-            opts.setdefault("ipopt.max_wall_time", float(settings.max_time))
-        theta, nlp_result, cost0, cost, ic_work = refine(
-            structure, work, theta0, criterion=settings.criterion,
-            shooting_interval=settings.shooting_interval,
-            regularization=settings.regularization, options=opts)
-        success, status, iters = (nlp_result.success, nlp_result.return_status,
-                                  nlp_result.iterations)
-        ics = tuple(ic * sy + (my if settings.offset else 0.0) for ic in ic_work)
+    s2 = _stage2(structure, work, theta0, settings, given_start=start_model is not None)
     t_stage2 = time.perf_counter() - t0
-    if np.all(np.isfinite(theta)):
-        model = to_physical(theta)
+    success, status = s2.success, s2.status
+    if np.all(np.isfinite(s2.theta)):
+        model = coords.to_physical(s2.theta)
     else:
         model, success, status = initial_model, False, "Invalid_Number_Detected"
-    where = _free_run_failure(model, data)
+    fit, pfit, where, non_finite = _score(model, data)
     if where is not None:
         success, status = False, "Unstable_Free_Run"
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UnstableModelWarning)
-        fit = fit_report(model, data, "simulation")
-    pfit = fit_report(model, data, "prediction")
-    non_finite = [name for name, e, r in zip(model.output_names, fit.error_percent, fit.nrmse)
-                  if not (np.isfinite(e) and np.isfinite(r))]
-    if non_finite and where is None:  # a fit that cannot be scored is never a success
+    elif non_finite:  # a fit that cannot be scored is never a success
         success, status = False, "Non_Finite_Fit"
     result = IdentificationResult(
         model=model, initial_model=initial_model, fit=fit, prediction_fit=pfit, success=success,
-        return_status=status, iterations=iters, cost=float(cost), cost_initial=float(cost0),
-        t_stage1=t_stage1, t_stage2=t_stage2, wall_time=time.perf_counter() - t_start,
-        condition_number=cond, settings=settings, nlp=nlp_result, initial_outputs=ics,
-        solver=solver)
+        return_status=status, iterations=s2.iterations, cost=float(s2.cost),
+        cost_initial=float(s2.cost_initial), t_stage1=t_stage1, t_stage2=t_stage2,
+        wall_time=time.perf_counter() - t_start, condition_number=cond, settings=settings,
+        nlp=s2.nlp, initial_outputs=coords.outputs(s2.initial_outputs), solver=s2.solver)
+    return _checked(result, where, non_finite)
+
+
+def _checked(result: IdentificationResult, where, non_finite) -> IdentificationResult:
+    """The result when converged; with an :class:`IdentificationWarning` when stopped at the
+    acceptable level or the time limit; otherwise a :class:`ConvergenceError` carrying it."""
+    settings, status, iters = result.settings, result.return_status, result.iterations
+    cost0, cost = result.cost_initial, result.cost
     if status in _CONVERGED:
         return result
     if where is not None:
@@ -671,20 +508,20 @@ def _identify(data, orders, settings: IdentificationSettings, initial) -> Identi
         raise ConvergenceError(
             f"the identified model's free-run fit is not a finite number for output(s) "
             f"{', '.join(map(str, non_finite))} (error % "
-            f"{', '.join(f'{e:.4g}' for e in fit.error_percent)}; stage 2: "
+            f"{', '.join(f'{e:.4g}' for e in result.fit.error_percent)}; stage 2: "
             f"{settings.criterion} criterion, {iters} iterations); lower the orders, add "
             "regularization or check that every output varies", result)
     if status in _ACCEPTABLE and settings.accept_acceptable:
         warnings.warn(f"stage 2 stopped at the acceptable level ({status}, {iters} iterations, "
                       f"cost {cost0:.3e} -> {cost:.3e}); the result is returned",
-                      IdentificationWarning, stacklevel=3)
+                      IdentificationWarning, stacklevel=4)
         return result
     if status in _TIMEOUT:
         warnings.warn(f"stage 2 reached max_time={settings.max_time} s after {iters} "
                       f"iterations (cost {cost0:.3e} -> {cost:.3e}); the best iterate is "
-                      "returned", IdentificationWarning, stacklevel=3)
+                      "returned", IdentificationWarning, stacklevel=4)
         return result
     raise ConvergenceError(
-        f"stage 2 ({settings.criterion} criterion, {solver}) did not converge: status "
+        f"stage 2 ({settings.criterion} criterion, {result.solver}) did not converge: status "
         f"{status!r} after {iters} iterations (cost {cost0:.3e} -> {cost:.3e}); raise "
         "max_iter, add regularization, or check the excitation", result)

@@ -19,18 +19,45 @@ Two criteria:
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import casadi as ca
 import numpy as np
 
-from .._nlp import make_solver
+from .._format import result_repr
+from .._nlp import NLPResult, make_solver
 from ..data import IOData
 from ..errors import ConfigError
-from ._model import HWLStructure, _input_part
+from ._structure import HWLStructure, _input_part
 from ._twins import ar_weights, recursion_step
 from ._regression import regressor_matrix, weights_matrix
 from ._simfit import FreeRunProblem
 
-__all__ = ["prediction_problem", "simulation_problem", "refine"]
+__all__ = ["prediction_problem", "simulation_problem", "refine", "RefinementResult"]
+
+
+@dataclass(frozen=True)
+class RefinementResult:
+    """Outcome of the stage-2 Ipopt NLP (:func:`refine`).
+
+    Attributes
+    ----------
+    theta : numpy.ndarray
+        Refined parameters (the last iterate when the solve failed: check ``nlp.success``).
+    nlp : NLPResult
+        The solver's outcome (status, iterations, time).
+    cost_initial, cost : float
+        Criterion at the start ``theta0`` and at ``theta``.  For the simulation criterion
+        both are free runs evaluated outside the NLP (from the measured initial outputs of
+        every record), so they compare like with like.
+    """
+
+    __repr__ = result_repr
+
+    theta: np.ndarray
+    nlp: NLPResult
+    cost_initial: float
+    cost: float
 
 
 def prediction_problem(structure: HWLStructure, data: IOData, regularization: float = 0.0,
@@ -140,23 +167,21 @@ def _gauss_newton_hessian(nlp, residual, structure, data, regularization) -> ca.
 
 def refine(structure: HWLStructure, data: IOData, theta0, *, criterion: str = "prediction",
            shooting_interval: int = 50, regularization: float = 0.0,
-           options: dict | None = None, hessian: str = "gauss-newton"):
+           options: dict | None = None, hessian: str = "gauss-newton") -> RefinementResult:
     """Solve the stage-2 NLP from ``theta0`` with Ipopt.
 
     Options not given take the package defaults (``casflutter._nlp.DEFAULT_IPOPT_OPTIONS``).
+    The NLP starts every record from its measured outputs.
 
     Returns
     -------
-    theta : ndarray
-        Refined parameters (the last iterate when the solve failed: check ``result.success``).
-    result : NLPResult
-        Solver outcome (status, iterations, time).
-    cost0, cost : float
-        Criterion at ``theta0`` and at ``theta``.  For the simulation criterion both are free
-        runs evaluated outside the NLP (``cost0`` from the measured initial outputs), so they
-        compare like with like.
-    initial_outputs : list
-        Empty: the Ipopt NLP starts every record from its measured outputs.
+    RefinementResult
+        The refined parameters, the solver's outcome and the criterion before and after.
+
+    Raises
+    ------
+    ConfigError
+        ``criterion`` is neither ``"prediction"`` nor ``"simulation"``.
     """
     theta0 = np.asarray(theta0, dtype=float)
     opts = dict(options or {})
@@ -165,7 +190,7 @@ def refine(structure: HWLStructure, data: IOData, theta0, *, criterion: str = "p
         solver = make_solver(nlp, opts, name="hwl_prediction")
         cost0 = cost(theta0)
         res = solver(theta0)
-        return res.x, res, cost0, res.f, []
+        return RefinementResult(res.x, res, cost0, res.f)
     if criterion == "simulation":
         nlp, residual, nodes0, split = simulation_problem(structure, data, shooting_interval,
                                                           regularization, theta0)
@@ -180,5 +205,5 @@ def refine(structure: HWLStructure, data: IOData, theta0, *, criterion: str = "p
         res = solver(x0, lbg=0.0, ubg=0.0)
         theta = split(res.x)[0]
         cost = free.cost(free.x0(theta)) if np.all(np.isfinite(theta)) else float("nan")
-        return theta, res, cost0, cost, []
+        return RefinementResult(theta, res, cost0, cost)
     raise ConfigError(f"criterion={criterion!r} is not known: use 'prediction' or 'simulation'")

@@ -20,9 +20,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._format import result_repr
 from ..data import IOData
 from ..errors import DataError
-from ._model import HWLModel, HWLStructure
+from ._model import HWLModel
+from ._structure import HWLStructure
 
 __all__ = ["regressor_matrix", "regression_layout", "stage1", "Stage1Result"]
 
@@ -118,6 +120,8 @@ class Stage1Result:
     n_rows : int
         Number of regression equations.
     """
+
+    __repr__ = result_repr
 
     model: HWLModel
     theta_over: np.ndarray

@@ -7,6 +7,9 @@ started from the measured outputs.  All candidates are scored on the same sample
 among the candidates whose score is within ``rel_tol`` of the best, the one with the fewest
 parameters (then the lowest score) wins, because a model with more terms than the system
 needs fits the held-out data as well as the right one, up to its estimation noise.
+Among candidates with the same number of parameters whose scores agree to ``SCORE_TIE_RTOL``
+(1e-6 relative), the first of the grid wins: the choice never hinges on the last bits of
+the scores, which change from machine to machine.
 """
 
 from __future__ import annotations
@@ -19,17 +22,23 @@ from typing import Any, Iterable, Mapping
 
 import numpy as np
 
+from .._format import result_repr
 from ..data import IOData
 from ..errors import CasflutterError, ConfigError, DataError
 from ._identify import (IdentificationResult, IdentificationSettings, fit_report, identify)
-from ._model import HWLModel, HWLStructure
+from ._model import HWLModel
 from ._orders import _NAMES, HWLOrders
+from ._structure import HWLStructure
 
 __all__ = ["OrderCandidate", "OrderSelection", "select_orders", "order_grid", "parse_grid"]
 
 #: default grid around the base orders: autoregressive order and both polynomial degrees
 DEFAULT_GRID = {"na": (1, 2, 3, 4), "p": (1, 2, 3), "q": (1, 2, 3)}
 MAX_CANDIDATES = 1000
+#: relative difference of held-out scores below which two candidates of the same size tie
+#: (the earlier of the grid wins); far below the parsimony tolerance ``rel_tol`` (0.02) and
+#: far above the scores' rounding (~1e-13 relative)
+SCORE_TIE_RTOL = 1e-6
 
 
 @dataclass(frozen=True)
@@ -53,6 +62,8 @@ class OrderCandidate:
         Seconds to identify and score it.
     model : HWLModel or None
     """
+
+    __repr__ = result_repr
 
     orders: HWLOrders
     n_params: int
@@ -78,13 +89,15 @@ class OrderSelection:
     candidates : tuple of OrderCandidate
         In the order tried.
     best : OrderCandidate
-        The parsimonious choice (module docstring).
+        The parsimonious choice (module docstring, :func:`_parsimonious`).
     rel_tol : float
     criterion : str
         Stage-2 criterion used for every candidate.
     skip : int
         Leading held-out samples not scored.
     """
+
+    __repr__ = result_repr
 
     candidates: tuple
     best: OrderCandidate
@@ -189,6 +202,21 @@ def parse_grid(text: str) -> dict[str, tuple[int, ...]]:
     return grid
 
 
+def _parsimonious(ok: list[OrderCandidate], rel_tol: float) -> OrderCandidate:
+    """Among the candidates (in grid order) whose score is within ``rel_tol`` of the best,
+    the one with the fewest parameters; of those, the lowest score, where a later candidate
+    replaces an earlier one only when it is lower by more than ``SCORE_TIE_RTOL``."""
+    s_min = min(c.score for c in ok)
+    near = [c for c in ok if c.score <= s_min * (1 + rel_tol)]
+    fewest = min(c.n_params for c in near)
+    best = None
+    for c in near:
+        if c.n_params == fewest and (best is None
+                                     or c.score < best.score * (1 - SCORE_TIE_RTOL)):
+            best = c
+    return best
+
+
 def select_orders(data: IOData, grid=None, *, base=(3, 1, 1, 1, 2, 2),
                   validation: float | IOData = 0.3, rel_tol: float = 0.02,
                   keep_models: bool = False, **settings: Any) -> OrderSelection:
@@ -266,9 +294,7 @@ def select_orders(data: IOData, grid=None, *, base=(3, 1, 1, 1, 2, 2),
     if not ok:
         msgs = "; ".join(f"{c.orders.as_tuple()}: {c.message or c.status}" for c in out[:5])
         raise DataError(f"no candidate orders could be identified ({msgs})")
-    s_min = min(c.score for c in ok)
-    near = [c for c in ok if c.score <= s_min * (1 + rel_tol)]
-    best = min(near, key=lambda c: (c.n_params, c.score))
+    best = _parsimonious(ok, rel_tol)
     if not keep_models:
         out = [c if c is best else replace(c, model=None) for c in out]
         best = next(c for c in out if c.orders == best.orders)

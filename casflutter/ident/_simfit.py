@@ -29,11 +29,12 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import LinAlgError, cho_factor, cho_solve
+from .._format import result_repr
 from .._threads import single_threaded
 
 from ..data import IOData
 from ._kernels import free_run, sensitivities
-from ._model import HWLStructure
+from ._structure import HWLStructure
 
 __all__ = ["FreeRunProblem", "LMResult", "fit_simulation_error"]
 
@@ -80,6 +81,8 @@ class LMResult:
         Segment lengths used (0: whole records).
     wall_time : float
     """
+
+    __repr__ = result_repr
 
     theta: np.ndarray
     initial_outputs: tuple
@@ -437,7 +440,7 @@ def _fit(problem, theta0, *, max_iter, tol, max_time, blowup) -> LMResult:
                 problem, x, seg, max_iter=max(1, min(30, max_iter - n_jac)), tol=1e-6,
                 deadline=deadline)
             n_jac, n_fev = n_jac + nj, n_fev + nf
-            log.info("simulation fit: %d-sample segments, cost %.4e (%s)", seg, f, status)
+            log.debug("simulation fit: %d-sample segments, cost %.4e (%s)", seg, f, status)
             if status in ("Unstable_Free_Run", "Maximum_WallTime_Exceeded"):
                 break
             seg *= 4

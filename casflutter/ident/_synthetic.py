@@ -1,4 +1,5 @@
-"""Known HWL models and their data, for checks, benchmarks and the demo."""
+"""Known HWL models and their data, for checks, benchmarks and the demo, and the small ROM
+of the documentation's examples (:func:`example_rom`)."""
 
 from __future__ import annotations
 
@@ -8,11 +9,14 @@ from scipy.signal import butter, sosfiltfilt
 
 from ..data import IOData, Record, chirp_excitation
 from ..errors import ConfigError
+from ..truth import load_problem, truth_records
+from ._common_denominator import identify_common_denominator
 from ._kernels import duffing_rk4
-from ._model import HWLModel, HWLStructure
+from ._model import HWLModel
 from ._orders import HWLOrders
+from ._structure import HWLStructure
 
-__all__ = ["random_hwl_model", "synthetic_data", "duffing_data"]
+__all__ = ["random_hwl_model", "synthetic_data", "duffing_data", "example_rom"]
 
 
 def random_hwl_model(n_modes: int = 5, orders=(3, 1, 1, 1, 2, 2), *, has_u: bool = True,
@@ -111,3 +115,34 @@ def duffing_data(n_samples: int = 65000, *, f0: float = 1.0, oversampling: float
     y = y + noise * np.sqrt(np.mean(y ** 2)) * rng.normal(size=n_samples)
     return IOData.from_arrays(y=y[:, None] + offset, u=u[:, None] + offset, dt=dt,
                               name="duffing", output_names=("y",), u_names=("u",))
+
+
+def example_rom():
+    """The linear ROM of the typical section that the examples of the later stages start from.
+
+    Chirp records of the typical section (Hodges & Pierce HP-1) at the speed index
+    ``V0 = 1.8`` (``dt = 0.1``, 60 time units, band 0.002-1 cycles per time unit), identified
+    by :func:`identify_common_denominator`: a two-mode model that identifies in about a
+    second and carries the section's flutter, so the realisation, the loop, the flutter
+    search, the LFT and the loop simulation can be tried on it.
+
+    Returns
+    -------
+    HWLModel
+        The identified model (a new one at every call).
+
+    See Also
+    --------
+    identify_common_denominator : how it is identified.
+    realize : its continuous Σf (eq. 5).
+
+    Examples
+    --------
+    >>> import casflutter as cf
+    >>> rom = cf.example_rom()
+    >>> rom.n_modes, rom.dt
+    (2, 0.1)
+    """
+    truth = load_problem("typical_section")
+    data = truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
+    return identify_common_denominator(data).model

@@ -8,7 +8,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-from ._model import HWLStructure, _ar_part, _input_part
+from ._structure import HWLStructure, _ar_part, _input_part
 
 __all__ = ["hwl_predict_function", "hwl_simulate_function", "ar_weights", "recursion_step"]
 

@@ -22,6 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
+from .._format import result_repr
 from ..errors import ConvergenceError
 from ._results import SUBCRITICAL, SUPERCRITICAL, Fold, HopfClassification, LCOSettings
 
@@ -231,6 +232,8 @@ class BranchStart:
     hint : str
         What to try when the first orbit fails.
     """
+
+    __repr__ = result_repr
 
     cp: object
     lyapunov: float

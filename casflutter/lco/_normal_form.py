@@ -36,6 +36,7 @@ import casadi as ca
 import numpy as np
 from scipy.optimize import brentq
 
+from .._format import result_repr
 from ..errors import ConfigError
 
 __all__ = ["MultilinearForms", "CriticalPair", "find_hopf", "find_neimark_sacker",
@@ -97,6 +98,8 @@ class CriticalPair:
     ``d|mu|/dV``); ``A`` the Jacobian there.
     """
 
+    __repr__ = result_repr
+
     V: float
     eigenvalue: complex
     q: np.ndarray
@@ -141,7 +144,8 @@ def find_hopf(forms: MultilinearForms, vrange, n_grid: int = 121, *, speed_scale
     Raises
     ------
     ConfigError
-        Unstable at the range start, or no crossing in the range.
+        Unstable at the range start, or no oscillatory eigenvalue crosses the imaginary
+        axis in the range.
     """
     def abscissa(V):
         lam = np.linalg.eigvals(forms.A(V))
@@ -168,7 +172,8 @@ def find_neimark_sacker(forms: MultilinearForms, vrange, n_grid: int = 121, *,
     Raises
     ------
     ConfigError
-        Unstable at the range start, or no crossing in the range.
+        Unstable at the range start, or no complex eigenvalue leaves the unit circle in the
+        range.
     """
     def radius(V):
         lam = np.linalg.eigvals(forms.A(V))

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError
 
 __all__ = ["LCOSettings", "LCOPoint", "Fold", "HopfClassification", "LCOBranch",
@@ -134,6 +135,8 @@ class LCOPoint:
         on the LCO (the truth's ``[u, u', lags]``; the ROM loop's map state).
     """
 
+    __repr__ = result_repr
+
     V: float
     period: float
     freq_hz: float
@@ -173,6 +176,8 @@ class Fold:
     max_multiplier : float
         The largest nontrivial multiplier modulus there (1 at an exact fold).
     """
+
+    __repr__ = result_repr
 
     V: float
     amplitude: dict
@@ -224,6 +229,8 @@ class HopfClassification:
     discrete : bool
         True for the sampled-data map (Neimark--Sacker).
     """
+
+    __repr__ = result_repr
 
     V: float
     omega: float
@@ -279,6 +286,8 @@ class LCOBranch:
     timings : dict
         Wall seconds: ``hopf``, ``branch``, ``total``.
     """
+
+    __repr__ = result_repr
 
     problem: str
     system: str

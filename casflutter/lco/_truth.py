@@ -71,11 +71,21 @@ def truth_outputs(truth, f: ca.Function, sensor_kind: str = "displacement") -> O
 
 
 def speed_convention(truth) -> tuple[float, str]:
-    """``(problem speed per speed index, unit)``: m/s for truths with an airspeed, else the
-    speed index itself."""
-    if hasattr(truth, "airspeed"):
-        return float(truth.airspeed(1.0)), "m/s"
-    return 1.0, truth.modal_structure().speed_index
+    """``(shown speed per speed index, unit)`` of a problem's
+    :class:`~casflutter.structure.SpeedConvention`: ``(U_ref, "m/s")`` when it has an
+    airspeed scale, else ``(1, the speed index's definition)``.
+
+    Parameters
+    ----------
+    truth : object
+        A problem with ``modal_structure()`` (a truth or a wing file's problem).
+
+    Returns
+    -------
+    tuple of (float, str)
+    """
+    speed = truth.modal_structure().speed
+    return speed.display_scale, speed.speed_unit
 
 
 class _OdeDisc:

@@ -328,7 +328,7 @@ def _controller_mat(result, doc: dict) -> dict:
         exact = result.rom_stable_V
         mat["exact_V"] = _mat_interval(exact)
         scale = speed_scale(_problem(result))
-        if scale.to_airspeed is not None:
+        if scale.has_airspeed:
             for name, pair in (("small_gain", ver.small_gain_V), ("exact", exact)):
                 iv = interval_values(pair, scale)
                 mat[f"{name}_airspeed_m_s"] = (np.zeros((0, 2)) if iv is None else np.array(
@@ -342,7 +342,8 @@ def label_summary(summary: dict, result) -> dict:
 
     Every speed index of the flutter blocks and of the controller gets its airspeed [m/s]
     and dynamic pressure [Pa] beside it when the problem has them, the ``units`` entry says
-    what each kind of number is in, and ``casflutter_version``, ``threads`` and ``flags``
+    what each kind of number is in, the LCO amplitudes get their sensors' units
+    (``lco.amplitude_units``), and ``casflutter_version``, ``threads`` and ``flags``
     (controller poles faster than the data's Nyquist frequency or the actuator) are added.
 
     Parameters
@@ -373,6 +374,11 @@ def label_summary(summary: dict, result) -> dict:
         ctl["certified"] = {"small_gain_V": interval_values(ver.small_gain_V, scale),
                             "exact_V": interval_values(result.rom_stable_V, scale)}
         ctl["poles"] = check
+    lco = summary.get("lco")
+    if isinstance(lco, dict) and result.lco.rom.sensors is not None:
+        # the amplitudes are of the sensor readings: say in what
+        lco["amplitude_units"] = list(sensor_units(_problem(result), _structure(result),
+                                                   bool(result.config.sensors.rows)))
     info = dict(getattr(result, "provenance", None) or {}) or provenance(seed=result.config.seed)
     summary["casflutter_version"] = info.get("casflutter_version")
     summary["threads"] = info.get("threads")

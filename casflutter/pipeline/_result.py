@@ -10,6 +10,7 @@ from typing import Any, Mapping
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..aeroelastic import (AeroelasticLFT, AeroelasticSystem, FlutterResult, LoopSimulation,
                            ParametricSystem, PKResult, RFASystem)
 from ..data import IOData
@@ -56,6 +57,8 @@ class LcoResult:
         (``lco.branch_points > 0``).
     """
 
+    __repr__ = result_repr
+
     rom: LoopSimulation
     truth: TruthLco | None
     V: float
@@ -79,6 +82,8 @@ class ParametricResult:
     flutter : FlutterResult
         Its flutter search.
     """
+
+    __repr__ = result_repr
 
     rom: ParametricROM
     system: ParametricSystem
@@ -105,6 +110,8 @@ class SimulationCheck:
     open_eig_rate, closed_eig_rate : float
         Spectral abscissae of the linear open and closed loops at ``V``.
     """
+
+    __repr__ = result_repr
 
     model: str
     V: float
@@ -142,6 +149,8 @@ class ClosedLoopChecks:
         Open and closed loop above each model's flutter speed.
     """
 
+    __repr__ = result_repr
+
     truth_sweep: TruthLoopSweep
     rom_simulation: SimulationCheck
     truth_simulation: SimulationCheck
@@ -163,6 +172,16 @@ def _flutter_summary(res: FlutterResult | None) -> dict | None:
     mode = res.flutter_mode
     return {"V": float(res.Vf), "freq_hz": float(res.omega_f) / (2 * np.pi),
             "mode": None if mode is None or mode < 0 else int(mode) + 1, "status": res.status}
+
+
+def skipped_notes(skipped: Mapping[str, str]) -> list[str]:
+    """``skipped A, B (reason)``: one line per reason of a run's skipped stages (each
+    ``"what: why"``)."""
+    by_reason: dict = {}
+    for text in skipped.values():
+        what, _, why = text.partition(": ")
+        by_reason.setdefault(why, []).append(what)
+    return [f"skipped {', '.join(whats)} ({why})" for why, whats in by_reason.items()]
 
 
 def _rel(a, b):
@@ -256,6 +275,8 @@ class RunResult:
         What produced the run (:func:`casflutter._outputs.provenance`: version, seed,
         thread settings, libraries) and its start time (``started``).
     """
+
+    __repr__ = result_repr
 
     config: RunConfig
     truth: AeroelasticTruth | None
@@ -367,6 +388,16 @@ class RunResult:
             text += (f" Parametric ROM ({len(self.parametric.rom.speeds)} speeds): "
                      f"{pct(self.parametric_error)}.")
         return text
+
+    def skipped_notes(self) -> list[str]:
+        """The stages that did not run and why, one line per reason.
+
+        Returns
+        -------
+        list of str
+            ``skipped A, B (reason)``; empty when every stage ran.
+        """
+        return skipped_notes(self.skipped)
 
     # ------------------------------------------------------------------ verification
     @property

@@ -26,7 +26,8 @@ A wing file without a simulator (``[problem] name`` a ``kind = "wing"`` file: mo
 sensors and records, :class:`casflutter.truth.WingProblem`) runs the same stages on its records
 at its own ``V0``; the stages that need the truth (its flutter search, ``frozen``,
 ``parametric``, the truth's LCO, ``closed_loop``, ``suppression``) are skipped with a logged
-note and listed in ``RunResult.skipped``.
+note and listed in ``RunResult.skipped``.  So is ``lco`` when the configured ROM is linear
+(the common-denominator ROM, or HWL orders with p = q = 1): a linear model has no limit cycle.
 
 A wing file with frequency-domain aerodynamics (``kind = "gaf"``: modal data and ``Q(ik)``,
 :class:`casflutter.truth.GAFProblem`) replaces stages 1-5 by the rational-function
@@ -78,7 +79,7 @@ from ..verify import (NotHurwitzError, StabilityInterval, speed_family_interval,
 from ._config import RunConfig, load_config
 from ._exports import check_output_folder, log_flags, write_outputs
 from ._result import (ClosedLoopChecks, LcoResult, ParametricResult, RunResult,
-                      SimulationCheck)
+                      SimulationCheck, skipped_notes)
 
 __all__ = ["run"]
 
@@ -92,7 +93,8 @@ _TRUTH_ONLY = {"flutter_truth": "the truth's flutter search", "frozen": "stage '
 
 
 class _Progress:
-    """Stage timings, and a line per stage on stderr unless quiet."""
+    """Stage timings, and one line per stage on stderr unless quiet (the stage's time at
+    DEBUG)."""
 
     def __init__(self, quiet: bool, names: list[str]):
         self.quiet = quiet
@@ -102,15 +104,14 @@ class _Progress:
 
     @contextmanager
     def stage(self, name: str):
-        if not self.quiet:
-            k = self.names.index(name) + 1
+        if not self.quiet and name not in self.timings:   # once, also when rom.v0_iterations
+            k = self.names.index(name) + 1                # repeats the stage
             print(f"[{k}/{len(self.names)}] {name} ...", file=sys.stderr, flush=True)
         t = time.perf_counter()
         yield
         dt = time.perf_counter() - t
         self.timings[name] = self.timings.get(name, 0.0) + dt
-        if not self.quiet:
-            print(f"      {name}: {dt:.2f} s", file=sys.stderr, flush=True)
+        log.debug("stage %s: %.2f s", name, dt)
 
     def note(self, text: str):
         if not self.quiet:
@@ -152,8 +153,7 @@ def _gaf_setup(cfg: RunConfig, gaf: GAFProblem) -> tuple[RFASettings, dict]:
     if "lco" in cfg.stages:
         skipped["lco"] = ("stage 'lco': the RFA of Q(ik) is linear (no LCO); it needs "
                           "records of a nonlinear model or a truth simulator")
-    for text in skipped.values():
-        log.info("skipped %s", text)
+    _log_skipped(skipped)
     return settings, skipped
 
 
@@ -179,9 +179,9 @@ def _run_gaf(cfg: RunConfig, gaf: GAFProblem, settings: RFASettings, structure, 
                             max_refine=cfg.flutter.max_refine)
         pk = pk_flutter(gaf.table, structure, np.linspace(U_lo, U_hi, 29),
                         modes=_pk_modes(gaf, U_lo))
-    prog.note(f"RFA ΣAE(U): Uf = {fl_U.Vf if fl_U.Vf is not None else float('nan'):.4f} m/s, "
-              f"{fl_U.omega_f if fl_U.omega_f is not None else float('nan'):.4f} rad/s; p–k: "
-              f"{pk.flutter_speed if pk.found else float('nan'):.4f} m/s")
+    prog.note("RFA ΣAE(U): " + (f"Uf = {fl_U.Vf:.5g} m/s, {fl_U.omega_f:.5g} rad/s"
+                                 if fl_U.Vf is not None else "no flutter") + "; p–k: "
+              + (f"{pk.flutter_speed:.5g} m/s" if pk.found else "no flutter"))
     if fl_U.Vf is None:
         raise CasflutterError(f"the RFA system of {gaf.name!r} has no flutter crossing in "
                               f"U ∈ [{U_lo:g}, {U_hi:g}] m/s: {fl_U.message}; widen "
@@ -198,7 +198,8 @@ def _run_gaf(cfg: RunConfig, gaf: GAFProblem, settings: RFASettings, structure, 
         flutter = find_flutter(system, cfg.flutter.V_range, n_grid=cfg.flutter.n_grid,
                                max_refine=cfg.flutter.max_refine)
     if flutter.Vf is None or abs(flutter.Vf / Vf - 1) > 1e-3:
-        prog.note(f"warning: ΣAE(V) of Σf frozen at Uf flutters at V = {flutter.Vf} in "
+        at = "nowhere" if flutter.Vf is None else f"at V = {flutter.Vf:.6g}"
+        prog.note(f"warning: ΣAE(V) of Σf frozen at Uf flutters {at} in "
                   f"{cfg.flutter.V_range}, not at Uf / U_ref = {Vf:.6g}; the LFT is built at "
                   "Uf / U_ref, where the frozen system is exact")
     out.update(system=system, flutter=flutter, gaf_Vf=Vf)
@@ -213,12 +214,34 @@ def _wing_setup(cfg: RunConfig, wing: WingProblem) -> tuple[RunConfig, dict]:
                           "set rom.v0_iterations = 1")
     _same_sensors(cfg, wing)
     why = f"needs a truth simulator; the wing file {wing.name!r} has records only"
-    wanted = {"flutter_truth"} | set(cfg.stages) | ({"truth_lco"} if "lco" in cfg.stages
-                                                     else set())
+    lco = "lco" in cfg.stages and not _linear_rom_skips(cfg)     # (else no LCO stage at all)
+    wanted = {"flutter_truth"} | set(cfg.stages) | ({"truth_lco"} if lco else set())
     skipped = {k: f"{v}: {why}" for k, v in _TRUTH_ONLY.items() if k in wanted}
-    for text in skipped.values():
-        log.info("skipped %s", text)
+    _log_skipped(skipped)
     return replace(cfg, data=replace(cfg.data, V0=float(wing.V0))), skipped
+
+
+def _log_skipped(skipped: dict) -> None:
+    """One log line per reason: ``skipped A, B (reason)``."""
+    for line in skipped_notes(skipped):
+        log.info(line)
+
+
+def _linear_rom_skips(cfg: RunConfig) -> dict:
+    """``{"lco": reason}`` when the configured ROM is linear (a linear model has no limit
+    cycle: above flutter it only grows), else ``{}``; decided from the configuration."""
+    r = cfg.rom
+    if "lco" not in cfg.stages:
+        return {}
+    if r.method == "common_denominator":
+        what = 'rom.method = "common_denominator" is linear'
+    elif tuple(r.orders)[4:] == (1, 1):
+        what = f"rom.orders = {list(r.orders)} has p = q = 1: the HWL model is linear"
+    else:
+        return {}
+    return {"lco": f"stage 'lco': {what} and has no limit cycle (above flutter it only "
+                   "grows); identify a nonlinear ROM (rom.method = \"hwl\" with p or q >= 2, "
+                   "Table I: [3, 1, 1, 1, 2, 2]) or drop 'lco' from stages"}
 
 
 def _mode(res: FlutterResult) -> int:
@@ -310,12 +333,13 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
         raise ConfigError(f"problem.name = {cfg.problem.name!r} is a {type(problem).__name__}, "
                           "which casflutter.pipeline.run does not take; give a truth problem "
                           "or a wing file (kind = \"wing\")")
+    if not isinstance(problem, GAFProblem) and (linear := _linear_rom_skips(cfg)):
+        _log_skipped(linear)
+        skipped = {**skipped, **linear}
     names = _stage_names(cfg, skipped)
     if isinstance(problem, GAFProblem):
         names = ["rfa", "flutter", "realize", "structure"] + names[5:]
     prog = _Progress(quiet, names)
-    for text in skipped.values():
-        prog.note(f"skipped {text}")
     structure = problem.modal_structure().with_sensors(cfg.sensors.rows or None,
                                                        cfg.sensors.kind)
     rows = cfg.sensors.rows or None
@@ -370,9 +394,12 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
         V0 = float(Vf)
     fit = (ident.fit if isinstance(ident, IdentificationResult)
            else fit_report(model, data, "simulation"))
-    prog.note(f"{model}; fit error % " + ", ".join(f"{e:.3f}" for e in fit.error_percent))
-    prog.note(f"ROM Vf = {Vf if Vf is not None else float('nan'):.4f}; truth Vf = "
-              f"{flutter_truth.Vf if flutter_truth and flutter_truth.flutter else float('nan'):.4f}")
+    prog.note(f"{model}; fit error % " + ", ".join(f"{e:.4g}" for e in fit.error_percent))
+    rom_vf = f"ROM Vf = {Vf:.5g}" if Vf is not None else "ROM: no flutter in flutter.V_range"
+    if flutter_truth is not None:   # no truth on a wing file: nothing to say of it
+        rom_vf += (f"; truth Vf = {flutter_truth.Vf:.5g}" if flutter_truth.flutter is not None
+                   else "; truth: no flutter in flutter.V_range")
+    prog.note(rom_vf)
     out.update(data=data, identification=ident, identification_history=tuple(history),
                fit=fit, realization=real, system=system, flutter=flutter,
                flutter_truth=flutter_truth)
@@ -390,7 +417,7 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
             psys = ParametricSystem(prom, structure)
             out["parametric"] = ParametricResult(prom, psys, find_flutter(
                 psys, vr, n_grid=cfg.flutter.n_grid, max_refine=cfg.parametric.max_refine))
-    if "lco" in cfg.stages:
+    if "lco" in cfg.stages and "lco" not in skipped:
         with prog.stage("lco"):
             out["lco"] = _lco(cfg, truth, model, structure, flutter, flutter_truth, prog)
     if "controller" in cfg.stages:
@@ -551,9 +578,9 @@ def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth, prog) 
         tr = truth_lco(truth, V_truth, lc.duration, crit, lc.initial_deflection, dt=model.dt,
                        sensor_rows=structure.Hs, sensor=structure.sensor,
                        max_extensions=_MAX_EXTENSIONS)
-    prog.note(f"ROM LCO at V = {V_lco:.4f} (loop flutter {V_loop or float('nan'):.4f}, "
-              f"continuous exact-order Hopf {V_hopf:.4f}): "
-              f"{sim.sensors.kind}, {sim.sensors.frequency_hz:.3f} Hz")
+    loop = "" if V_loop is None else f"loop flutter {V_loop:.5g}, "
+    prog.note(f"ROM LCO at V = {V_lco:.5g} ({loop}continuous exact-order Hopf {V_hopf:.5g}): "
+              f"{sim.sensors.kind}, {sim.sensors.frequency_hz:.4g} Hz")
     branches = _branches(cfg, truth, model, structure, prog) if lc.branch_points else {}
     return LcoResult(rom=sim, truth=tr, V=V_lco, V_hopf_exact_order=V_hopf,
                      flutter_exact_order=fl_exact, V_hopf_loop=V_loop, **branches)

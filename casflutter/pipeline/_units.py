@@ -1,11 +1,11 @@
 """The units of a run's outputs: speed index, airspeed and dynamic pressure kept apart.
 
 Every stage works in the problem's speed index ``V`` (eq. 6: the structure sees
-``alpha V^2 y``); what ``V`` means is the problem's own convention
-(``modal_structure().speed_index``, e.g. ``V = U / U_ref``).  A problem that knows its speed
-scale converts it to the airspeed ``U`` [m/s] (``problem.airspeed(V)``) and, when it knows
-the air density, to the dynamic pressure ``q = rho U^2 / 2`` [Pa].  :class:`SpeedScale`
-gathers these conversions, and :func:`speed_values` writes one speed with every unit named
+``alpha V^2 y``); what ``V`` means is the problem's own
+:class:`~casflutter.structure.SpeedConvention` (``modal_structure().speed``, e.g.
+``V = U / U_ref``), which converts it to the airspeed ``U`` [m/s] when the problem has a
+speed scale and to the dynamic pressure ``q = rho U^2 / 2`` [Pa] when it knows the air
+density.  :func:`speed_values` writes one speed with every unit named
 (``{"speed_index": ..., "airspeed_m_s": ..., "dynamic_pressure_Pa": ...}``), so that no output
 holds a bare number whose unit the reader must guess.
 """
@@ -13,68 +13,29 @@ holds a bare number whose unit the reader must guess.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Callable
 
-__all__ = ["SpeedScale", "speed_scale", "speed_values", "interval_values", "units_block",
-           "sensor_units", "FLAP_UNIT"]
+from ..structure import SpeedConvention
+
+__all__ = ["speed_scale", "speed_values", "interval_values", "units_block", "sensor_units",
+           "FLAP_UNIT"]
 
 #: Unit of the flap deflection ``v`` of every problem (the truths' ``aero_forces``).
 FLAP_UNIT = "rad"
 
 
-@dataclass(frozen=True)
-class SpeedScale:
-    """The speed conventions of a problem.
-
-    Attributes
-    ----------
-    definition : str
-        What the speed index is (``modal_structure().speed_index``).
-    time_unit : str
-        Unit of time of the problem (frequencies are in rad per this unit).
-    to_airspeed : callable or None
-        Speed index -> airspeed [m/s] (``None``: the problem has no speed scale).
-    to_dynamic_pressure : callable or None
-        Speed index -> dynamic pressure [Pa] (``None``: no air density known).
-    """
-
-    definition: str
-    time_unit: str = "s"
-    to_airspeed: Callable[[float], float] | None = None
-    to_dynamic_pressure: Callable[[float], float] | None = None
-
-    @property
-    def speed_index_label(self) -> str:
-        """``"speed index (<definition>)"``."""
-        return f"speed index ({self.definition})"
-
-
-def speed_scale(problem) -> SpeedScale:
-    """The :class:`SpeedScale` of a truth or a wing problem.
+def speed_scale(problem) -> SpeedConvention:
+    """The :class:`~casflutter.structure.SpeedConvention` of a truth or a wing problem.
 
     Parameters
     ----------
     problem : object
-        Anything with ``modal_structure()``; ``airspeed(V)`` [m/s] when it has a speed scale,
-        and ``dynamic_pressure(V)`` [Pa] or ``params.rho`` [kg/m^3] for the dynamic pressure.
+        Anything with ``modal_structure()``.
 
     Returns
     -------
-    SpeedScale
+    SpeedConvention
     """
-    ms = problem.modal_structure()
-    to_u = getattr(problem, "airspeed", None)
-    to_u = to_u if callable(to_u) else None
-    to_q = None
-    if callable(getattr(problem, "dynamic_pressure", None)):
-        if getattr(problem, "rho", 1.0) is not None:
-            to_q = problem.dynamic_pressure
-    elif to_u is not None:
-        rho = getattr(getattr(problem, "params", None), "rho", None)
-        if isinstance(rho, (int, float)) and math.isfinite(rho) and rho > 0:
-            to_q = lambda V, _u=to_u, _r=float(rho): 0.5 * _r * _u(V) ** 2  # noqa: E731
-    return SpeedScale(str(ms.speed_index), str(ms.time_unit), to_u, to_q)
+    return problem.modal_structure().speed
 
 
 def _num(x):
@@ -84,14 +45,14 @@ def _num(x):
     return x if math.isfinite(x) else None
 
 
-def speed_values(V, scale: SpeedScale) -> dict | None:
+def speed_values(V, scale: SpeedConvention) -> dict | None:
     """One speed index with its airspeed and dynamic pressure, each key naming its unit.
 
     Parameters
     ----------
     V : float or None
         Speed index.
-    scale : SpeedScale
+    scale : SpeedConvention
 
     Returns
     -------
@@ -103,15 +64,15 @@ def speed_values(V, scale: SpeedScale) -> dict | None:
         return None
     V = float(V)
     out = {"speed_index": _num(V)}
-    if scale.to_airspeed is not None:
-        out["airspeed_m_s"] = _num(scale.to_airspeed(V)) if math.isfinite(V) else None
-    if scale.to_dynamic_pressure is not None:
-        out["dynamic_pressure_Pa"] = (_num(scale.to_dynamic_pressure(V)) if math.isfinite(V)
+    if scale.has_airspeed:
+        out["airspeed_m_s"] = _num(scale.airspeed(V)) if math.isfinite(V) else None
+    if scale.has_dynamic_pressure:
+        out["dynamic_pressure_Pa"] = (_num(scale.dynamic_pressure(V)) if math.isfinite(V)
                                       else None)
     return out
 
 
-def interval_values(pair, scale: SpeedScale) -> dict | None:
+def interval_values(pair, scale: SpeedConvention) -> dict | None:
     """A speed interval ``(lo, hi)`` in every unit: ``{"speed_index": [lo, hi],
     "airspeed_m_s": [...], "dynamic_pressure_Pa": [...]}`` (``None`` without an interval)."""
     if pair is None:
@@ -120,7 +81,7 @@ def interval_values(pair, scale: SpeedScale) -> dict | None:
     return {k: [lo[k], hi[k]] for k in lo}
 
 
-def units_block(scale: SpeedScale) -> dict:
+def units_block(scale: SpeedConvention) -> dict:
     """The ``units`` entry of ``summary.json``: what each kind of number is measured in.
 
     Returns
@@ -130,13 +91,12 @@ def units_block(scale: SpeedScale) -> dict:
         ``dynamic_pressure_Pa`` (``None`` when the problem has no such scale), ``freq_hz``,
         ``time``.
     """
-    t = scale.time_unit
     return {"V": scale.speed_index_label + ": every key V, V0, *_V, V_* that is not named "
                  "*_m_s or *_Pa",
-            "airspeed_m_s": "m/s" if scale.to_airspeed is not None else None,
-            "dynamic_pressure_Pa": "Pa" if scale.to_dynamic_pressure is not None else None,
-            "freq_hz": "Hz" if t == "s" else f"cycles per time unit {t}",
-            "time": t}
+            "airspeed_m_s": "m/s" if scale.has_airspeed else None,
+            "dynamic_pressure_Pa": "Pa" if scale.has_dynamic_pressure else None,
+            "freq_hz": scale.frequency_unit,
+            "time": scale.time_unit}
 
 
 def sensor_units(problem, structure, custom_rows: bool) -> tuple[str, ...]:

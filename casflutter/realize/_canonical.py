@@ -133,9 +133,7 @@ def canonical_realization(model) -> control.StateSpace:
     Examples
     --------
     >>> import casflutter as cf
-    >>> truth = cf.load_problem("typical_section")
-    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
-    >>> rom = cf.identify_common_denominator(data).model
+    >>> rom = cf.example_rom()
     >>> sys_d = cf.canonical_realization(rom)
     >>> sys_d.dt, sys_d.ninputs, sys_d.noutputs
     (0.1, 3, 2)

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError
 from ..ident import CommonDenominatorResult, HWLModel
 from ._canonical import canonical_matrices, canonical_realization, lag_coefficients
@@ -95,6 +96,8 @@ class ParametricROM:
         Speeds not increasing, fewer than two, not one per identification, or ROMs of
         different orders.
     """
+
+    __repr__ = result_repr
 
     speeds: np.ndarray
     identifications: tuple

@@ -25,6 +25,7 @@ import control
 import numpy as np
 from scipy.signal import cont2discrete
 
+from .._format import result_repr
 from ..errors import DimensionError, OrderError
 
 __all__ = ["Realization", "era", "inverse_tustin", "tustin_to_continuous", "continuous_to_tustin",
@@ -203,6 +204,8 @@ class Realization:
         The Markov parameters realised.
     """
 
+    __repr__ = result_repr
+
     sigma_f: control.StateSpace
     discrete: control.StateSpace
     hankel_singular_values: np.ndarray
@@ -258,9 +261,7 @@ def realize(model, order: int | str = "auto", *, tol: float = 1e-9,
     Examples
     --------
     >>> import casflutter as cf
-    >>> truth = cf.load_problem("typical_section")
-    >>> data = cf.truth_records(truth, V0=1.8, dt=0.1, duration=60.0, band=(0.002, 1.0))
-    >>> rom = cf.identify_common_denominator(data).model
+    >>> rom = cf.example_rom()
     >>> r = cf.realize(rom)
     >>> r.order, r.sigma_f.isctime()
     (8, True)

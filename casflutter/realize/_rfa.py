@@ -38,6 +38,7 @@ from dataclasses import dataclass, field, replace
 import casadi as ca
 import numpy as np
 
+from .._format import result_repr
 from .._nlp import NLPResult, solve_nlp
 from ..data import GAFTable
 from ..errors import ConfigError, ConvergenceError, DataError
@@ -170,6 +171,8 @@ class RationalApproximation:
         or ``Search_Direction_Becomes_Too_Small`` when the data are exactly rational in the
         roots and the residual sits at the rounding floor).
     """
+
+    __repr__ = result_repr
 
     method: str
     b: float
@@ -498,8 +501,8 @@ def fit_rfa(table: GAFTable, settings: RFASettings | None = None,
     Y = _stack(Q) * w.reshape(1, -1)
     if s.method == "roger":
         gamma, res = _fit_roger_lags(k, Y, s, bounds, _initial_lags(s, kmax, bounds))
-        log.info("Roger lag roots %s (%d Ipopt iterations, %s)", np.round(gamma, 5),
-                 res.iterations, res.return_status)
+        log.debug("Roger lag roots %s (%d Ipopt iterations, %s)", np.round(gamma, 5),
+                  res.iterations, res.return_status)
         X = _roger_lstsq(k, Y, gamma, s.poly_order) / w.reshape(1, -1)
         A = np.zeros((3, N, M))
         A[:s.poly_order + 1] = X[:s.poly_order + 1].reshape(-1, N, M)
@@ -509,8 +512,8 @@ def fit_rfa(table: GAFTable, settings: RFASettings | None = None,
     else:
         lg0, E0 = _ms_start(k, Y, w, s, kmax, bounds, N, M)
         gamma, E, res = _fit_ms_lags(k, Y, w, s, bounds, lg0, E0, N, M)
-        log.info("minimum-state lag roots %s (%d Ipopt iterations, %s)", np.round(gamma, 5),
-                 res.iterations, res.return_status)
+        log.debug("minimum-state lag roots %s (%d Ipopt iterations, %s)", np.round(gamma, 5),
+                  res.iterations, res.return_status)
         D, X0 = _ms_lstsq(k, Y, w, gamma, E, s.poly_order, N, M)
         A = np.zeros((3, N, M))
         A[:s.poly_order + 1] = (X0 / w.reshape(1, -1)).reshape(-1, N, M)

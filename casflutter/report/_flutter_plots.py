@@ -7,7 +7,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-__all__ = ["plot_vg_vf", "plot_root_locus", "plot_lco", "plot_pole_loci"]
+from ._labels import label_unit
+
+__all__ = ["plot_vg_vf", "plot_root_locus", "plot_lco", "plot_pole_loci", "speed_axes"]
 
 
 def _tracking(obj):
@@ -15,14 +17,48 @@ def _tracking(obj):
     return (obj.tracking, obj) if hasattr(obj, "tracking") else (obj, None)
 
 
+def speed_axes(ax, scale: float, index_label: str | None) -> None:
+    """A secondary speed-index axis on top of ``ax``, whose x axis is ``scale`` times the
+    speed index (the airspeed in m/s); nothing when ``scale`` is 1 or no label is given.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The top panel of a figure drawn against the problem's speed.
+    scale : float
+        Problem speed per speed index (``airspeed(1.0)``).
+    index_label : str or None
+        Label of the secondary axis, e.g. ``"speed index V = U / U_ref"``.
+    """
+    if index_label is None or scale == 1.0:
+        return
+    sec = ax.secondary_xaxis("top", functions=(lambda x: x / scale, lambda v: v * scale))
+    sec.set_xlabel(index_label, fontsize="small")
+    sec.tick_params(labelsize="small")
+
+
+def _mode_label(mode: int | None, mode_names) -> str:
+    """``"mode 2 (torsion 1)"`` for the 0-based ``mode`` (numbered from 1 for a reader)."""
+    if mode is None or mode < 0:
+        return ""
+    name = (f" ({mode_names[mode]})" if mode_names is not None and mode < len(mode_names)
+            else "")
+    return f"mode {mode + 1}{name}"
+
+
 def plot_vg_vf(result, *, branches=None, hz: bool = True, ax=None, mode_names=None,
-               speed_label: str = "speed index V") -> Figure:
-    """V–g and V–f plot: damping ratio ``ζ = −Re λ/|λ|`` and frequency of every branch against V.
+               speed_label: str = "speed index V", speed_scale: float = 1.0,
+               speed_unit: str = "", index_label: str | None = None,
+               frequency_unit: str | None = None) -> Figure:
+    """V–g and V–f plot: damping ratio ``ζ = −Re λ/|λ|`` and frequency of every branch against
+    the speed.
 
     With a :class:`~casflutter.aeroelastic.FlutterResult` the branches that grow out of a
-    structural mode are drawn in colour and named by their mode (numbered from 1); the
-    branches of the aerodynamic lag states are drawn faint and grey, with one legend entry,
-    and the axes are scaled to the structural branches (every mode's frequency in view).
+    structural mode are drawn in that mode's colour (the same in every panel of a figure)
+    and named once by their mode (numbered from 1); the branches of the aerodynamic lag
+    states are drawn faint and grey, with one legend entry, and the axes are scaled to the
+    structural branches (every mode's frequency in view).  The title names the flutter speed
+    and frequency in the axes' units and the mode whose curve crosses zero.
 
     Parameters
     ----------
@@ -31,13 +67,23 @@ def plot_vg_vf(result, *, branches=None, hz: bool = True, ax=None, mode_names=No
     branches : sequence of int, optional
         Branches to draw (default: one of each conjugate pair and the real branches).
     hz : bool
-        Frequency axis in Hz (else rad/s).
+        Frequency axis in Hz (else in rad per the problem's time unit).
     ax : pair of Axes, optional
         Where to draw (damping, frequency); a new figure otherwise.
     mode_names : sequence of str, optional
         Names of the structural modes, added to their legend entries.
     speed_label : str
         Label of the speed axis.
+    speed_scale : float
+        Speed on the axis per speed index of ``result`` (``airspeed(1.0)`` to draw against
+        the airspeed in m/s; 1: the speed index itself).
+    speed_unit : str
+        Unit of the axis speed in the title (``"m/s"``; empty for the speed index).
+    index_label : str, optional
+        With ``speed_scale != 1``: label of a secondary axis on top with the speed index.
+    frequency_unit : str, optional
+        Unit of the frequency axis (default ``"Hz"``, or ``"rad/s"`` with ``hz=False``); a
+        problem in nondimensional time gives its own (``"Ω/ω_θ"``).
 
     Returns
     -------
@@ -49,10 +95,12 @@ def plot_vg_vf(result, *, branches=None, hz: bool = True, ax=None, mode_names=No
     else:
         ag, af = ax
         fig = ag.figure
+    funit = frequency_unit or ("Hz" if hz else "rad/s")
     bs = tr.upper_branches() if branches is None else np.asarray(branches)
     freq = np.abs(tr.frequency_hz if hz else tr.frequency)
     zeta = tr.damping_ratio
-    structural, aero_drawn = [], False
+    speed = tr.V * speed_scale
+    structural, aero_drawn, named = [], False, set()
     for b in sorted(bs, key=lambda b: (res.origin[b] if res is not None and res.origin[b] >= 0
                                        else 10 ** 6, b)):
         origin = int(res.origin[b]) if res is not None else -2
@@ -60,30 +108,32 @@ def plot_vg_vf(result, *, branches=None, hz: bool = True, ax=None, mode_names=No
             kw = dict(color="0.6", lw=0.7, alpha=0.5, zorder=1,
                       label=None if aero_drawn else "aerodynamic lag states")
             aero_drawn = True
-            ag.plot(tr.V, zeta[:, b], **kw)
-            af.plot(tr.V, freq[:, b], color="0.6", lw=0.7, alpha=0.5, zorder=1)
+            ag.plot(speed, zeta[:, b], **kw)
+            af.plot(speed, freq[:, b], color="0.6", lw=0.7, alpha=0.5, zorder=1)
             continue
-        if origin >= 0:
-            name = (f" ({mode_names[origin]})" if mode_names is not None
-                    and origin < len(mode_names) else "")
-            lab = f"mode {origin + 1}{name}"
-        else:
-            lab = f"branch {b + 1}"
         structural.append(b)
-        line, = ag.plot(tr.V, zeta[:, b], lw=1.5, label=lab, zorder=3)
-        af.plot(tr.V, freq[:, b], color=line.get_color(), lw=1.5, zorder=3)
+        if origin >= 0:             # one colour and one legend entry per mode
+            kw = dict(color=f"C{origin % 10}", lw=1.5 if origin not in named else 1.0,
+                      label=None if origin in named else _mode_label(origin, mode_names))
+            named.add(origin)
+        else:
+            kw = dict(lw=1.5, label=f"branch {b + 1}")
+        line, = ag.plot(speed, zeta[:, b], zorder=3, **kw)
+        af.plot(speed, freq[:, b], color=line.get_color(), lw=kw["lw"], zorder=3)
     ag.axhline(0.0, color="k", lw=0.8)
     if res is not None:
         for c in res.crossings:
             style = "--" if c.kind == "flutter" else ":"
             for a in (ag, af):
-                a.axvline(c.V, color="r" if c.direction == "destabilizing" else "g", ls=style,
-                          lw=0.8)
+                a.axvline(c.V * speed_scale, color="r" if c.direction == "destabilizing"
+                          else "g", ls=style, lw=0.8)
         if res.Vf is not None:
-            mode = (f" (mode {res.flutter_mode + 1})"
-                    if res.flutter_mode is not None and res.flutter_mode >= 0 else "")
-            ag.set_title(f"flutter: Vf = {res.Vf:.4g}, {res.frequency_hz:.3g} Hz{mode}",
-                         fontsize="medium")
+            mode = _mode_label(res.flutter_mode, mode_names)
+            f = res.frequency_hz if funit == "Hz" else res.omega_f
+            symbol = "U" if speed_unit == "m/s" else "V"
+            ag.set_title(f"flutter: {symbol}f = {res.Vf * speed_scale:.4g}"
+                         f"{' ' + speed_unit if speed_unit else ''}, {f:.4g} {funit}"
+                         + (f", {mode}" if mode else ""), fontsize="medium")
         else:
             ag.set_title(res.status.replace("_", " "), fontsize="medium")
         if structural and aero_drawn:
@@ -94,8 +144,9 @@ def plot_vg_vf(result, *, branches=None, hz: bool = True, ax=None, mode_names=No
             pad = 0.1 * max(hi - lo, 1e-3)
             ag.set_ylim(min(lo, 0.0) - pad, hi + pad)
     ag.set_ylabel("damping ratio ζ = −Re λ / |λ|")
-    af.set_ylabel("frequency [Hz]" if hz else "frequency [rad/s]")
+    af.set_ylabel(f"frequency [{funit}]")
     af.set_xlabel(speed_label)
+    speed_axes(ag, speed_scale, index_label)
     ag.grid(True, alpha=0.3)
     af.grid(True, alpha=0.3)
     if ax is None:     # the legend beside the plots, clear of the branches
@@ -142,7 +193,8 @@ def _last_cycles(t, X, freq_hz: float, cycles: int):
 
 
 def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | None = None,
-             truth=None, labels=None, cycles: int = 6, title: str | None = None) -> Figure:
+             truth=None, labels=None, cycles: int = 6, title: str | None = None,
+             speed_scale: float = 1.0, speed_unit: str = "", time_unit: str = "s") -> Figure:
     """LCO time history and spectrum (paper Fig. 9).
 
     One row per channel and a spectrum row.  With the truth's response the ROM's is drawn
@@ -164,11 +216,19 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
         The truth's own response beside the ROM's (sensor outputs only), from
         :func:`casflutter.truth.truth_lco`.
     labels : sequence of str, optional
-        Axis label per channel with its unit (default ``sensor 1``, ``mode 1``, ...).
+        Axis label per channel with its unit (``"name [unit]"``; the unit also follows each
+        amplitude); default ``sensor 1``, ``mode 1``, ...
     cycles : int
         Periods shown of each time history (the whole record when it has no frequency).
     title : str, optional
         Figure title.
+    speed_scale : float
+        Problem speed per speed index: with ``speed_unit`` the panels name the speed in
+        that unit beside the speed index (``V = 1.248 (36.07 m/s)``).
+    speed_unit : str
+        Unit of ``speed_scale`` (``"m/s"``; empty: the speed index alone).
+    time_unit : str
+        The problem's time unit: time in it, frequencies in cycles per it (Hz for seconds).
 
     Returns
     -------
@@ -186,27 +246,32 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
     if truth is not None and which == "sensors":
         pairs.append(("truth", truth.timepts, truth.zm, truth.analysis, truth.V))
     ncol = len(pairs)
+    hz = "Hz" if time_unit == "s" else f"cycles per {time_unit}"
     fig, axes = plt.subplots(len(chans) + 1, ncol, figsize=(5.2 * ncol + 1.2, 2.1 * len(chans) + 2.6),
                              squeeze=False, sharey="row")
     for col, (label, t, Z, a, V) in enumerate(pairs):
         f = a.frequency_hz if a is not None else float("nan")
         tt, ZZ = _last_cycles(t, Z, f, cycles)
-        head = f"{label} at V = {V:.4g}: {a.kind if a is not None else ''}"
+        air = f" ({V * speed_scale:.4g} {speed_unit})" if speed_unit else ""
+        head = f"{label} at V = {V:.4g}{air}: {a.kind if a is not None else ''}"
         if a is not None and a.kind == "lco":
-            head += f", {f:.3g} Hz"
+            head += f", {f:.3g} {hz}"
         axes[0, col].set_title(head, fontsize="medium")
         for row, j in enumerate(chans):
             ax = axes[row, col]
             ax.plot(tt, ZZ[:, j], color="C0" if col == 0 else "k", lw=1.0)
             if a is not None and j < len(a.amplitude) and a.kind == "lco":
-                ax.text(0.99, 0.95, f"amplitude {a.amplitude[j]:.4g}", transform=ax.transAxes,
+                ax.text(0.99, 0.95,
+                        f"amplitude {a.amplitude[j]:.4g} {label_unit(names[row])}".rstrip(),
+                        transform=ax.transAxes,
                         ha="right", va="top", fontsize="small",
                         bbox=dict(fc="white", ec="none", alpha=0.8))
             if col == 0:
                 ax.set_ylabel(names[row], fontsize="small")
             ax.grid(True, alpha=0.3)
         axes[len(chans) - 1, col].set_xlabel(
-            "time [s]" + (f" (last {cycles} periods)" if np.isfinite(f) and f > 0 else ""))
+            f"time [{time_unit}]" + (f" (last {cycles} periods)" if np.isfinite(f) and f > 0
+                                     else ""))
         afr = axes[len(chans), col]
         dom = a.dominant if a is not None else 0
         if a is not None and a.spectrum.size:
@@ -217,7 +282,7 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
                            and np.isfinite(an.frequency_hz) else None)
         if fmax:
             afr.set_xlim(0, fmax)
-        afr.set_xlabel("frequency [Hz]")
+        afr.set_xlabel(f"frequency [{hz}]")
         dom_name = names[chans.index(dom)] if dom in chans else f"{word} {dom + 1}"
         afr.set_ylabel("|FFT|", fontsize="small")
         afr.set_title(f"spectrum of {dom_name.split(' [')[0]}", fontsize="small")

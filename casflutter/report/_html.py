@@ -6,7 +6,9 @@ import base64
 import html
 from pathlib import Path
 
-__all__ = ["html_report", "PAPER_TABLE_I"]
+from .._format import sig
+
+__all__ = ["html_report", "PAPER_TABLE_I", "VF_FLAG_FRACTION", "flutter_speed_flags"]
 
 #: Paper Table I and §IV figures, for the comparison column.
 PAPER_TABLE_I = {
@@ -26,14 +28,78 @@ PAPER_TABLE_I = {
 }
 
 
+#: A ROM flutter speed that differs from the truth's by more than this fraction is flagged
+#: in the report (unconservative when above the truth's: a clearance read off the ROM would
+#: admit speeds at which the wing flutters).
+VF_FLAG_FRACTION = 0.02
+
+
 def _fmt(x, digits=4):
     if x is None:
         return "—"
-    if isinstance(x, float):
-        return f"{x:.{digits}g}"
-    if isinstance(x, (list, tuple)):
-        return "(" + ", ".join(_fmt(v, digits) for v in x) + ")"
-    return html.escape(str(x))
+    if isinstance(x, bool) or not isinstance(x, (int, float, list, tuple)):
+        return html.escape(str(x))
+    return html.escape(sig(x, digits))
+
+
+def _airspeed_scale(s: dict) -> float | None:
+    """Metres per second per speed index, read off a flutter block that has both."""
+    for key in ("flutter", "flutter_truth"):
+        b = s.get(key) or {}
+        if b.get("V") and b.get("airspeed_m_s") is not None:
+            return float(b["airspeed_m_s"]) / float(b["V"])
+    return None
+
+
+def _with_airspeed(V, scale: float | None) -> str:
+    """``1.2 (34.68 m/s)``, ``(0, 1.568) = (0, 45.31) m/s``: a speed index (or an interval of
+    them) and, where the problem has a scale, its airspeed."""
+    if V is None:
+        return "—"
+    if scale is None:
+        return _fmt(V)
+    if isinstance(V, (list, tuple)):
+        return f"{_fmt(V)} = {_fmt([None if v is None else v * scale for v in V])} m/s"
+    return f"{_fmt(V)} ({_fmt(V * scale)} m/s)"
+
+
+def flutter_speed_flags(summary: dict, threshold: float = VF_FLAG_FRACTION) -> list[str]:
+    """The ROM flutter speeds of a run that differ from the truth's by more than
+    ``threshold``, each said in one sentence (unconservative above the truth's).
+
+    Parameters
+    ----------
+    summary : dict
+        The run's summary (``summary.json``): ``flutter_truth`` and the ROMs' blocks
+        ``flutter`` (the paper's route), ``flutter_parametric``.
+    threshold : float
+        Relative difference above which a speed is flagged (0.02: 2 %).
+
+    Returns
+    -------
+    list of str
+        Empty when the truth has no flutter speed or every ROM is within the threshold.
+    """
+    truth = (summary.get("flutter_truth") or {}).get("V")
+    if not truth:
+        return []
+    scale = _airspeed_scale(summary)
+    out = []
+    for key, what in (("flutter", "The ROM's flutter speed (the paper's route)"),
+                      ("flutter_parametric", "The parametric ROM's flutter speed")):
+        V = (summary.get(key) or {}).get("V")
+        if V is None:
+            continue
+        rel = V / truth - 1.0
+        if abs(rel) <= threshold:
+            continue
+        side = ("above the truth's, {t}: unconservative, a clearance read off the ROM would "
+                "admit speeds at which the wing flutters" if rel > 0 else
+                "below the truth's, {t}: conservative")
+        out.append(f"{what}, V = {_with_airspeed(V, scale)}, is {100 * abs(rel):.3g} % "
+                   + side.format(t=_with_airspeed(truth, scale))
+                   + f" (flagged when the difference exceeds {100 * threshold:g} %).")
+    return out
 
 
 def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflutter run",
@@ -59,34 +125,35 @@ def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflu
     s = summary
     fl, ctrl = s.get("flutter") or {}, s.get("controller") or {}
     lco, sup = s.get("lco") or {}, s.get("suppression") or {}
+    scale = _airspeed_scale(s)
     ours = {
-        "nominal speed index V0": s.get("V0"),
-        "number of modes N": s.get("ns", 0) // 2,
-        "(mu, na, nb, r, p, q)": tuple(s.get("orders") or []),
-        "order of Σf nf": s.get("nf"),
-        "order of Σs": s.get("ns"),
-        "order of ΣAE": s.get("nae"),
-        "flutter speed index Vf": fl.get("V"),
-        "flutter mode": fl.get("mode"),
-        "LCO fundamental frequency [Hz]": lco.get("freq_hz"),
-        "order of controller K(s)": ctrl.get("order"),
-        "number of sensors": s.get("n_sensors"),
-        "stable speed range (controller)": ctrl.get("stable_V"),
-        "LCO attenuation": (None if sup.get("attenuation_percent") is None
+        "nominal speed index V0": _with_airspeed(s.get("V0"), scale),
+        "number of modes N": _fmt(s.get("ns", 0) // 2),
+        "(mu, na, nb, r, p, q)": _fmt(tuple(s.get("orders") or [])),
+        "order of Σf nf": _fmt(s.get("nf")),
+        "order of Σs": _fmt(s.get("ns")),
+        "order of ΣAE": _fmt(s.get("nae")),
+        "flutter speed index Vf": _with_airspeed(fl.get("V"), scale),
+        "flutter mode": _fmt(fl.get("mode")),
+        "LCO fundamental frequency [Hz]": _fmt(lco.get("freq_hz")),
+        "order of controller K(s)": _fmt(ctrl.get("order")),
+        "number of sensors": _fmt(s.get("n_sensors")),
+        "stable speed range (controller)": _with_airspeed(ctrl.get("stable_V"), scale),
+        "LCO attenuation": (_fmt(None) if sup.get("attenuation_percent") is None
                             else f"{sup['attenuation_percent']:.1f} %"),
     }
     ft = s.get("flutter_truth") or {}
     truth = {   # the truth simulator's own values, where it has one
-        "flutter speed index Vf": ft.get("V"),
-        "stable speed range (controller)": ctrl.get("truth_stable_V"),
-        "flutter mode": ft.get("mode"),
-        "LCO fundamental frequency [Hz]": (lco.get("truth_freq_hz")
-                                           if lco.get("truth_kind") == "lco" else None),
+        "flutter speed index Vf": _with_airspeed(ft.get("V"), scale),
+        "stable speed range (controller)": _with_airspeed(ctrl.get("truth_stable_V"), scale),
+        "flutter mode": _fmt(ft.get("mode")),
+        "LCO fundamental frequency [Hz]": _fmt(lco.get("truth_freq_hz")
+                                               if lco.get("truth_kind") == "lco" else None),
     }
-    rows = "\n".join(f"<tr><td>{html.escape(k)}</td><td>{_fmt(ours.get(k))}</td>"
-                     f"<td>{_fmt(truth.get(k))}</td>"
+    rows = "\n".join(f"<tr><td>{html.escape(k)}</td><td>{ours[k]}</td>"
+                     f"<td>{truth.get(k, _fmt(None))}</td>"
                      f"<td>{html.escape(v)}</td></tr>" for k, v in PAPER_TABLE_I.items())
-    fit = ", ".join(f"{e:.3f}" for e in s.get("fit_error_percent") or [])
+    fit = ", ".join(sig(e, 4) for e in s.get("fit_error_percent") or [])
     imgs = []
     for name, path in figures.items():
         data = base64.b64encode(Path(path).read_bytes()).decode("ascii")
@@ -96,29 +163,43 @@ def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflu
                     f"<figcaption>{html.escape(caption)}</figcaption></figure>")
     lco_text = ""
     if lco.get("amplitude") is not None and lco.get("truth_amplitude") is not None:
-        lco_text = (f"<p>LCO amplitude per sensor (half peak to peak), each model a little "
-                    f"above its own flutter speed: ROM {_fmt(lco['amplitude'])} at "
-                    f"V = {_fmt(lco.get('V'))}, truth {_fmt(lco['truth_amplitude'])} at "
-                    f"V = {_fmt(lco.get('truth_V'))}.</p>")
+        units = lco.get("amplitude_units")
+        unit = (f" [{html.escape(units[0])}]" if units and len(set(units)) == 1
+                else f" [{html.escape(', '.join(units))}]" if units else "")
+        lco_text = (f"<p>LCO amplitude per sensor{unit} (half peak to peak), each model a "
+                    f"little above its own flutter speed: ROM {_fmt(lco['amplitude'])} at "
+                    f"V = {_with_airspeed(lco.get('V'), scale)}, truth "
+                    f"{_fmt(lco['truth_amplitude'])} at "
+                    f"V = {_with_airspeed(lco.get('truth_V'), scale)}.</p>")
+    flags = flutter_speed_flags(s)
+    flag_text = ("" if not flags else "<h2>Flags</h2>\n<ul>" + "".join(
+        f'<li class="flag">{html.escape(f)}</li>' for f in flags) + "</ul>")
     timings = s.get("timings_s", {})
     trows = "\n".join(f"<tr><td>{html.escape(k)}</td><td>{v:.2f}</td></tr>"
                       for k, v in timings.items() if isinstance(v, (int, float)))
+    version = s.get("casflutter_version")
+    gamma = (f"verified γ = {_fmt(ctrl.get('gamma'))} (‖T_w̄z‖∞ of the LFT at Vf, eq. 16), "
+             if ctrl else "")
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{html.escape(title)}</title>
 <style>body{{font-family:sans-serif;max-width:960px;margin:2em auto;color:#222}}
 table{{border-collapse:collapse;margin:1em 0}}td,th{{border:1px solid #bbb;padding:4px 10px}}
 th{{background:#eee}}img{{max-width:100%}}figure{{margin:1.5em 0}}
-figcaption{{font-size:90%;color:#555}}</style></head><body>
+figcaption{{font-size:90%;color:#555}}.flag{{color:#a00}}</style></head><body>
 <h1>{html.escape(title)}: {html.escape(str(s.get('problem')))}</h1>
 <p>Reproduction of K.-Y. Lum et al., ACC 2016, on casflutter's truth simulator
-(the paper's CFD and wind tunnel are not available). Seed {_fmt(s.get('seed'))}.</p>
+(the paper's CFD and wind tunnel are not available). Seed {_fmt(s.get('seed'))};
+casflutter {_fmt(version)}.{'' if scale is None else
+f" Speeds as the speed index V with the airspeed U = {_fmt(scale)} V m/s beside it."}</p>
+{flag_text}
 <h2>Table I</h2>
 <table><tr><th>quantity</th><th>this run (ROM)</th><th>truth simulator</th><th>paper</th></tr>
 {rows}</table>
-<p>ROM fit error per mode [%]: {fit}. Truth flutter: V = {_fmt(ft.get('V'))},
-{_fmt(ft.get('freq_hz'))} Hz. Controller: verified γ = {_fmt(ctrl.get('gamma'))},
-small-gain interval of V {_fmt(ctrl.get('small_gain_V'))}, exact stable interval {_fmt(ctrl.get('stable_V'))}
-on the ROM loop and {_fmt(ctrl.get('truth_stable_V'))} on the truth's own linearisation (flap
+<p>ROM fit error per mode [%]: {fit}. Truth flutter: V = {_with_airspeed(ft.get('V'), scale)},
+{_fmt(ft.get('freq_hz'))} Hz. Controller: {gamma}small-gain interval of V
+{_with_airspeed(ctrl.get('small_gain_V'), scale)}, exact stable interval
+{_with_airspeed(ctrl.get('stable_V'), scale)} on the ROM loop and
+{_with_airspeed(ctrl.get('truth_stable_V'), scale)} on the truth's own linearisation (flap
 behind a servo of {_fmt(ctrl.get('truth_servo_omega'))} rad/s).</p>
 {lco_text}
 <h2>Figures</h2>

@@ -1,8 +1,9 @@
-"""Axis labels a person reads: sensor names with their units, 1-based mode numbers."""
+"""Axis labels a person reads: sensor names with their units, frequencies in the problem's
+time, 1-based mode numbers."""
 
 from __future__ import annotations
 
-__all__ = ["sensor_unit", "sensor_labels"]
+__all__ = ["sensor_unit", "sensor_labels", "frequency_unit", "label_unit"]
 
 _POWER = {"displacement": "", "velocity": "/{t}", "acceleration": "/{t}²"}
 
@@ -58,3 +59,41 @@ def sensor_labels(names, units, kind: str, time_unit: str = "s") -> list[str]:
             n = f"sensor {j + 1}"
         out.append(f"{n} [{sensor_unit(u, kind, time_unit)}]")
     return out
+
+
+#: frequencies of a problem in nondimensional time, as a figure writes them
+_NONDIMENSIONAL = {"1/omega_theta": "Ω/ω_θ"}
+
+
+def frequency_unit(time_unit: str) -> str | None:
+    """The unit of an angular frequency in a problem's time: ``None`` for seconds (the
+    caller chooses Hz or rad/s), else the nondimensional frequency (``"Ω/ω_θ"`` for the
+    typical section's time ``1/omega_theta``, ``"rad/(T)"`` for another time unit ``T``).
+
+    Parameters
+    ----------
+    time_unit : str
+        The problem's time unit (``ModalStructure.time_unit``).
+
+    Returns
+    -------
+    str or None
+    """
+    if time_unit == "s":
+        return None
+    return _NONDIMENSIONAL.get(time_unit, f"rad/({time_unit})")
+
+
+def label_unit(label: str) -> str:
+    """The unit of an axis label ``"name [unit]"`` (``""`` when it has none).
+
+    Parameters
+    ----------
+    label : str
+        E.g. from :func:`sensor_labels`.
+
+    Returns
+    -------
+    str
+    """
+    return label.rsplit(" [", 1)[1].rstrip("]") if label.endswith("]") and " [" in label else ""

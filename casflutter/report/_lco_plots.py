@@ -9,6 +9,8 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from ._flutter_plots import speed_axes
+
 __all__ = ["plot_bifurcation", "plot_bifurcation_pair", "draw_branch"]
 
 
@@ -131,10 +133,12 @@ def plot_bifurcation(branch, outputs=None, *, frequency: bool = True, hb_points=
         a.grid(alpha=0.3)
     axes[n - 1].set_xlabel(_speed_label(branch))
     h = branch.hopf
-    kind = f"{h.kind} {'Neimark-Sacker' if h.discrete else 'Hopf'} point at " \
+    kind = f"{h.kind} {_point_name(branch)} at " \
            f"{float(branch.speed(h.V)):.4g} {branch.speed_unit if branch.speed_unit == 'm/s' else ''}"
     axes[0].set_title(title or f"{branch.problem}: {kind.strip()}", fontsize="medium")
-    _legend_proxies(axes[0])
+    if branch.speed_unit == "m/s":
+        speed_axes(axes[0], branch.speed_scale, "speed index V")
+    _legend_proxies(axes[0], _point_name(branch))
     if ax is None:
         fig.tight_layout()
     return fig
@@ -149,10 +153,16 @@ def _default_outputs(branch):
     return sorted(branch.outputs, key=lambda n: -last[n])[:2]
 
 
-def _legend_proxies(ax) -> None:
+def _point_name(branch) -> str:
+    """The flutter point of a continuous system is a Hopf point; that of a sampled-data
+    loop (a map) a Neimark–Sacker point."""
+    return "Neimark–Sacker point" if branch.hopf.discrete else "Hopf point"
+
+
+def _legend_proxies(ax, point: str = "Hopf point") -> None:
     handles = [Line2D([], [], color="0.2", lw=1.8, label="stable"),
                Line2D([], [], color="0.2", lw=1.3, ls="--", label="unstable"),
-               Line2D([], [], color="0.2", marker="o", mfc="white", ls="none", label="Hopf point"),
+               Line2D([], [], color="0.2", marker="o", mfc="white", ls="none", label=point),
                Line2D([], [], color="0.2", marker="^", ls="none", label="fold")]
     old = ax.get_legend()
     extra = [h for h in (old.legend_handles if old is not None else [])]
@@ -190,8 +200,7 @@ def plot_bifurcation_pair(truth_branch, rom_branch, outputs=None, *,
     for col, (br, label) in enumerate(((truth_branch, "truth"), (rom_branch, "ROM loop"))):
         unit = f" {br.speed_unit}" if br.speed_unit == "m/s" else ""
         plot_bifurcation(br, outputs, frequency=frequency, ax=axes[:, col],
-                         title=f"{label}: {br.hopf.kind} "
-                               f"{'Neimark-Sacker' if br.hopf.discrete else 'Hopf'} point at "
+                         title=f"{label}: {br.hopf.kind} {_point_name(br)} at "
                                f"{float(br.speed(br.hopf.V)):.4g}{unit}")
     if speed_range is None:
         speeds = [float(br.speed(v)) for br in (truth_branch, rom_branch)

@@ -12,9 +12,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from ..aeroelastic import simulate_loop
-from ._flutter_plots import plot_lco, plot_pole_loci, plot_vg_vf
+from ..lco import speed_convention
+from ._flutter_plots import plot_lco, plot_pole_loci, plot_vg_vf, speed_axes
 from ._html import html_report
-from ._labels import sensor_labels
+from ._labels import frequency_unit, label_unit, sensor_labels
 from ._lco_plots import plot_bifurcation_pair
 from ._pipeline_plots import plot_flap_pulses, plot_gain_ramp, plot_hankel, plot_rom_fit
 
@@ -81,6 +82,20 @@ def _sensor_labels(result) -> list[str]:
     return sensor_labels(st.sensor_names, units, st.sensor, st.time_unit)
 
 
+def _speed_kw(result, time_unit: str) -> dict:
+    """The V–g/V–f keywords of a run: the airspeed with the speed index on a second axis
+    where the problem has a speed scale, and frequencies in Hz (in the problem's own
+    nondimensional frequency when its time is not seconds)."""
+    problem = result.problem if result.problem is not None else result.truth
+    scale, unit = speed_convention(problem)
+    funit = frequency_unit(time_unit)
+    kw = dict(hz=funit is None, frequency_unit=funit)
+    if unit == "m/s":
+        return dict(kw, speed_scale=scale, speed_unit="m/s", speed_label="airspeed U [m/s]",
+                    index_label="speed index V")
+    return dict(kw, speed_label=f"speed index {unit}".strip())
+
+
 def write_figures(out: Path, result) -> dict:
     """Paper Fig. 7–11, the V–g/V–f plot, the Hankel singular values and (when the run
     computed them) the LCO branches as PNG files.
@@ -100,14 +115,20 @@ def write_figures(out: Path, result) -> dict:
     out = Path(out)
     files = {}
     if result.identification is None:   # a GAF wing file: no records, ROM or ERA
+        names = result.problem.structure.mode_names
         if result.rfa_flutter is not None:
             fl = result.rfa_flutter     # the structural branches, not the lag roots
-            modes = [b for b in fl.tracking.upper_branches() if fl.origin[b] >= 0]
-            fig = plot_vg_vf(fl, branches=modes, hz=False)
-            fig.axes[-1].set_xlabel("airspeed U [m/s]")
+            lam = fl.tracking.eigenvalues
+            modes = [b for b in fl.tracking.upper_branches()
+                     if fl.origin[b] >= 0 and np.mean(np.abs(lam[:, b].imag)) > 0]
+            fig = plot_vg_vf(fl, branches=modes, hz=False, mode_names=names, speed_unit="m/s",
+                             speed_label="airspeed U [m/s]")
+            speed_axes(fig.axes[0], result.problem.U_ref, "speed index V = U / U_ref")
+            fig.tight_layout()
             files["vg_vf_airspeed"] = _save(fig, out / "vg_vf_airspeed.png")
         if result.flutter is not None:
-            files["vg_vf"] = _save(plot_vg_vf(result.flutter), out / "vg_vf.png")
+            files["vg_vf"] = _save(plot_vg_vf(result.flutter, mode_names=names,
+                                              **_speed_kw(result, "s")), out / "vg_vf.png")
         return files
     model = result.identification.model
     st = result.system.structure
@@ -125,18 +146,21 @@ def write_figures(out: Path, result) -> dict:
                                                            fp["rom_zm"], fp["v"], labels,
                                                            time_unit=st.time_unit),
                                           out / "fig8_flap_pulses.png")
+    speed = _speed_kw(result, st.time_unit)
+    air = dict(speed_scale=speed.get("speed_scale", 1.0), speed_unit=speed.get("speed_unit", ""))
     if result.lco is not None:
         lco = result.lco
         pct = 100 * (result.config.lco.speed_factor - 1)
         files["fig9_lco"] = _save(plot_lco(
             lco.rom, truth=lco.truth, labels=labels,
-            title=f"Fig. 9: LCO of each model {pct:.3g} % above its own flutter speed"),
+            title=f"Fig. 9: LCO of each model {pct:.3g} % above its own flutter speed",
+            time_unit=st.time_unit, **air),
             out / "fig9_lco.png")
         if lco.truth_branch is not None and lco.rom_branch is not None:
             files["lco_branches"] = _save(plot_bifurcation_pair(lco.truth_branch,
                                                                 lco.rom_branch),
                                           out / "lco_branches.png")
-    files["vg_vf"] = _save(plot_vg_vf(result.flutter, mode_names=st.mode_names),
+    files["vg_vf"] = _save(plot_vg_vf(result.flutter, mode_names=st.mode_names, **speed),
                            out / "vg_vf.png")
     vr = result.config.flutter.V_range
     Vg = np.linspace(max(vr[0], 1e-3), vr[1], 60)
@@ -159,9 +183,16 @@ def write_figures(out: Path, result) -> dict:
             sim.timepts, sim.zm, sim.gain, sim.v, labels,
             phases=(t0, t0 + ss.ramp, t0 + ss.ramp + ss.hold), open_loop_amplitude=amp,
             dominant=dom, time_unit=st.time_unit, flap_limit_deg=limit,
-            title=f"Fig. 11: suppression of the truth's LCO at V = {sup.V:.4g}"),
+            title=f"Fig. 11: suppression of the truth's LCO at V = {sup.V:.4g}"
+                  + (f" ({sup.V * air['speed_scale']:.4g} m/s)" if air["speed_unit"] else "")),
             out / "fig11_gain_ramp.png")
     return files
+
+
+def _amplitudes(values, units) -> str:
+    """``124.2 m/s², 86.33 m/s²``: amplitudes with their sensors' units."""
+    units = list(units) + [""] * len(values)
+    return ", ".join(f"{a:.4g} {u}".rstrip() for a, u in zip(values, units))
 
 
 def figure_captions(result) -> dict:
@@ -207,7 +238,8 @@ def figure_captions(result) -> dict:
     if result.lco is not None:
         lco = result.lco
         sens = lco.rom.sensors
-        rom_a = ", ".join(f"{a:.4g}" for a in sens.amplitude) if sens is not None else "-"
+        units = [label_unit(lab) for lab in _sensor_labels(result)]
+        rom_a = _amplitudes(sens.amplitude, units) if sens is not None else "-"
         tr = lco.truth
         V_rom = lco.V_hopf_loop if lco.V_hopf_loop is not None else lco.V_hopf_exact_order
         Vt = None if result.flutter_truth is None else result.flutter_truth.Vf
@@ -215,7 +247,7 @@ def figure_captions(result) -> dict:
         text = (f"Fig. 9. Limit-cycle oscillation of the ROM loop at V = {lco.V:.4g} ({f:g} "
                 f"x its own flutter speed {V_rom:.4g}, that of the sampled-data loop)")
         if tr is not None:
-            tr_a = ", ".join(f"{a:.4g}" for a in tr.amplitude)
+            tr_a = _amplitudes(tr.amplitude, units)
             text += (f" and of the truth at V = {tr.V:.4g} ({f:g} x its flutter speed "
                      f"{float('nan') if Vt is None else Vt:.4g}); sensor amplitudes (half "
                      f"peak to peak) ROM {rom_a}, truth {tr_a}.")

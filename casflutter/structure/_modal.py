@@ -9,13 +9,13 @@ with modal displacement output ``u = Cs x_s`` and measured output ``zm``.
 State ordering
 --------------
 The structural state is ``x_s = [u_1, u̇_1, u_2, u̇_2, ..., u_N, u̇_N]``: one block of two
-states per mode.  This is the ordering of eq. 7, where ``As = diag(A_s^i)`` and
-``Bs = diag(B_s^i)`` are block diagonal, so each mode's states are contiguous and the
-matrices read as in the paper.  The truth simulators keep their own full-order state
-(``[u, u', lag states]``, the natural layout of their second-order equations); neither
-ordering leaks to callers: :meth:`ModalStructure.displaced_state` (and the truths' method of
-the same name) build an initial state, :attr:`ModalStructure.Cs` / :attr:`~ModalStructure.Cv`
-select displacements and velocities.
+states per mode (:attr:`ModalStructure.layout`).  This is the ordering of eq. 7, where
+``As = diag(A_s^i)`` and ``Bs = diag(B_s^i)`` are block diagonal, so each mode's states are
+contiguous and the matrices read as in the paper.  The truth simulators keep their own
+full-order state (``[u, u', lag states]``); neither ordering leaks to callers:
+:meth:`ModalStructure.displaced_state` and :meth:`ModalStructure.modal_state` (and the
+truths' methods of the same names) return a :class:`~casflutter.structure.ModalState`, which
+every simulation puts where its own model keeps it (:mod:`casflutter.structure._state`).
 
 Sensors
 -------
@@ -41,7 +41,10 @@ from dataclasses import dataclass, field, replace
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError, DimensionError
+from ._speed import SpeedConvention
+from ._state import ModalLayout, ModalStates
 
 __all__ = ["ModalStructure", "SENSOR_KINDS", "check_sensor_rows"]
 
@@ -101,7 +104,7 @@ def check_sensor_rows(rows, n_modes: int, *, key: str = "sensors.rows",
 
 
 @dataclass(frozen=True)
-class ModalStructure:
+class ModalStructure(ModalStates):
     """N-mode structural model Σs of eq. 6-7, with its sensors and names.
 
     Parameters
@@ -127,15 +130,19 @@ class ModalStructure:
         (default: the identity, the modes themselves).
     coordinate_names : tuple of str, optional
         Names of the ``n`` physical coordinates (default: the mode names).
-    time_unit : str
-        The unit of time of ``omega``.
-    speed_index : str
-        The convention of the speed index ``V``.
+    speed : SpeedConvention
+        What the speed index ``V`` is, the unit of time of ``omega``, and the airspeed and
+        dynamic pressure when the problem knows them (default: ``V`` in seconds, no
+        airspeed scale).
 
     Attributes
     ----------
     n_modes : int
         Number of modes ``N`` (from ``omega``).
+    time_unit : str
+        The unit of time of ``omega`` (``speed.time_unit``).
+    speed_index : str
+        What the speed index ``V`` is (``speed.definition``).
 
     Raises
     ------
@@ -144,6 +151,8 @@ class ModalStructure:
     ConfigError
         Non-positive or non-finite frequencies, negative damping, unknown sensor kind.
     """
+
+    __repr__ = result_repr
 
     omega: np.ndarray
     zeta: np.ndarray
@@ -154,8 +163,7 @@ class ModalStructure:
     sensor_names: tuple = ()
     shapes: np.ndarray | None = None
     coordinate_names: tuple = ()
-    time_unit: str = "s"
-    speed_index: str = "V"
+    speed: SpeedConvention = field(default_factory=SpeedConvention)
     n_modes: int = field(init=False)
 
     def __post_init__(self):
@@ -171,6 +179,8 @@ class ModalStructure:
             raise ConfigError(f"zeta must be finite and >= 0, got {zeta}")
         if not np.isfinite(self.alpha):
             raise ConfigError(f"alpha must be finite, got {self.alpha}")
+        if not isinstance(self.speed, SpeedConvention):
+            raise ConfigError(f"speed must be a SpeedConvention, got {type(self.speed).__name__}")
         if self.sensor not in SENSOR_KINDS:
             raise ConfigError(f"sensor={self.sensor!r} is not allowed; choose one of {SENSOR_KINDS}")
         n = omega.size
@@ -233,54 +243,26 @@ class ModalStructure:
             changes["sensor"] = kind
         return replace(self, **changes) if changes else self
 
-    def modal_state(self, u=None, udot=None) -> np.ndarray:
-        """The structural state ``x_s`` of given modal displacements and velocities.
+    @property
+    def time_unit(self) -> str:
+        """The unit of time of ``omega`` (``speed.time_unit``)."""
+        return self.speed.time_unit
 
-        Parameters
-        ----------
-        u, udot : array_like, shape (N,), optional
-            Modal displacements and velocities (default zero).
+    @property
+    def speed_index(self) -> str:
+        """What the speed index ``V`` is (``speed.definition``)."""
+        return self.speed.definition
 
-        Returns
-        -------
-        ndarray, shape (2N,)
-        """
-        x = np.zeros(self.n_states)
-        for values, offset, name in ((u, 0, "u"), (udot, 1, "udot")):
-            if values is None:
-                continue
-            v = np.asarray(values, dtype=float).ravel()
-            if v.size != self.n_modes:
-                raise DimensionError(f"{name} has {v.size} entries, the structure has "
-                                     f"{self.n_modes} modes")
-            x[offset::2] = v
-        return x
-
-    def displaced_state(self, mode: int, deflection: float) -> np.ndarray:
-        """The structural state at rest with mode ``mode`` displaced by ``deflection``.
-
-        Parameters
-        ----------
-        mode : int
-            0-based mode index.
-        deflection : float
-            Modal displacement ``u_mode``.
-
-        Returns
-        -------
-        ndarray, shape (2N,)
-        """
-        if not 0 <= int(mode) < self.n_modes:
-            raise DimensionError(f"mode {mode} is not one of the {self.n_modes} modes (0-based)")
-        u = np.zeros(self.n_modes)
-        u[int(mode)] = deflection
-        return self.modal_state(u)
+    @property
+    def layout(self) -> ModalLayout:
+        """Where ``x_s`` keeps each mode: ``[u_1, u̇_1, u_2, u̇_2, ...]`` (eq. 7)."""
+        return ModalLayout(self.n_modes, interleaved=True)
 
     @property
     def mode_states(self) -> list[np.ndarray]:
         """State indices ``[u_i, u̇_i]`` of each mode in ``x_s`` (for eigenvector
         participation)."""
-        return [np.array([2 * i, 2 * i + 1]) for i in range(self.n_modes)]
+        return self.layout.mode_states
 
     # ------------------------------------------------------------------ matrices
     @property
@@ -368,7 +350,7 @@ class ModalStructure:
         Parameters
         ----------
         V : float
-            Speed index.
+            Speed index: the generalised forces ``y`` enter scaled by ``V²``.
 
         Returns
         -------

@@ -27,6 +27,7 @@ import casadi as ca
 import numpy as np
 from scipy.optimize import minimize_scalar, nnls
 
+from .._format import result_repr
 from ..design import partition
 from ..errors import ConfigError, DimensionError
 
@@ -61,6 +62,8 @@ class GammaSensitivity:
     method : str
         Description of the method.
     """
+
+    __repr__ = result_repr
 
     gamma: float
     synthesis_gamma: float

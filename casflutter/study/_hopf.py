@@ -27,6 +27,7 @@ from typing import Any, Callable, Mapping, Sequence
 import casadi as ca
 import numpy as np
 
+from .._format import result_repr
 from .._nlp import make_solver
 from ..errors import ConfigError, ConvergenceError
 from ..truth import load_problem
@@ -129,6 +130,8 @@ class HopfPoint:
     lam_g, lam_x : ndarray
         Multipliers at the solution.
     """
+
+    __repr__ = result_repr
 
     Vf: float
     omega_f: float

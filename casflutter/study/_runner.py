@@ -30,6 +30,7 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import Any, Mapping
 
+from .._format import result_repr
 from .._interrupt import sigterm_raises
 from .._logging import PROGRESS, PROGRESS_END
 from ..errors import ConfigError
@@ -262,6 +263,8 @@ class SweepResult:
     worker_restarts : int
         Local worker pools replaced after a worker process died.
     """
+
+    __repr__ = result_repr
 
     study: Study
     store: Path

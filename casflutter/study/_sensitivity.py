@@ -23,6 +23,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 from scipy.linalg import eig
 
+from .._format import result_repr
 from ..aeroelastic import find_flutter
 from ..errors import ConfigError, ConvergenceError
 from ..truth import load_problem
@@ -55,6 +56,8 @@ class ParameterSensitivity:
     difference : str
         ``"central"`` or ``"forward"`` (``∂A/∂p`` at a domain bound).
     """
+
+    __repr__ = result_repr
 
     name: str
     value: float
@@ -90,6 +93,8 @@ class FlutterSensitivity:
         ``"eigenvalue perturbation"``.
     """
 
+    __repr__ = result_repr
+
     problem: str
     params: Mapping[str, float]
     Vf: float
@@ -113,7 +118,7 @@ class FlutterSensitivity:
 
     def table(self) -> str:
         """Plain-text ranked table."""
-        lines = [f"{self.problem}: Vf = {self.Vf:.8g}, omega_f = {self.omega_f:.6g} "
+        lines = [f"{self.problem}: Vf = {self.Vf:.6g}, omega_f = {self.omega_f:.6g} "
                  f"({self.method})",
                  f"{'rank':>4}  {'parameter':<12} {'value':>11} {'dVf/dp':>13} "
                  f"{'normalised':>11}  {'domega/dp':>11}"]

@@ -31,8 +31,9 @@ from scipy.integrate import solve_ivp
 from scipy.interpolate import make_interp_spline
 from scipy.linalg import eigh
 
+from .._format import result_repr
 from ..errors import ConfigError, DataError, DimensionError
-from ..structure import ModalStructure
+from ..structure import ModalLayout, ModalStates, ModalStructure, SpeedConvention
 from ._aero import JONES_A, check_timepts, integrate_lags, sample_derivatives
 
 __all__ = ["AeroMatrices", "SimulationResult", "AeroelasticTruth"]
@@ -86,6 +87,8 @@ class SimulationResult:
         Right-hand-side evaluations.
     """
 
+    __repr__ = result_repr
+
     timepts: np.ndarray
     states: np.ndarray
     u: np.ndarray
@@ -120,7 +123,7 @@ def _as_1d(name: str, arr, K: int) -> np.ndarray:
     return a
 
 
-class AeroelasticTruth(abc.ABC):
+class AeroelasticTruth(ModalStates, abc.ABC):
     """Base class of the truth simulators (typical section, Goland wing).
 
     Subclasses provide the structural matrices, the aerodynamic operator at a speed index
@@ -171,7 +174,13 @@ class AeroelasticTruth(abc.ABC):
 
     @abc.abstractmethod
     def _names(self) -> dict:
-        """Mode names, coordinate names, sensor rows/names, time unit, speed convention."""
+        """Mode names, coordinate names, sensor rows/names (and units, kind)."""
+
+    @property
+    @abc.abstractmethod
+    def speed(self) -> SpeedConvention:
+        """What the speed index ``V`` is, the unit of time, the airspeed and dynamic pressure
+        (:class:`~casflutter.structure.SpeedConvention`)."""
 
     def _nonlinear_force(self, x: np.ndarray) -> np.ndarray | None:
         """Extra structural restoring force ``f_nl(x)`` (``None`` if linear)."""
@@ -210,62 +219,18 @@ class AeroelasticTruth(abc.ABC):
                               sensor=nm.get("sensor", "displacement"),
                               mode_names=tuple(nm["mode_names"]),
                               sensor_names=tuple(nm["sensor_names"]), shapes=self._Phi.copy(),
-                              coordinate_names=tuple(nm["coordinate_names"]),
-                              time_unit=nm["time_unit"], speed_index=nm["speed_index"])
+                              coordinate_names=tuple(nm["coordinate_names"]), speed=self.speed)
+
+    @property
+    def layout(self) -> ModalLayout:
+        """Where the truth's state ``[u, u', lags]`` keeps each mode."""
+        return ModalLayout(self.n_modes, interleaved=False)
 
     @property
     def mode_states(self) -> list[np.ndarray]:
         """Indices ``[u_i, u'_i]`` of each mode in the truth's state ``[u, u', lags]`` (for the
         origin-mode attribution of :func:`casflutter.aeroelastic.find_flutter`)."""
-        N = self.n_modes
-        return [np.array([i, N + i]) for i in range(N)]
-
-    def modal_state(self, u=None, udot=None) -> np.ndarray:
-        """The truth's structural state ``[u, u']`` of given modal displacements and
-        velocities (an initial state of :meth:`simulate`, the flow at rest).
-
-        Parameters
-        ----------
-        u, udot : array_like, shape (N,), optional
-            Modal displacements and velocities (default zero).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``(2N,)``.
-        """
-        N = self.n_modes
-        x = np.zeros(2 * N)
-        for values, offset, name in ((u, 0, "u"), (udot, N, "udot")):
-            if values is None:
-                continue
-            v = np.asarray(values, dtype=float).ravel()
-            if v.size != N:
-                raise DimensionError(f"{name} has {v.size} entries, the truth has {N} modes")
-            x[offset:offset + N] = v
-        return x
-
-    def displaced_state(self, mode: int, deflection: float) -> np.ndarray:
-        """The truth's structural state ``[u, u']`` at rest with mode ``mode`` displaced.
-
-        Parameters
-        ----------
-        mode : int
-            0-based mode index.
-        deflection : float
-            Modal displacement ``u_mode``.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``(2N,)``: an initial state of :meth:`simulate` (the flow at rest).
-        """
-        N = self.n_modes
-        if not 0 <= int(mode) < N:
-            raise DimensionError(f"mode {mode} is not one of the {N} modes (0-based)")
-        u = np.zeros(N)
-        u[int(mode)] = deflection
-        return self.modal_state(u)
+        return self.layout.mode_states
 
     def sensor_units(self) -> tuple[str, ...]:
         """Units of the sensor rows' readings (``""`` where the problem gives none)."""
@@ -560,19 +525,13 @@ class AeroelasticTruth(abc.ABC):
         return f
 
     def _simulation_inputs(self, timepts, x0, v, nx: int):
-        """Checked inputs of a simulation: the times, the full initial state (``[u, u']`` is
-        completed with the lag states at rest), the flap samples and their quintic spline
-        (``None`` without flap motion)."""
+        """Checked inputs of a simulation: the times, the full initial state (a structural
+        state is completed with the lag states at rest), the flap samples and their quintic
+        spline (``None`` without flap motion)."""
         t = np.asarray(timepts, float)
         if t.ndim != 1 or t.size < 2 or np.any(np.diff(t) <= 0):
             raise DataError("timepts must be a 1-D increasing array of at least 2 samples")
-        N = self.n_modes
-        x0 = np.asarray(x0, float).reshape(-1)
-        if x0.size == 2 * N:
-            x0 = np.concatenate([x0, np.zeros(nx - 2 * N)])
-        if x0.size != nx:
-            raise DimensionError(f"x0 must have length 2N = {2 * N} or {nx} (with lag states), "
-                                 f"got {x0.size}")
+        x0 = self.layout.initial(x0, nx)
         if v is None:
             return t, x0, np.zeros(t.size), None
         vs = _as_1d("v", v, t.size)
@@ -589,9 +548,10 @@ class AeroelasticTruth(abc.ABC):
         ----------
         timepts : numpy.ndarray
             ``(K,)`` increasing output times (any spacing).
-        x0 : numpy.ndarray
-            Initial state: ``[u, u']`` (length ``2N``; lag states start at zero, i.e. the
-            flow at rest) or the full state ``[u, u', z1, z2]``.
+        x0 : ModalState or numpy.ndarray
+            Initial state: a :class:`~casflutter.structure.ModalState` (e.g.
+            :meth:`displaced_state`) or ``[u, u']`` (length ``2N``), the lag states at zero
+            (the flow at rest), or the full state ``[u, u', z1, z2]``.
         V : float
             Speed index.
         v : numpy.ndarray, optional

@@ -21,6 +21,7 @@ import control
 import numpy as np
 from scipy.optimize import brentq
 
+from .._format import result_repr
 from .._linalg import spectral_abscissa
 from ..errors import CasflutterError, ConfigError
 
@@ -49,6 +50,8 @@ class TruthLoopSimulation:
     gain : ndarray, shape (K,)
         Gain schedule ``g(t_k)``.
     """
+
+    __repr__ = result_repr
 
     timepts: np.ndarray
     zm: np.ndarray
@@ -115,9 +118,9 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
         Speed index.
     timepts : array_like, shape (K,)
         Uniform sample times.
-    x0 : array_like
-        Initial state: ``[u, u']`` (flow at rest, e.g. :meth:`displaced_state`) or the full
-        state.
+    x0 : ModalState or array_like
+        Initial state: a :class:`~casflutter.structure.ModalState` (e.g.
+        :meth:`displaced_state`) or ``[u, u']``, the flow at rest; or the truth's full state.
     gain : callable
         ``g(t)`` multiplying the controller output.
     actuator_omega, actuator_zeta : float
@@ -167,74 +170,108 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     """
     if sensor not in ("acceleration", "displacement"):
         raise ConfigError(f"sensor={sensor!r}: use 'acceleration' or 'displacement'")
-    for name, value in (("flap_limit", flap_limit), ("flap_rate_limit", flap_rate_limit)):
-        if value is not None and not (np.isfinite(value) and value > 0):
-            raise ConfigError(f"{name} = {value!r}: give a positive limit, or None for none")
-    pos_max = np.inf if flap_limit is None else float(flap_limit)
-    rate_max = np.inf if flap_rate_limit is None else float(flap_rate_limit)
+    servo = _FlapServo.of(actuator_omega, actuator_zeta, flap_limit, flap_rate_limit)
     t = np.asarray(timepts, dtype=float)
     dt = float(t[1] - t[0])
-    f = truth.flap_dynamics(V)
+    s = truth.layout.initial(x0, truth.state_matrix(V).shape[0])  # the flow at rest
     Hs = _sensor_rows(truth, sensor_rows)
-    N = truth.n_modes
+    ZM = np.full((t.size, Hs.shape[0]), np.nan)
+    Vf = np.zeros(t.size)
+    G = np.zeros(t.size)
+    _run_closed_loop(truth, truth.flap_dynamics(V), s, _sampled(K, dt), servo, Hs,
+                     sensor == "acceleration", t, gain, kick, substeps, (ZM, Vf, G))
+    return TruthLoopSimulation(t, ZM, Vf, G)
+
+
+def _sampled(K: control.StateSpace, dt: float):
+    """``(A, B, C, D, n_states)`` of the controller sampled with a zero-order hold at ``dt``
+    (a static gain as it is)."""
     Kd = control.sample_system(K, dt, method="zoh") if K.nstates else K
     Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (Kd.A, Kd.B, Kd.C, Kd.D))
-    nk = Ak.shape[0] if K.nstates else 0
-    nx = truth.state_matrix(V).shape[0]
-    s = np.zeros(nx)
-    x0 = np.asarray(x0, dtype=float).ravel()
-    s[:x0.size] = x0  # [u, u'] (flow at rest) or the full state
+    return Ak, Bk, Ck, Dk, (Ak.shape[0] if K.nstates else 0)
+
+
+def _run_closed_loop(truth, f, s, controller, servo, Hs, acceleration: bool, t, gain, kick,
+                     substeps: int, records) -> None:
+    """The sample loop of :func:`closed_loop_truth` from the truth state ``s``: read the
+    sensors, update the controller (state ``(A, B, C, D, n)`` discretised), hold the command
+    and integrate over the sample; fills ``records = (zm, v, g)`` up to a blow-up."""
+    Ak, Bk, Ck, Dk, nk = controller
+    ZM, Vf, G = records
+    N, n = truth.n_modes, t.size
+    h = float(t[1] - t[0]) / substeps
     xa = np.zeros(2)  # actuator: v, v'
     xk = np.zeros(nk)
-    wa2, ca = actuator_omega ** 2, 2 * actuator_zeta * actuator_omega
-    h = dt / substeps
-    n = t.size
-    ZM = np.full((n, Hs.shape[0]), np.nan)
-    Vf = np.zeros(n)
-    G = np.zeros(n)
-
-    def servo_acceleration(xa_, vc):
-        vdd = wa2 * (vc - xa_[0]) - ca * xa_[1]
-        if abs(xa_[1]) >= rate_max and vdd * xa_[1] > 0:
-            vdd = 0.0  # the servo runs at its rate limit
-        if abs(xa_[0]) >= pos_max and xa_[0] * vdd > 0:
-            vdd = 0.0  # on the end stop
-        return vdd
-
-    def deriv(s_, xa_, vc):
-        vdd = servo_acceleration(xa_, vc)
-        ds, _ = f(s_, xa_[0], xa_[1], vdd)
-        return ds, np.array([xa_[1], vdd])
-
     vc = 0.0  # command held over the current sample interval
     kicked = kick is None
     for k in range(n):
         if not kicked and t[k] >= kick[0]:
-            s[:2 * N] += truth.displaced_state(kick[1], kick[2])
+            s[:2 * N] += truth.layout.vector(truth.displaced_state(kick[1], kick[2]))
             kicked = True
-        vdd_now = servo_acceleration(xa, vc)
-        _, acc = f(s, xa[0], xa[1], vdd_now)
-        zm = Hs @ (acc if sensor == "acceleration" else s[:Hs.shape[1]])
+        _, acc = f(s, xa[0], xa[1], servo.acceleration(xa, vc))
+        zm = Hs @ (acc if acceleration else s[:Hs.shape[1]])
         if not np.all(np.isfinite(zm)) or np.abs(s).max() > 1e6:
             break
         ZM[k], Vf[k], G[k] = zm, xa[0], gain(t[k])
         vc = G[k] * float((Ck @ xk + Dk @ zm)[0]) if nk else G[k] * float((Dk @ zm)[0])
-        vc = float(np.clip(vc, -pos_max, pos_max))
+        vc = float(np.clip(vc, -servo.pos_max, servo.pos_max))
         if nk and G[k] > 0:  # the controller runs from its engagement (state zero before)
             xk = Ak @ xk + Bk @ zm
         if k == n - 1:
             break
-        for _ in range(substeps):
-            k1s, k1a = deriv(s, xa, vc)
-            k2s, k2a = deriv(s + 0.5 * h * k1s, xa + 0.5 * h * k1a, vc)
-            k3s, k3a = deriv(s + 0.5 * h * k2s, xa + 0.5 * h * k2a, vc)
-            k4s, k4a = deriv(s + h * k3s, xa + h * k3a, vc)
+        s, xa = servo.integrate(f, s, xa, vc, h, substeps)
+
+
+@dataclass(frozen=True)
+class _FlapServo:
+    """The second-order flap actuator of :func:`closed_loop_truth` with its end stops
+    (``pos_max``) and rate limit (``rate_max``, ``inf`` without them), and the classical
+    Runge--Kutta integration of the truth and the servo over one sample."""
+
+    wa2: float        # actuator_omega ** 2
+    ca: float         # 2 actuator_zeta actuator_omega
+    pos_max: float
+    rate_max: float
+
+    @classmethod
+    def of(cls, actuator_omega, actuator_zeta, flap_limit, flap_rate_limit) -> "_FlapServo":
+        """The servo of the arguments of :func:`closed_loop_truth` (limits checked)."""
+        for name, value in (("flap_limit", flap_limit), ("flap_rate_limit", flap_rate_limit)):
+            if value is not None and not (np.isfinite(value) and value > 0):
+                raise ConfigError(f"{name} = {value!r}: give a positive limit, or None for none")
+        return cls(actuator_omega ** 2, 2 * actuator_zeta * actuator_omega,
+                   np.inf if flap_limit is None else float(flap_limit),
+                   np.inf if flap_rate_limit is None else float(flap_rate_limit))
+
+    def acceleration(self, xa, vc: float) -> float:
+        """Flap acceleration for the servo state ``xa = (v, v')`` and the command ``vc``."""
+        vdd = self.wa2 * (vc - xa[0]) - self.ca * xa[1]
+        if abs(xa[1]) >= self.rate_max and vdd * xa[1] > 0:
+            vdd = 0.0  # the servo runs at its rate limit
+        if abs(xa[0]) >= self.pos_max and xa[0] * vdd > 0:
+            vdd = 0.0  # on the end stop
+        return vdd
+
+    def integrate(self, f, s, xa, vc: float, h: float, steps: int):
+        """``steps`` Runge--Kutta steps of length ``h`` of the truth ``f`` (its
+        :meth:`flap_dynamics`) and the servo under the held command ``vc``."""
+
+        def deriv(s_, xa_):
+            vdd = self.acceleration(xa_, vc)
+            ds, _ = f(s_, xa_[0], xa_[1], vdd)
+            return ds, np.array([xa_[1], vdd])
+
+        for _ in range(steps):
+            k1s, k1a = deriv(s, xa)
+            k2s, k2a = deriv(s + 0.5 * h * k1s, xa + 0.5 * h * k1a)
+            k3s, k3a = deriv(s + 0.5 * h * k2s, xa + 0.5 * h * k2a)
+            k4s, k4a = deriv(s + h * k3s, xa + h * k3a)
             s = s + h / 6 * (k1s + 2 * k2s + 2 * k3s + k4s)
             xa = xa + h / 6 * (k1a + 2 * k2a + 2 * k3a + k4a)
-            xa[1] = float(np.clip(xa[1], -rate_max, rate_max))
-            if abs(xa[0]) > pos_max:  # the end stop
-                xa[0], xa[1] = float(np.sign(xa[0]) * pos_max), 0.0
-    return TruthLoopSimulation(t, ZM, Vf, G)
+            xa[1] = float(np.clip(xa[1], -self.rate_max, self.rate_max))
+            if abs(xa[0]) > self.pos_max:  # the end stop
+                xa[0], xa[1] = float(np.sign(xa[0]) * self.pos_max), 0.0
+        return s, xa
 
 
 @dataclass(frozen=True)
@@ -301,6 +338,8 @@ class SuppressionResult:
         The sensor with the largest open-loop RMS.
     """
 
+    __repr__ = result_repr
+
     V: float
     simulation: TruthLoopSimulation
     attenuation_percent: float | None
@@ -333,7 +372,7 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
     Parameters
     ----------
     truth : AeroelasticTruth
-        The simulator.
+        The nonlinear simulator (:func:`closed_loop_truth` runs it with the flap servo).
     K : control.StateSpace
         Controller from the accelerometers to the flap command.
     V_flutter : float
@@ -389,9 +428,17 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
                             kick=(t_release, mode, deflection), sensor_rows=sensor_rows,
                             sensor=sensor, flap_limit=sp.flap_limit,
                             flap_rate_limit=sp.flap_rate_limit)
-    zm = sim.zm
-    if not np.all(np.isfinite(zm)):
+    if not np.all(np.isfinite(sim.zm)):
         raise CasflutterError(f"the closed-loop truth simulation at V = {V:.4f} blew up")
+    return _suppression_result(float(V), sim, t, sp, started_from_lco=x0 is not None)
+
+
+def _suppression_result(V: float, sim: TruthLoopSimulation, t, sp: SuppressionSettings,
+                        started_from_lco: bool) -> SuppressionResult:
+    """The RMS and peaks of each phase of a suppression run and the attenuation of the
+    dominant sensor (see :func:`suppression_run`)."""
+    zm = sim.zm
+    T = sp.settle + sp.ramp + sp.hold + sp.release
 
     def rms(a, b):
         sel = (t >= a) & (t < b)
@@ -407,7 +454,7 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
     closed_rms = rms(t_full + sp.hold * 2 / 3, t_full + sp.hold)
     after = rms(T - sp.release / 3, T)
     att = 100.0 * (1.0 - closed_rms[dom] / open_rms[dom]) if open_rms[dom] > 0 else None
-    return SuppressionResult(V=float(V), simulation=sim,
+    return SuppressionResult(V=V, simulation=sim,
                              attenuation_percent=None if att is None else float(att),
                              open_loop_rms=tuple(map(float, open_rms)),
                              closed_loop_rms=tuple(map(float, closed_rms)),
@@ -418,7 +465,7 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
                                                                        sp.settle))),
                              closed_loop_amplitude=tuple(map(float, peak(
                                  t_full + sp.hold * 2 / 3, t_full + sp.hold))),
-                             started_from_lco=x0 is not None)
+                             started_from_lco=started_from_lco)
 
 
 def truth_loop_matrix(truth, K: control.StateSpace, V: float, *, actuator_omega: float,
@@ -432,7 +479,7 @@ def truth_loop_matrix(truth, K: control.StateSpace, V: float, *, actuator_omega:
     Parameters
     ----------
     truth : AeroelasticTruth
-        The simulator.
+        The simulator, linearised at ``V`` (its :meth:`statespace` with the actuator).
     K : control.StateSpace
         Controller from the sensors to the flap command.
     V : float
@@ -475,6 +522,8 @@ class TruthLoopSweep:
         when the closed loop is unstable there.
     """
 
+    __repr__ = result_repr
+
     V: np.ndarray
     open_abscissa: np.ndarray
     closed_abscissa: np.ndarray
@@ -496,10 +545,8 @@ def truth_loop_sweep(truth, K: control.StateSpace, V_flutter: float, V, *,
         The truth's flutter speed index: the stable interval reported is the one around it.
     V : array_like
         Increasing speed indices.
-    actuator_omega, actuator_zeta : float
-        The flap actuator.
-    sensor_rows : array_like, optional
-        ``Hs`` (default: the truth's own).
+    actuator_omega, actuator_zeta, sensor_rows :
+        The actuator and the sensor rows, as in :func:`truth_loop_matrix`.
 
     Returns
     -------

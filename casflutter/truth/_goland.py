@@ -29,24 +29,22 @@ on the assumed-mode coordinates.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import brentq
 from scipy.special import hankel2
 
 from ..errors import ConfigError
+from ..structure import AirspeedMixin, SpeedConvention
 from ._aero import JONES_B, jones_C, strip_coefficients
 from ._base import AeroelasticTruth, AeroMatrices
 from ._params import ChordGeometryMixin, ParamsMixin, require
+from ._params import parameter as _p  # the parameter fields below
 
 __all__ = ["GolandParams", "GolandWing", "clamped_free_roots", "theodorsen_C"]
 
 _NQUAD = 200
-
-
-def _p(default, unit, doc):
-    return field(default=default, metadata={"unit": unit, "doc": doc})
 
 
 @dataclass(frozen=True)
@@ -153,7 +151,7 @@ def _bending_shapes(y: np.ndarray, L: float, n: int) -> tuple[np.ndarray, np.nda
     return np.array(out), np.array(out2)
 
 
-class GolandWing(AeroelasticTruth):
+class GolandWing(AirspeedMixin, AeroelasticTruth):
     """Full-order truth: the Goland wing, assumed modes + strip-theory Jones aerodynamics.
 
     Parameters
@@ -199,35 +197,13 @@ class GolandWing(AeroelasticTruth):
         super().__init__(p)
 
     # conventions --------------------------------------------------------------------
-    def speed_index(self, U: float) -> float:
-        """Speed index ``V = U / (b omega_ref)`` for an airspeed ``U`` [m/s].
-
-        Parameters
-        ----------
-        U : float
-            Airspeed [m/s].
-
-        Returns
-        -------
-        float
-            Speed index.
-        """
-        return float(U) / (self.params.b * self.params.omega_ref)
-
-    def airspeed(self, V: float) -> float:
-        """Airspeed ``U = V b omega_ref`` [m/s] for a speed index ``V``.
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        float
-            Airspeed [m/s].
-        """
-        return float(V) * self.params.b * self.params.omega_ref
+    @property
+    def speed(self) -> SpeedConvention:
+        """Speed index ``V = U / (b omega_ref)`` (``U_ref = b omega_ref``), time in seconds,
+        dynamic pressure from ``rho``."""
+        p = self.params
+        return SpeedConvention("V = U / (b omega_ref), omega_ref = (pi/2L) sqrt(GJ/I)", "s",
+                               U_ref=(p.b, p.omega_ref), rho=p.rho)
 
     @property
     def alpha(self) -> float:
@@ -308,9 +284,7 @@ class GolandWing(AeroelasticTruth):
                 "sensor_rows": rows,
                 "sensor_names": ("tip plunge [m]", "tip pitch [rad]",
                                  "tip leading edge [m]", "tip trailing edge [m]"),
-                "sensor_units": ("m", "rad", "m", "m"),
-                "time_unit": "s",
-                "speed_index": "V = U / (b omega_ref), omega_ref = (pi/2L) sqrt(GJ/I)"}
+                "sensor_units": ("m", "rad", "m", "m")}
 
     # frequency domain ---------------------------------------------------------------
     def generalized_aero_forces(self, k, *, theodorsen: str = "exact") -> np.ndarray:

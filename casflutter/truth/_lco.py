@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._format import result_repr
 from ..data import ResponseAnalysis, analyze_response
 from ..errors import ConfigError
 
@@ -38,6 +39,8 @@ class TruthLco:
         The truth's full state at the end (on the LCO when ``kind == "lco"``): where a
         suppression run starts from the established LCO.
     """
+
+    __repr__ = result_repr
 
     V: float
     kind: str

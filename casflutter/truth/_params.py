@@ -65,6 +65,7 @@ class ParamsMixin:
         Returns
         -------
         Parameters of this class.
+            The copy, checked like a new instance.
 
         Raises
         ------
@@ -94,6 +95,7 @@ class ParamsMixin:
         Returns
         -------
         Parameters of this class.
+            ``base`` with the changes.
 
         Raises
         ------
@@ -143,6 +145,12 @@ def parse_sets(items: Iterable[str]) -> dict[str, str]:
             raise ConfigError(f"--set item {item!r} is not of the form name=value")
         out[name] = value.strip()
     return out
+
+
+def parameter(default, unit: str, doc: str):
+    """A parameter field of a truth's parameter dataclass: its default, unit and meaning
+    (read by :meth:`ParamsMixin.describe` and the problem listings)."""
+    return dataclasses.field(default=default, metadata={"unit": unit, "doc": doc})
 
 
 def require(cond: bool, message: str) -> None:

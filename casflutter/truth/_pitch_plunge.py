@@ -57,6 +57,7 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from ..errors import ConfigError
+from ..structure import AirspeedMixin, SpeedConvention
 from ._aero import JONES_B, strip_coefficients
 from ._base import AeroelasticTruth, AeroMatrices
 
@@ -290,7 +291,7 @@ def _flap_from(table: Any, source: str) -> FlapCoefficients:
                             _number("flap.cm_beta", table["cm_beta"]))
 
 
-class PitchPlungeSection(AeroelasticTruth):
+class PitchPlungeSection(AirspeedMixin, AeroelasticTruth):
     """Full-order truth of a dimensional pitch--plunge rig section (module docstring).
 
     Parameters
@@ -344,13 +345,12 @@ class PitchPlungeSection(AeroelasticTruth):
         return type(self)(self.params.with_sets(sets), self.name, self.definition)
 
     # ---- conventions -----------------------------------------------------------------
-    def speed_index(self, U: float) -> float:
-        """The speed index is the airspeed ``U`` [m/s]."""
-        return float(U)
-
-    def airspeed(self, V: float) -> float:
-        """The airspeed ``U = V`` [m/s]."""
-        return float(V)
+    @property
+    def speed(self) -> SpeedConvention:
+        """The speed index is the airspeed ``U`` [m/s] (``U_ref = 1``); time in seconds;
+        dynamic pressure from ``rho``."""
+        return SpeedConvention("U [m/s] (the speed index is the airspeed)", "s", U_ref=1.0,
+                               rho=self.params.rho)
 
     @property
     def alpha(self) -> float:
@@ -445,5 +445,4 @@ class PitchPlungeSection(AeroelasticTruth):
         return {"mode_names": [f"mode {i + 1} ({k})" for i, k in enumerate(kinds)],
                 "coordinate_names": ("heave [m]", "pitch [rad]"),
                 "sensor_rows": Phi.copy(), "sensor_names": ("heave", "pitch"),
-                "sensor_units": ("m", "rad"),
-                "time_unit": "s", "speed_index": "U [m/s] (the speed index is the airspeed)"}
+                "sensor_units": ("m", "rad")}

@@ -33,13 +33,14 @@ delay ``r = 1``.  :attr:`RecordSettings.coupling_delay` delays the forces by tha
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from .._settings import finite_numbers
 from ..data import IOData, Record, backward_derivatives, check_band, stepped_chirp_motion
-from ..errors import ConfigError
+from ..errors import ConfigError, DataWarning
 
 __all__ = ["RecordSettings", "truth_records"]
 
@@ -155,6 +156,31 @@ class RecordSettings:
         return (self.amplitude,) * n_channels
 
 
+def _check_lowest_mode(truth, s: RecordSettings) -> None:
+    """Warn when the records cannot see the lowest structural mode (see :func:`truth_records`),
+    the mark of settings in another time unit than the problem's."""
+    ms = truth.modal_structure()
+    k = int(np.argmin(ms.omega))
+    f = float(ms.omega[k]) / (2 * np.pi)          # cycles per time unit
+    if not f > 0:
+        return
+    unit = ms.time_unit
+    misses = []
+    if not s.band[0] <= f <= s.band[1]:
+        misses.append(f"the chirp band {list(s.band)} cycles per {unit} does not hold it")
+    if s.duration * f < 2.0:
+        misses.append(f"a record of duration {s.duration:g} holds {s.duration * f:.2g} of its "
+                      "periods")
+    if misses:
+        hint = "" if unit == "s" else ", not seconds"
+        warnings.warn(f"records of {type(truth).__name__}: its lowest structural mode "
+                      f"({ms.mode_names[k]}) is at {f:.4g} cycles per {unit}; "
+                      + " and ".join(misses) + f". dt, duration and band are in the problem's "
+                      f"time unit ({unit}{hint}): give a band around its modes and records of "
+                      "many periods (e.g. problems/<name>/flutter.toml)",
+                      DataWarning, stacklevel=3)
+
+
 def truth_records(truth, settings: RecordSettings | None = None, **changes) -> IOData:
     """Chirp records of a truth simulator at the speed index ``settings.V0``.
 
@@ -180,6 +206,13 @@ def truth_records(truth, settings: RecordSettings | None = None, **changes) -> I
         ``meta`` holds ``V``, ``band``, ``derivatives``, ``amplitude`` (per channel) and
         ``levels``.
 
+    Warns
+    -----
+    DataWarning
+        A chirp band that misses the problem's lowest structural mode, or records shorter
+        than two of its periods: ``dt``, ``duration`` and ``band`` are in the problem's time
+        unit (``1/omega_theta`` for the typical section, not seconds).
+
     Raises
     ------
     ConfigError
@@ -201,6 +234,7 @@ def truth_records(truth, settings: RecordSettings | None = None, **changes) -> I
     """
     s = replace(settings or RecordSettings(), **changes) if changes else (
         settings or RecordSettings())
+    _check_lowest_mode(truth, s)
     N = truth.n_modes
     K, dt = s.n_samples, s.dt
     t = np.arange(K) * dt

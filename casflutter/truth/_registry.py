@@ -3,18 +3,23 @@
 A problem is named by one of :data:`PROBLEMS` (a built-in truth class with published
 defaults), by a TOML file describing a rig section (``kind = "pitch_plunge"``, see
 :mod:`._pitch_plunge`) or a user's wing without a simulator (``kind = "wing"``: modal data and
-records; ``kind = "gaf"``: modal data and ``Q(ik)``; see :mod:`._wing_file`), or by the name
-of a folder of ``problems/`` whose ``problem.toml`` is such a file (e.g. ``nata``,
-``example_wing``, ``goland_gaf``).
+records; ``kind = "gaf"``: modal data and ``Q(ik)``; see :mod:`._wing_file`), a gridded plant
+family (``kind = "plant_family"``: state-space models at a grid of speeds, read into a
+:class:`casflutter.data.FamilyFile`; :func:`casflutter.aeroelastic.load_family` makes it a
+family), or by the name of a folder of ``problems/`` whose ``problem.toml`` is such a file (e.g.
+``nata``, ``example_wing``, ``goland_gaf``, ``goland_4flaps``).
 """
 
 from __future__ import annotations
+
+import difflib
 
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
 from .. import _resources
 from .._resources import read_toml
+from ..data import FAMILY_KIND, FamilyFile, read_family_file
 from ..errors import ConfigError
 from ._base import AeroelasticTruth
 from ._goland import GolandWing
@@ -72,7 +77,8 @@ def file_problem_names() -> list[str]:
         if path.parent.name in PROBLEMS:
             continue
         try:
-            if read_toml(path, "problem definition").get("kind") in (*FILE_KINDS, *WING_KINDS):
+            if read_toml(path, "problem definition").get("kind") in (*FILE_KINDS, *WING_KINDS,
+                                                                     FAMILY_KIND):
                 out.append(path.parent.name)
         except ConfigError:
             continue
@@ -102,13 +108,16 @@ def _cls(name: str) -> type[AeroelasticTruth]:
         return PROBLEMS[name]
     except KeyError:
         avail = list(PROBLEMS) + file_problem_names()
-        raise ConfigError(f"unknown problem {name!r}; available: {', '.join(avail)}, or a "
-                          "problem TOML file (kind = \"pitch_plunge\")") from None
+        close = difflib.get_close_matches(name, avail, n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise ConfigError(f"unknown problem {name!r}{hint}; available: {', '.join(avail)}, or "
+                          "a problem TOML file (kind = \"pitch_plunge\")") from None
 
 
-def load_problem_file(path, sets=()) -> AeroelasticTruth | WingProblem | GAFProblem:
-    """The truth described by a problem TOML file (``kind = "pitch_plunge"``), or the wing of a
-    wing file (``kind = "wing"`` or ``"gaf"``, no simulator).
+def load_problem_file(path, sets=()) -> AeroelasticTruth | WingProblem | GAFProblem | FamilyFile:
+    """The truth described by a problem TOML file (``kind = "pitch_plunge"``), the wing of a
+    wing file (``kind = "wing"`` or ``"gaf"``, no simulator), or the record of a gridded plant
+    family (``kind = "plant_family"``).
 
     Parameters
     ----------
@@ -119,7 +128,7 @@ def load_problem_file(path, sets=()) -> AeroelasticTruth | WingProblem | GAFProb
 
     Returns
     -------
-    AeroelasticTruth, WingProblem or GAFProblem
+    AeroelasticTruth, WingProblem, GAFProblem or casflutter.data.FamilyFile
 
     Raises
     ------
@@ -134,9 +143,15 @@ def load_problem_file(path, sets=()) -> AeroelasticTruth | WingProblem | GAFProb
     kind = data.get("kind")
     if kind in WING_KINDS:
         return WING_KINDS[kind].from_mapping(data, sets=sets, path=path)
+    if kind == FAMILY_KIND:
+        if list(sets):
+            raise ConfigError(f"problem file {path} is a gridded plant family: it has no "
+                              "parameters to --set (edit the file or its arrays)")
+        return read_family_file(path)
     if kind not in FILE_KINDS:
         raise ConfigError(f"problem file {path}: key 'kind' must be one of "
-                          f"{', '.join(map(repr, (*FILE_KINDS, *WING_KINDS)))}, got {kind!r}")
+                          f"{', '.join(map(repr, (*FILE_KINDS, *WING_KINDS, FAMILY_KIND)))}, "
+                          f"got {kind!r}")
     default = path.parent.name if path.name == "problem.toml" else path.stem
     problem = data.get("problem", {})
     name = dict(problem if isinstance(problem, dict) else {}).get("name", default)

@@ -89,16 +89,18 @@ rho U_ref^2 b L / modal_mass`` so that ``alpha V^2 y = Q / modal_mass`` with ``y
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from ..structure import AirspeedMixin, SpeedConvention
 from ._aero import JONES_A, JONES_B, strip_coefficients
 from ._base import AeroelasticTruth, AeroMatrices, SimulationResult
 from ._goland import _bending_shapes
 from ._params import ChordGeometryMixin, ParamsMixin, require
+from ._params import parameter as _p  # the parameter fields below
 
 __all__ = ["SeedWingParams", "SeedWing", "SEED_FREQUENCIES_HZ", "SEED_SENSOR_ROWS",
            "SEED_MODE_NAMES", "SEED_U_REF"]
@@ -114,10 +116,6 @@ SEED_SENSOR_ROWS = ((0.1299, -0.0006, -0.2866, -0.1130, 0.0766),
 SEED_U_REF = 28.9
 
 _BENDING_ORDER = (1, 1, 2, 1, 3)  # clamped-free shape carrying each mode's vertical part
-
-
-def _p(default, unit, doc):
-    return field(default=default, metadata={"unit": unit, "doc": doc})
 
 
 @dataclass(frozen=True)
@@ -175,7 +173,7 @@ class SeedWingParams(ChordGeometryMixin, ParamsMixin):
         require(2 <= self.n_strips <= 100, f"n_strips = {self.n_strips} must be in 2..100")
 
 
-class SeedWing(AeroelasticTruth):
+class SeedWing(AirspeedMixin, AeroelasticTruth):
     """Full-order nonlinear truth of the paper's wind-tunnel wing (module docstring).
 
     Parameters
@@ -217,35 +215,13 @@ class SeedWing(AeroelasticTruth):
         super().__init__(p)
 
     # conventions --------------------------------------------------------------------
-    def speed_index(self, U: float) -> float:
-        """Speed index ``V = U / U_ref`` for an airspeed ``U`` [m/s].
-
-        Parameters
-        ----------
-        U : float
-            Airspeed [m/s].
-
-        Returns
-        -------
-        float
-            Speed index.
-        """
-        return float(U) / self.params.U_ref
-
-    def airspeed(self, V: float) -> float:
-        """Airspeed ``U = V U_ref`` [m/s] for a speed index ``V``.
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        float
-            Airspeed [m/s].
-        """
-        return float(V) * self.params.U_ref
+    @property
+    def speed(self) -> SpeedConvention:
+        """Speed index ``V = U / U_ref`` (Table I: ``U_ref = 28.9 m/s``), time in seconds,
+        dynamic pressure from ``rho``."""
+        p = self.params
+        return SpeedConvention(f"V = U / U_ref, U_ref = {p.U_ref:g} m/s (Table I)", "s",
+                               U_ref=p.U_ref, rho=p.rho)
 
     @property
     def alpha(self) -> float:
@@ -548,6 +524,4 @@ class SeedWing(AeroelasticTruth):
                 "sensor_names": ("Acc1 (bending/torsion)", "Acc2 (lateral)"),
                 # Hs u: the tip store's deflections [m] (the shapes are per unit u)
                 "sensor_units": ("m", "m"),
-                "sensor": "acceleration",
-                "time_unit": "s",
-                "speed_index": "V = U / U_ref, U_ref = 28.9 m/s (Table I)"}
+                "sensor": "acceleration"}

@@ -19,19 +19,17 @@ axis, both on the chord ``2b``), the paper's force-coefficient outputs.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
+from ..structure import SpeedConvention
 from ._aero import JONES_B, strip_coefficients
 from ._base import AeroelasticTruth, AeroMatrices
 from ._params import ParamsMixin, require
+from ._params import parameter as _p  # the parameter fields below
 
 __all__ = ["TypicalSectionParams", "TypicalSection"]
-
-
-def _p(default, unit, doc):
-    return field(default=default, metadata={"unit": unit, "doc": doc})
 
 
 @dataclass(frozen=True)
@@ -110,20 +108,6 @@ class TypicalSection(AeroelasticTruth):
         """Flow constant of eq. (6): ``omega_theta^2 / (pi mu)``."""
         return self.params.omega_theta ** 2 / (np.pi * self.params.mu)
 
-    def airspeed_ratio(self, V: float) -> float:
-        """``U / (b omega_theta)`` is ``V`` itself for the typical section.
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        float
-        """
-        return float(V)
-
     def aero_matrices(self, V: float) -> AeroMatrices:
         """Jones/Wagner aerodynamic operator at speed index ``V`` (module docstring).
         """
@@ -168,6 +152,11 @@ class TypicalSection(AeroelasticTruth):
             names = [f"{names[0]} {i + 1}" for i in range(2)]
         return {"mode_names": names, "coordinate_names": ("h/b", "theta"),
                 "sensor_rows": Phi.copy(), "sensor_names": ("h/b", "theta"),
-                "sensor_units": ("-", "rad"),
-                "time_unit": "s" if p.omega_theta != 1.0 else "1/omega_theta",
-                "speed_index": "V = U / (b omega_theta)"}
+                "sensor_units": ("-", "rad")}
+
+    @property
+    def speed(self) -> SpeedConvention:
+        """Speed index ``V = U / (b omega_theta)`` without an airspeed scale (the section is
+        nondimensional); time in ``1/omega_theta`` (seconds when ``omega_theta`` is given)."""
+        return SpeedConvention("V = U / (b omega_theta)",
+                               "s" if self.params.omega_theta != 1.0 else "1/omega_theta")

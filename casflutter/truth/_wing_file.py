@@ -71,7 +71,8 @@ from ..data import GAFTable, IOData, Record, load_gaf
 from ..data._matfile import read_mat
 from ..data._records import _read_npz
 from ..errors import ConfigError, DataError
-from ..structure import SENSOR_KINDS, ModalStructure, check_sensor_rows
+from ..structure import (SENSOR_KINDS, AirspeedMixin, ModalStructure, SpeedConvention,
+                         check_sensor_rows)
 
 __all__ = ["WING_KIND", "GAF_KIND", "WingProblem", "GAFProblem"]
 
@@ -145,7 +146,7 @@ def _names(value, key: str, source: str, n: int, distinct: bool = True) -> tuple
 
 
 @dataclass(frozen=True)
-class _Wing:
+class _Wing(AirspeedMixin):
     """What both kinds share: the modes, the sensors, the speed scale."""
 
     name: str
@@ -193,13 +194,11 @@ class _Wing:
             rows.append((f"sensor[{name}]", s.sensor, unit or "-", "row of Hs"))
         return rows
 
-    def airspeed(self, V):
-        """Airspeed ``U = V U_ref`` [m/s] of a speed index."""
-        return float(V) * self.U_ref
-
-    def speed_index(self, U):
-        """Speed index ``V = U / U_ref`` of an airspeed [m/s]."""
-        return float(U) / self.U_ref
+    @property
+    def speed(self) -> SpeedConvention:
+        """The file's speed convention: ``V = U / U_ref``, time in seconds, ``rho`` when
+        given (``structure.speed``)."""
+        return self.structure.speed
 
     def dynamic_pressure(self, V) -> float:
         """Dynamic pressure ``q = rho (V U_ref)^2 / 2`` [Pa] at speed index ``V``.
@@ -212,7 +211,7 @@ class _Wing:
         if self.rho is None:
             raise ConfigError(f"{self.path}: no speed.rho; give the air density [kg/m^3] for "
                               "the dynamic pressure")
-        return 0.5 * self.rho * self.airspeed(V) ** 2
+        return self.speed.dynamic_pressure(V)
 
     @staticmethod
     def _common(data: Mapping, path: Path, kind: str, extra: set) -> dict:
@@ -258,8 +257,8 @@ class _Wing:
                                           else path.stem))
         structure = ModalStructure(
             2 * np.pi * f, zeta, alpha, np.array(rows), kind_s, mode_names=mode_names,
-            sensor_names=snames, time_unit="s",
-            speed_index=f"V = U / U_ref, U_ref = {U_ref:g} m/s")
+            sensor_names=snames,
+            speed=SpeedConvention(f"V = U / U_ref, U_ref = {U_ref:g} m/s", "s", U_ref, rho))
         return dict(name=label, structure=structure, U_ref=U_ref, rho=rho,
                     sensor_units=units, path=path, definition=dict(data))
 

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
+from .._format import result_repr
 from ..errors import ConfigError, ConvergenceError
 from ._common import SystemLike, as_statespace, is_hurwitz, ssdata
 
@@ -55,6 +56,8 @@ class HinfNorm:
     wall_time : float
         Seconds spent.
     """
+
+    __repr__ = result_repr
 
     gamma: float
     omega_peak: float

@@ -21,6 +21,7 @@ from dataclasses import dataclass, replace
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError, DimensionError
 from ._common import NotHurwitzError, is_hurwitz, spectral_abscissa
 
@@ -108,6 +109,8 @@ class StabilityInterval:
     crossing_lower, crossing_upper : str
         ``"complex pair"``, ``"real through 0"`` or ``"none"``.
     """
+
+    __repr__ = result_repr
 
     lower: float
     upper: float

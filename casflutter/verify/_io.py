@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..errors import DataError, DimensionError
 from ._common import SystemLike, as_statespace, ssdata
 
@@ -59,6 +60,8 @@ class PlantData:
     source_format : str
         ``"casflutter"`` or ``"compleib"``.
     """
+
+    __repr__ = result_repr
 
     sys: control.StateSpace
     nmeas: int | None

@@ -11,11 +11,13 @@ from dataclasses import dataclass, field
 import control
 import numpy as np
 
+from .._format import result_repr, sig
 from ..errors import ConfigError, DimensionError
 from ._common import NotHurwitzError, SystemLike, as_statespace, is_hurwitz, ssdata
 from ._hinf import HinfNorm, hinf_norm
 from ._interval import (StabilityInterval, feedback_stability_interval, small_gain_interval,
                         speed_interval)
+from ._io import PlantData
 from ._lft import lft_closed_loop
 
 __all__ = ["VerificationReport", "verify_controller", "verify_lft", "delta_family"]
@@ -55,6 +57,8 @@ class VerificationReport:
     notes : tuple of str
         Why something was not computed, and other remarks.
     """
+
+    __repr__ = result_repr
 
     closed_loop: control.StateSpace
     poles: np.ndarray
@@ -120,23 +124,31 @@ class VerificationReport:
         }
         return out
 
-    def format(self, max_poles: int = 8) -> str:
-        """A readable multi-line report.
+    def format(self, max_poles: int = 8, *, speed_scale: float | None = None) -> str:
+        """A readable multi-line report (numbers with 6 significant digits).
 
         Parameters
         ----------
         max_poles : int
             Number of rightmost closed-loop poles listed.
+        speed_scale : float, optional
+            Airspeed [m/s] per speed index (``U = speed_scale V``), when the plant's problem
+            has one: the speed intervals are then given in m/s as well.
 
         Returns
         -------
         str
         """
         def f(x):
-            return f"{x:.6g}" if x is not None else "-"
+            return sig(x, 6)
 
         def iv(t):
             return "-" if t is None else f"({f(t[0])}, {f(t[1])})"
+
+        def speeds(t):
+            if t is None or not speed_scale:
+                return iv(t)
+            return f"{iv(t)}, U in {iv(tuple(speed_scale * v for v in t))} m/s"
 
         lines = ["casflutter verification report",
                  f"  closed loop: {self.closed_loop.nstates} states, "
@@ -155,15 +167,17 @@ class VerificationReport:
             lines.append(f"  H-inf norm ||T_wf->zf|| : gamma_f = {f(hd.gamma)} at omega = "
                          f"{f(hd.omega_peak)} rad/s  [{hd.method}]")
         if self.Vf is not None:
-            lines.append(f"  Vf = {f(self.Vf)}, delta channel n_delta = {self.n_delta}")
+            air = f" (U = {f(speed_scale * self.Vf)} m/s)" if speed_scale else ""
+            lines.append(f"  Vf = {f(self.Vf)}{air}, delta channel n_delta = {self.n_delta}; "
+                         "dV = V² - Vf² (eq. 10), V the speed index")
             lines.append(f"  small gain (paper, whole wbar): dV in {iv(self.small_gain_dV)}"
-                         f"  ->  V in {iv(self.small_gain_V)}")
+                         f"  ->  V in {speeds(self.small_gain_V)}")
             lines.append(f"  small gain (wf->zf only)     : dV in "
                          f"{iv(self.small_gain_dV_delta)}  ->  V in "
-                         f"{iv(self.small_gain_V_delta)}")
+                         f"{speeds(self.small_gain_V_delta)}")
             ex = None if self.exact is None else (self.exact.lower, self.exact.upper)
             lines.append(f"  exact stability ({'-' if self.exact is None else self.exact.method})"
-                         f"  : dV in {iv(ex)}  ->  V in {iv(self.exact_V)}")
+                         f"  : dV in {iv(ex)}  ->  V in {speeds(self.exact_V)}")
         for n in self.notes:
             lines.append(f"  note: {n}")
         return "\n".join(lines)
@@ -197,20 +211,22 @@ def delta_family(closed_loop: control.StateSpace, n_delta: int
     return A, B[:, :n_delta], C[:n_delta, :], D[:n_delta, :n_delta]
 
 
-def verify_controller(P: SystemLike, K: SystemLike, nmeas: int, ncon: int, *,
-                      Vf: float | None = None, n_delta: int | None = None,
-                      delta_channel: int | None = None, method: str = "auto",
-                      tol: float = 1e-10) -> VerificationReport:
+def verify_controller(P: SystemLike | PlantData, K: SystemLike, nmeas: int | None = None,
+                      ncon: int | None = None, *, Vf: float | None = None,
+                      n_delta: int | None = None, delta_channel: int | None = None,
+                      method: str = "auto", tol: float = 1e-10) -> VerificationReport:
     """Re-check a controller ``K`` on the partitioned plant ``P`` (eq. 14-16).
 
     Parameters
     ----------
-    P : control.StateSpace
-        Plant, inputs ``[w̄; v]``, outputs ``[z; zm]`` (``control.hinfsyn`` convention).
+    P : control.StateSpace or PlantData
+        Plant, inputs ``[w̄; v]``, outputs ``[z; zm]`` (``control.hinfsyn`` convention); a
+        :class:`PlantData` (:func:`load_plant`) brings its partition and ΔV channel, which
+        the arguments below override.
     K : control.StateSpace or array_like
         Controller from the ``nmeas`` measurements to the ``ncon`` controls.
     nmeas, ncon : int
-        Number of measurements and controls.
+        Number of measurements and controls (from ``P`` when it is a :class:`PlantData`).
     Vf : float, optional
         Nominal speed index; with ``n_delta`` the ΔV intervals are computed.
     n_delta : int, optional
@@ -235,7 +251,8 @@ def verify_controller(P: SystemLike, K: SystemLike, nmeas: int, ncon: int, *,
     IllPosedError
         Loop not well posed (``I - Dk D22`` singular).
     ConfigError
-        ``Vf`` without ``n_delta`` (or the reverse), or a discrete-time system.
+        ``Vf`` without ``n_delta`` (or the reverse), a discrete-time system, or no
+        ``nmeas``/``ncon`` (neither given nor in the :class:`PlantData`).
 
     See Also
     --------
@@ -252,16 +269,17 @@ def verify_controller(P: SystemLike, K: SystemLike, nmeas: int, ncon: int, *,
     >>> rep.stable, round(rep.hinf.gamma, 4)
     (True, 0.5)
     """
-    if delta_channel is not None:
-        if n_delta is not None and n_delta != delta_channel:
-            raise ConfigError(f"n_delta={n_delta} and delta_channel={delta_channel} differ; "
-                              "give one of them")
-        n_delta = delta_channel
-    if (Vf is None) != (n_delta is None):
-        raise ConfigError("give both Vf and n_delta (size of the ΔV channel, eq. 13-15) "
-                          f"or neither; got Vf={Vf!r}, n_delta={n_delta!r}")
-    if Vf is not None and not Vf >= 0:
-        raise ConfigError(f"Vf must be >= 0, got {Vf!r}")
+    if isinstance(P, PlantData):      # the partition the file carries, unless overridden
+        nmeas = P.nmeas if nmeas is None else nmeas
+        ncon = P.ncon if ncon is None else ncon
+        if Vf is None and n_delta is None and delta_channel is None:
+            Vf, n_delta = P.Vf, P.n_delta
+        P = P.sys
+    if nmeas is None or ncon is None:
+        raise ConfigError(f"nmeas = {nmeas!r}, ncon = {ncon!r}: give the number of "
+                          "measurements and controls of the plant (or a PlantData that "
+                          "holds them, e.g. load_plant('plant.json'))")
+    n_delta = _delta_size(Vf, n_delta, delta_channel)
     P = as_statespace(P, "plant P")
     K = as_statespace(K, "controller K")
     cl = lft_closed_loop(P, K, nmeas, ncon)
@@ -274,32 +292,57 @@ def verify_controller(P: SystemLike, K: SystemLike, nmeas: int, ncon: int, *,
     notes: list[str] = []
     extra: dict = {}
     if Vf is not None:
-        Ad, Bf, Cf, Dff = delta_family(cl, n_delta)
-        hinf_d = hinf_norm(cl[:n_delta, :n_delta], method=method, tol=tol)
-        extra.update(Vf=float(Vf), n_delta=int(n_delta), hinf_delta=hinf_d)
-        if stable:
-            for key, g in (("", hinf.gamma), ("_delta", hinf_d.gamma)):
-                r = math.inf if g == 0 else 1.0 / g
-                extra["small_gain_dV" + key] = (-r, r)
-                extra["small_gain_V" + key] = small_gain_interval(g, Vf)
-            try:
-                ex = feedback_stability_interval(Ad, Bf, Cf, Dff)
-            except NotHurwitzError as exc:  # pragma: no cover - guarded by `stable`
-                notes.append(str(exc))
-            else:
-                extra.update(exact=ex, exact_V=speed_interval(ex.lower, ex.upper, Vf))
-            if np.any(Dff):
-                notes.append("closed-loop feedthrough D_zf,wf != 0: A(ΔV) is rational in "
-                             "ΔV; the exact interval uses the rational (LFT) pencil")
-        else:
-            notes.append("nominal closed loop is unstable (spectral abscissa "
-                         f"{alpha:.6g} >= 0): gamma is infinite and no ΔV interval around "
-                         "ΔV = 0 exists; the controller does not stabilise the plant at Vf")
+        extra = _delta_intervals(cl, hinf, stable, alpha, Vf, n_delta, method, tol, notes)
     elif not stable:
         notes.append(f"nominal closed loop is unstable (spectral abscissa {alpha:.6g}); "
                      "the H-inf norm is infinite")
     return VerificationReport(closed_loop=cl, poles=poles, stable=stable,
                               spectral_abscissa=alpha, hinf=hinf, notes=tuple(notes), **extra)
+
+
+def _delta_size(Vf, n_delta, delta_channel) -> int | None:
+    """The size of the ΔV channel from ``n_delta`` or its alias ``delta_channel``, checked
+    against ``Vf`` (both or neither)."""
+    if delta_channel is not None:
+        if n_delta is not None and n_delta != delta_channel:
+            raise ConfigError(f"n_delta={n_delta} and delta_channel={delta_channel} differ; "
+                              "give one of them")
+        n_delta = delta_channel
+    if (Vf is None) != (n_delta is None):
+        raise ConfigError("give both Vf and n_delta (size of the ΔV channel, eq. 13-15) "
+                          f"or neither; got Vf={Vf!r}, n_delta={n_delta!r}")
+    if Vf is not None and not Vf >= 0:
+        raise ConfigError(f"Vf must be >= 0, got {Vf!r}")
+    return n_delta
+
+
+def _delta_intervals(cl, hinf: HinfNorm, stable: bool, alpha: float, Vf, n_delta: int,
+                     method: str, tol: float, notes: list) -> dict:
+    """The fields of :class:`VerificationReport` about the ΔV channel: its norm, the
+    small-gain intervals (eq. 16) and the exact interval of the loop ``A(ΔV)``; the reasons
+    for any missing one are appended to ``notes``."""
+    Ad, Bf, Cf, Dff = delta_family(cl, n_delta)
+    hinf_d = hinf_norm(cl[:n_delta, :n_delta], method=method, tol=tol)
+    extra = dict(Vf=float(Vf), n_delta=int(n_delta), hinf_delta=hinf_d)
+    if not stable:
+        notes.append("nominal closed loop is unstable (spectral abscissa "
+                     f"{alpha:.6g} >= 0): gamma is infinite and no ΔV interval around "
+                     "ΔV = 0 exists; the controller does not stabilise the plant at Vf")
+        return extra
+    for key, g in (("", hinf.gamma), ("_delta", hinf_d.gamma)):
+        r = math.inf if g == 0 else 1.0 / g
+        extra["small_gain_dV" + key] = (-r, r)
+        extra["small_gain_V" + key] = small_gain_interval(g, Vf)
+    try:
+        ex = feedback_stability_interval(Ad, Bf, Cf, Dff)
+    except NotHurwitzError as exc:  # pragma: no cover - guarded by `stable`
+        notes.append(str(exc))
+    else:
+        extra.update(exact=ex, exact_V=speed_interval(ex.lower, ex.upper, Vf))
+    if np.any(Dff):
+        notes.append("closed-loop feedthrough D_zf,wf != 0: A(ΔV) is rational in "
+                     "ΔV; the exact interval uses the rational (LFT) pencil")
+    return extra
 
 
 def verify_lft(lft, K: SystemLike, *, method: str = "auto",

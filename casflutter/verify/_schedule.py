@@ -23,6 +23,7 @@ from typing import Callable
 import numpy as np
 import scipy.signal
 
+from .._format import result_repr
 from .._settings import finite_numbers
 from ..errors import ConfigError
 from ._common import as_statespace, ssdata
@@ -53,6 +54,8 @@ class ScheduledResponse:
         The time the plant's state norm passed ``state_limit`` (the run stops there, to keep
         the numbers finite; by then the loop has long been unstable); None if it did not.
     """
+
+    __repr__ = result_repr
 
     t: np.ndarray
     V: np.ndarray
@@ -192,62 +195,25 @@ def scheduled_response(plant: Callable[[float], object], controllers, switch_spe
     except (TypeError, ValueError):
         raise ConfigError(f"hysteresis = {hysteresis!r} must be a number >= 0") from None
     s = _check_switches(switch_speeds, len(K), hysteresis)
-    if transfer not in ("rest", "output"):
-        raise ConfigError(f"transfer = {transfer!r}: allowed 'rest' (the incoming controller "
-                          "starts from zero) and 'output' (from the state that repeats the "
-                          "last command)")
-    for name, value in (("dt", dt), ("dV", dV)):
-        if not (np.isfinite(value) and value > 0):
-            raise ConfigError(f"{name} = {value!r} must be > 0")
-    if not (np.isfinite(state_limit) and state_limit > 0):
-        raise ConfigError(f"state_limit = {state_limit!r} must be > 0")
-    if not dt < t_bp[-1]:
-        raise ConfigError(f"dt = {dt:g} s must be shorter than the run ({t_bp[-1]:g} s)")
+    _check_stepping(transfer, dt, dV, state_limit, float(t_bp[-1]))
     n_steps = int(np.floor(t_bp[-1] / dt + 1e-9))
     t = dt * np.arange(n_steps + 1)
     P0 = as_statespace(plant(float(V_bp[0])), "plant(V)")
-    n, nin, ny = P0.nstates, P0.ninputs, P0.noutputs
-    if not (isinstance(ncon, (int, np.integer)) and 1 <= ncon <= nin):
-        raise ConfigError(f"ncon = {ncon!r}: the plant has {nin} inputs, the last ncon of which "
-                          "are the controls")
-    nw = nin - ncon
-    for i, k in enumerate(K):
-        if k.ninputs != ny or k.noutputs != ncon:
-            raise ConfigError(f"controllers[{i}] has {k.ninputs} inputs and {k.noutputs} "
-                              f"outputs; the plant needs {ny} (its measurements) in and "
-                              f"{ncon} (its controls) out")
-    w = np.zeros((t.size, nw)) if disturbance is None else np.asarray(disturbance, float)
-    if w.shape != (t.size, nw) or not np.all(np.isfinite(w)):
-        raise ConfigError(f"disturbance: finite, of shape ({t.size}, {nw}) (the times 0, dt, "
-                          f"..., {t[-1]:g} s and the plant's {nw} disturbance inputs), got "
-                          f"{w.shape}")
-    x = np.zeros(n) if x0 is None else np.asarray(x0, dtype=float).ravel()
-    if x.shape != (n,) or not np.all(np.isfinite(x)):
-        raise ConfigError(f"x0: {n} finite numbers (the plant's state), got shape {x.shape}")
-    if not (np.any(x) or np.any(w)):
-        raise ConfigError("no excitation: x0 and the disturbance are both zero, so the "
-                          "response is zero; give an initial state or a disturbance")
-
+    n, ny = P0.nstates, P0.noutputs
+    nw = _check_sizes(P0, K, ncon)
+    w, x = _check_excitation(disturbance, x0, t, nw, n)
     V_t = np.interp(t, t_bp, V_bp)
     V_mid = np.interp(t[:-1] + 0.5 * dt, t_bp, V_bp)
-    cache: dict[tuple[int, int], tuple[np.ndarray, ...]] = {}
+    loops = _DiscreteLoops(plant, K, nw, ncon, ny, n, dt, dV, float(V_bp[0]))
+    active = int(np.searchsorted(s, float(V_t[0]), side="right"))
+    return _march(loops, K, s, hysteresis, transfer, state_limit, t, V_t, V_mid, w, x, active)
 
-    def discrete(i: int, V: float):
-        key = (i, int(round(V / dV)))
-        if key not in cache:
-            Pa = _augmented(as_statespace(plant(key[1] * dV), "plant(V)"), nw, ncon)
-            if Pa.nstates != n:
-                raise ConfigError(f"plant({key[1] * dV:g}) has {Pa.nstates} states; "
-                                  f"plant({V_bp[0]:g}) has {n}")
-            Acl, Bcl, Ccl, Dcl = ssdata(lft_closed_loop(Pa, K[i], ny, ncon))
-            Ad, Bd, *_ = scipy.signal.cont2discrete((Acl, Bcl, Ccl, Dcl), dt, method="zoh")
-            cache[key] = (Ad, Bd, Ccl, Dcl)
-        return cache[key]
 
-    def band(V: float) -> int:
-        return int(np.searchsorted(s, V, side="right"))
-
-    active = band(float(V_t[0]))
+def _march(loops, K, s, hysteresis: float, transfer: str, state_limit: float, t, V_t, V_mid,
+           w, x, active: int) -> ScheduledResponse:
+    """Step the switched closed loop from the plant state ``x`` with controller ``active``
+    (see :func:`scheduled_response`)."""
+    n, ny, ncon, n_steps = x.size, loops.ny, loops.ncon, t.size - 1
     xk = np.zeros(K[active].nstates)
     used = np.empty(t.size, dtype=int)
     out = np.empty((t.size, ny + ncon))
@@ -256,12 +222,7 @@ def scheduled_response(plant: Callable[[float], object], controllers, switch_spe
     last = t.size - 1
     for k in range(t.size):
         V = float(V_t[k])
-        if active < s.size and V >= s[active] + 0.5 * hysteresis:
-            new = active + 1
-        elif active > 0 and V <= s[active - 1] - 0.5 * hysteresis:
-            new = active - 1
-        else:
-            new = active
+        new = _next_band(active, V, s, hysteresis)
         if new != active:
             switches.append((float(t[k]), V, active, new))
             active, xk = new, np.zeros(K[new].nstates)
@@ -269,7 +230,7 @@ def scheduled_response(plant: Callable[[float], object], controllers, switch_spe
                 u_last = out[k - 1, ny:] - ssdata(K[new])[3] @ out[k - 1, :ny]
                 xk = np.linalg.lstsq(ssdata(K[new])[2], u_last, rcond=None)[0]
         used[k] = active
-        Ad, Bd, C, D = discrete(active, float(V_mid[min(k, n_steps - 1)]))
+        Ad, Bd, C, D = loops.at(active, float(V_mid[min(k, n_steps - 1)]))
         z = np.concatenate([x, xk])
         out[k] = C @ z + D @ w[k]
         if not np.linalg.norm(x) <= state_limit:
@@ -282,3 +243,84 @@ def scheduled_response(plant: Callable[[float], object], controllers, switch_spe
     return ScheduledResponse(t=t[keep], V=V_t[keep], controller=used[keep],
                              measurements=out[keep, :ny], control=out[keep, ny:],
                              switches=tuple(switches), stopped_at=stopped_at)
+
+
+def _check_stepping(transfer: str, dt, dV, state_limit, t_end: float) -> None:
+    """Check the transfer rule, the time step, the speed grid and the state limit."""
+    if transfer not in ("rest", "output"):
+        raise ConfigError(f"transfer = {transfer!r}: allowed 'rest' (the incoming controller "
+                          "starts from zero) and 'output' (from the state that repeats the "
+                          "last command)")
+    for name, value in (("dt", dt), ("dV", dV)):
+        if not (np.isfinite(value) and value > 0):
+            raise ConfigError(f"{name} = {value!r} must be > 0")
+    if not (np.isfinite(state_limit) and state_limit > 0):
+        raise ConfigError(f"state_limit = {state_limit!r} must be > 0")
+    if not dt < t_end:
+        raise ConfigError(f"dt = {dt:g} s must be shorter than the run ({t_end:g} s)")
+
+
+def _check_sizes(P0, K, ncon) -> int:
+    """Check that ``ncon`` and every controller fit the plant; the number of disturbances."""
+    nin, ny = P0.ninputs, P0.noutputs
+    if not (isinstance(ncon, (int, np.integer)) and 1 <= ncon <= nin):
+        raise ConfigError(f"ncon = {ncon!r}: the plant has {nin} inputs, the last ncon of which "
+                          "are the controls")
+    for i, k in enumerate(K):
+        if k.ninputs != ny or k.noutputs != ncon:
+            raise ConfigError(f"controllers[{i}] has {k.ninputs} inputs and {k.noutputs} "
+                              f"outputs; the plant needs {ny} (its measurements) in and "
+                              f"{ncon} (its controls) out")
+    return nin - ncon
+
+
+def _check_excitation(disturbance, x0, t, nw: int, n: int):
+    """The disturbance samples and the initial state, checked; not both zero."""
+    w = np.zeros((t.size, nw)) if disturbance is None else np.asarray(disturbance, float)
+    if w.shape != (t.size, nw) or not np.all(np.isfinite(w)):
+        raise ConfigError(f"disturbance: finite, of shape ({t.size}, {nw}) (the times 0, dt, "
+                          f"..., {t[-1]:g} s and the plant's {nw} disturbance inputs), got "
+                          f"{w.shape}")
+    x = np.zeros(n) if x0 is None else np.asarray(x0, dtype=float).ravel()
+    if x.shape != (n,) or not np.all(np.isfinite(x)):
+        raise ConfigError(f"x0: {n} finite numbers (the plant's state), got shape {x.shape}")
+    if not (np.any(x) or np.any(w)):
+        raise ConfigError("no excitation: x0 and the disturbance are both zero, so the "
+                          "response is zero; give an initial state or a disturbance")
+    return w, x
+
+
+def _next_band(active: int, V: float, s: np.ndarray, hysteresis: float) -> int:
+    """The controller in use at speed ``V`` after ``active``: one band up or down once ``V``
+    is past a switch speed by half the hysteresis."""
+    if active < s.size and V >= s[active] + 0.5 * hysteresis:
+        return active + 1
+    if active > 0 and V <= s[active - 1] - 0.5 * hysteresis:
+        return active - 1
+    return active
+
+
+class _DiscreteLoops:
+    """The closed loops of the plant with each controller, discretised with a zero-order
+    hold (scipy) once per controller and speed of the ``dV`` grid."""
+
+    def __init__(self, plant, K, nw: int, ncon: int, ny: int, n: int, dt: float, dV: float,
+                 V0: float):
+        self.plant, self.K, self.nw, self.ncon, self.ny, self.n = plant, K, nw, ncon, ny, n
+        self.dt, self.dV, self.V0 = dt, dV, V0
+        self.cache: dict[tuple[int, int], tuple[np.ndarray, ...]] = {}
+
+    def at(self, i: int, V: float):
+        """``(Ad, Bd, C, D)`` of the loop with controller ``i`` at the grid speed nearest
+        ``V``."""
+        key = (i, int(round(V / self.dV)))
+        if key not in self.cache:
+            Vg = key[1] * self.dV
+            Pa = _augmented(as_statespace(self.plant(Vg), "plant(V)"), self.nw, self.ncon)
+            if Pa.nstates != self.n:
+                raise ConfigError(f"plant({Vg:g}) has {Pa.nstates} states; "
+                                  f"plant({self.V0:g}) has {self.n}")
+            Acl, Bcl, Ccl, Dcl = ssdata(lft_closed_loop(Pa, self.K[i], self.ny, self.ncon))
+            Ad, Bd, *_ = scipy.signal.cont2discrete((Acl, Bcl, Ccl, Dcl), self.dt, method="zoh")
+            self.cache[key] = (Ad, Bd, Ccl, Dcl)
+        return self.cache[key]

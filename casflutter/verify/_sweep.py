@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError
 from ._common import SystemLike, as_statespace
 from ._lft import lft_closed_loop
@@ -32,6 +33,8 @@ class SpeedSweep:
     spectral_abscissa : numpy.ndarray
         Largest real part per V (``inf`` where not well posed).
     """
+
+    __repr__ = result_repr
 
     V: np.ndarray
     dV: np.ndarray

@@ -14,7 +14,7 @@ This example follows ``r`` along the speed on two models:
 * the wing itself: the truth's linearisation with the flap behind its 40 Hz servo
   (:class:`casflutter.aeroelastic.TruthLoop`);
 * the default run's ROM loop (eq. 8, identified at V0 = 0.69 and scaled by V²,
-  ``problems/seed_wing/rom_loop_seed0.npz``), behind the same servo.
+  ``problems/seed_wing_rom/rom_loop_seed0.npz``), behind the same servo.
 """
 
 import matplotlib.pyplot as plt
@@ -28,7 +28,7 @@ SERVO = 251.3                            # rad/s: the wind-tunnel servo, 40 Hz
 speeds = np.linspace(1.1, 2.45, 136)     # from just below flutter to past the paper's 2.4
 
 wing = TruthLoop(SeedWing(), SERVO)
-rom, Vf = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
+rom, Vf = load_rom_loop(problems_dir() / "seed_wing_rom" / "rom_loop_seed0.npz")
 models = {"wing (truth linearisation)": mode_residues(wing, speeds),
           "default ROM loop (frozen, eq. 8)": mode_residues(rom.with_servo(SERVO), speeds)}
 
@@ -85,7 +85,7 @@ fig.tight_layout()
 #   destabilise the same mode below its flutter speed (the flutter mode grows out of the
 #   lateral mode, 63 rad/s at rest and damped 0.5 %, and there its residue points the other
 #   way).  Two order-3
-#   controllers hold (0, 2.26) and (1.03, 2.40) (``problems/seed_wing/``, certified in the
+#   controllers hold (0, 2.26) and (1.03, 2.40) (``tests/witnesses/``, certified in the
 #   tests); one order-4 controller holds (0, 2.41).
 #
 # The frozen ROM puts the flutter mode's control reversal half a speed unit too high, where

@@ -75,8 +75,11 @@ system = RFASystem(fit, structure, table.U_ref)
 U_lo, U_hi = 60.0, 200.0
 result = find_flutter(system, (U_lo, U_hi), n_grid=57 if QUICK else 141)
 pk = pk_flutter(table, structure, np.linspace(U_lo, U_hi, 15 if QUICK else 29), modes=(0, 1))
-low = [b for b in result.tracking.upper_branches() if result.origin[b] in (0, 1)]
-fig = plot_vg_vf(result, branches=low, hz=False)
+lam = result.tracking.eigenvalues          # the oscillatory branches of the two modes
+low = [b for b in result.tracking.upper_branches()
+       if result.origin[b] in (0, 1) and np.mean(np.abs(lam[:, b].imag)) > 0]
+fig = plot_vg_vf(result, branches=low, hz=False, mode_names=table.mode_names, speed_unit="m/s",
+                 speed_label="airspeed U [m/s]")
 ag, af = fig.axes
 for j in range(2):
     ag.plot(pk.U, pk.damping_ratio[:, j], "ko", ms=4, mfc="none",
@@ -85,7 +88,6 @@ for j in range(2):
 ag.axhline(0.0, color="0.6", lw=0.8)
 ag.set_ylim(-0.15, 0.7)
 ag.legend(fontsize=7)
-af.set_xlabel("airspeed U [m/s]")
 
 # %%
 # The flutter point beside the published values (the remaining −1 % in frequency is the

@@ -47,9 +47,9 @@ print(f"flutter: V_f = {result.Vf:.4f}, U_f = {U_f:.1f} m/s (reference {ref['air
 lam = result.tracking.eigenvalues
 low = [k for k in result.tracking.upper_branches()
        if 0.5 * structure.omega[0] < np.mean(lam[:, k].imag) < 1.3 * structure.omega[1]]
-fig = plot_vg_vf(result, branches=low)
-fig.axes[1].set_xlabel(r"speed index $V = U/(b\,\omega_{ref})$"
-                       f"  ({b * omega_ref:.1f} m/s per unit)")
+fig = plot_vg_vf(result, branches=low, hz=False, mode_names=structure.mode_names,
+                 speed_scale=b * omega_ref, speed_unit="m/s", speed_label="airspeed U [m/s]",
+                 index_label=r"speed index $V = U/(b\,\omega_{ref})$")
 
 # %%
 # The ROM route.  Records of the truth are taken at :math:`V_0`; the single-speed ROM with the

@@ -8,7 +8,7 @@ paper's claim is a controller that holds the wing over V ∈ (0, 2.4), up to 3.5
 Above V0 the real aerodynamic lags get faster (their time scale is the chord over the
 airspeed); the ROM's keep the time scale of V0.
 
-``problems/seed_wing/truth_interval_controller_order8.json`` is an order-8 controller that
+``tests/witnesses/truth_interval_controller_order8.json`` is an order-8 controller that
 holds the seed wing's own linearisation (flap behind its 40 Hz servo) over (0, 2.4); the
 verification layer certifies that below.  Closing it around three models shows which one
 predicts what it does on the wing:
@@ -34,6 +34,10 @@ from casflutter.realize import ParametricROM, realize, speed_nodes
 from casflutter.truth import RecordSettings, SeedWing, truth_records
 from casflutter.verify import load_controller, speed_family_interval
 
+# The witness controllers are inputs of the tests, kept in the source tree's tests/witnesses
+# (not installed with the package); the certification below does not depend on how they were
+# found.
+WITNESSES = problems_dir().resolve().parent / "tests" / "witnesses"
 SERVO = 251.3      # rad/s: the wind-tunnel servo, 40 Hz
 V0 = 0.69          # the paper's identification speed (Table I)
 
@@ -56,7 +60,7 @@ parametric = ParametricSystem(ParametricROM(nodes, tuple(
     identify_common_denominator(truth_records(truth, records, V0=float(v)), 2, 6)
     for v in nodes)), structure)
 wing = TruthLoop(truth, SERVO, sensors=structure)
-K = load_controller(problems_dir() / "seed_wing" / "truth_interval_controller_order8.json")
+K = load_controller(WITNESSES / "truth_interval_controller_order8.json")
 
 # %%
 # The certified interval on the wing

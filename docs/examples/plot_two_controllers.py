@@ -11,7 +11,7 @@ would do if their intervals overlapped.
 --random-orders 3,4``) answers that order by order: at order 3 the best from either side leave
 a gap around the dip; at order 4 they overlap.
 
-This example loads the kept order-4 pair (``problems/seed_wing/rom_order4_*_controller.json``,
+This example loads the kept order-4 pair (``tests/witnesses/rom_order4_*_controller.json``,
 both found by that search and certified in the tests), draws the closed loop's spectral
 abscissa along V for each, computed here, beside the open loop's, and simulates a speed sweep
 through the switch (:func:`casflutter.verify.scheduled_response`).
@@ -25,11 +25,14 @@ from casflutter._resources import problems_dir
 from casflutter.aeroelastic import load_rom_loop
 from casflutter.verify import load_controller, scheduled_response, speed_family_interval
 
+# The witness controllers are inputs of the tests, kept in the source tree's tests/witnesses
+# (not installed with the package); the certification below does not depend on how they were
+# found.
+WITNESSES = problems_dir().resolve().parent / "tests" / "witnesses"
 SERVO = 251.3                                  # rad/s: the wind-tunnel servo, 40 Hz
-rom, Vf = load_rom_loop(problems_dir() / "seed_wing" / "rom_loop_seed0.npz")
+rom, Vf = load_rom_loop(problems_dir() / "seed_wing_rom" / "rom_loop_seed0.npz")
 family = rom.with_servo(SERVO)
-controllers = {end: load_controller(problems_dir() / "seed_wing" /
-                                    f"rom_order4_{end}_controller.json")
+controllers = {end: load_controller(WITNESSES / f"rom_order4_{end}_controller.json")
                for end in ("low", "high")}
 
 

@@ -42,9 +42,8 @@ print(f"divergence: V_d = {result.divergence.V:.4f} (reference {ref['divergence'
 # %%
 # The V–g and V–f diagrams: the damping ratio of the pitch branch falls through zero at
 # :math:`V_f`, where its frequency has nearly merged with the plunge branch.
-fig = plot_vg_vf(result, hz=False)
-fig.axes[1].set_xlabel(r"speed index $V = U/(b\,\omega_\theta)$")
-fig.axes[1].set_ylabel(r"frequency / $\omega_\theta$")
+fig = plot_vg_vf(result, hz=False, frequency_unit="Ω/ω_θ", mode_names=structure.mode_names,
+                 speed_label=r"speed index $V = U/(b\,\omega_\theta)$")
 
 # %%
 # The same branches in the complex plane, coloured by the speed index.

@@ -22,7 +22,7 @@ from casflutter.truth import load_problem
 HERE = Path(__file__).resolve().parent
 K = np.concatenate([np.linspace(0.0, 0.2, 9), np.linspace(0.25, 2.0, 36)])
 
-TEMPLATE = '''# The Goland wing (Goland 1945) from frequency-domain aerodynamics (route 2 of issue 15): the
+TEMPLATE = '''# The Goland wing (Goland 1945) from frequency-domain aerodynamics: the
 # modal data and a table of generalised aerodynamic forces Q(ik), no simulator.  Written by
 # make_problem.py from casflutter's Goland strip model (exact Theodorsen function); the layout
 # is documented in casflutter/truth/_wing_file.py (casflutter.truth.GAFProblem).

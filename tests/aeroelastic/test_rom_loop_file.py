@@ -11,7 +11,7 @@ from casflutter.aeroelastic import AeroelasticSystem, load_rom_loop
 from casflutter.errors import DataError
 from casflutter.structure import ModalStructure
 
-FILE = problems_dir() / "seed_wing" / "rom_loop_seed0.npz"
+FILE = problems_dir() / "seed_wing_rom" / "rom_loop_seed0.npz"
 
 
 def test_the_loop_is_the_one_the_arrays_describe():

@@ -21,11 +21,12 @@ its own loop is compared with the one the wing certifies.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import control
 import numpy as np
 import pytest
 
-from casflutter._resources import problems_dir
 from casflutter.aeroelastic import (AeroelasticSystem, ParametricSystem, TruthLoop, build_lft,
                                    find_flutter)
 from casflutter.errors import ConfigError
@@ -33,6 +34,9 @@ from casflutter.ident import identify_common_denominator
 from casflutter.realize import ParametricROM, speed_nodes
 from casflutter.truth import RecordSettings, SeedWing, truth_records
 from casflutter.verify import load_controller, speed_family_interval
+
+#: the test witnesses (tests/witnesses/README.md): inputs of the tests, each certified here
+WITNESS_DIR = Path(__file__).resolve().parents[1] / "witnesses"
 
 SERVO = 251.3                           # rad/s, the seed wing's 40 Hz servo
 SPEEDS = np.linspace(0.3, 2.3, 21)      # the parametric ROM's nodes span (0.3, 2.5)
@@ -52,7 +56,7 @@ def models():
     rom = ParametricROM(nodes, tuple(
         identify_common_denominator(truth_records(truth, records, V0=float(v)), 2, 6)
         for v in nodes))
-    K = load_controller(problems_dir() / "seed_wing" / "truth_interval_controller_order8.json")
+    K = load_controller(WITNESS_DIR / "truth_interval_controller_order8.json")
     return ParametricSystem(rom, truth.modal_structure()), TruthLoop(truth, SERVO), K
 
 

@@ -6,14 +6,18 @@ servo's transfer function multiplied in by hand, and python-control closing the 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import control
 import numpy as np
 import pytest
 
-from casflutter._resources import problems_dir
 from casflutter.aeroelastic import ServoSystem
 from casflutter.errors import ConfigError
 from casflutter.verify import load_controller
+
+#: the test witnesses (tests/witnesses/README.md): inputs of the tests, each certified here
+WITNESS_DIR = Path(__file__).resolve().parents[1] / "witnesses"
 
 OMEGA, ZETA = 251.3, 0.7
 
@@ -38,7 +42,7 @@ def test_every_speed_has_the_servo_in_front_of_the_flap(system):
 
 def test_the_closed_loop_is_python_controls(system):
     family = system.with_servo(OMEGA)
-    K = load_controller(problems_dir() / "seed_wing" / "truth_interval_controller_order8.json")
+    K = load_controller(WITNESS_DIR / "truth_interval_controller_order8.json")
     for V in (0.5, 1.7):
         cl = control.feedback(family.loop(V).flap_to_sensors(), K, sign=1)
         np.testing.assert_allclose(

@@ -10,13 +10,16 @@ from __future__ import annotations
 
 import json
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from casflutter._resources import problems_dir
 from casflutter.cli import main
 from casflutter.verify import controller_from_json
+
+#: the test witnesses (tests/witnesses/README.md): inputs of the tests, each certified here
+WITNESS_DIR = Path(__file__).resolve().parents[1] / "witnesses"
 
 
 @pytest.mark.parametrize("args, words", [
@@ -108,7 +111,7 @@ def test_a_saved_controller_is_continued_on_the_rom_loop_with_the_servo(tmp_path
     with the flap behind the 40 Hz servo: the continuation's claim (a dense eigenvalue scan)
     is certified by the verification layer's exact interval, computed independently."""
     out = tmp_path / "b.json"
-    start = problems_dir() / "seed_wing" / "truth_best_order3_controller.json"
+    start = WITNESS_DIR / "truth_best_order3_controller.json"
     assert main(["bench", "interval", "--start", str(start), "--orders", "",
                  "--no-full-order", "--servo", "251.3", "--interval", "0.05,1.0",
                  "--out", str(out)]) == 0

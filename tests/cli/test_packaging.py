@@ -82,5 +82,10 @@ def test_the_wheel_holds_license_py_typed_and_the_problems(tmp_path):
     assert "casflutter/py.typed" in names
     assert any(n.endswith(".dist-info/licenses/LICENSE") for n in names)
     assert any(n.startswith("casflutter/_problems/typical_section/") for n in names)
+    # the default loop of `casflutter bench interval` ships; measured records that only an
+    # example reads, and the tests' witness controllers, do not
+    assert "casflutter/_problems/seed_wing_rom/rom_loop_seed0.npz" in names
+    assert not any(n.endswith(".mat") and "/f16gvt/" in n for n in names)
+    assert not any("witnesses" in n or n.endswith("_controller.json") for n in names)
     meta = zipfile.ZipFile(wheel).read(next(n for n in names if n.endswith("METADATA"))).decode()
     assert "License-Expression: BSD-3-Clause" in meta and "Requires-Python: >=3.11" in meta

@@ -1,13 +1,15 @@
-"""The F-16 ground-vibration records shipped in problems/f16gvt (real measured data)."""
+"""The F-16 ground-vibration records of the source tree's problems/f16gvt (real measured data;
+not installed with the package)."""
+
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from casflutter._resources import problems_dir
 from casflutter.data import IOData
 from casflutter.ident import fit_report, identify
 
-FOLDER = problems_dir() / "f16gvt"
+FOLDER = Path(__file__).resolve().parents[2] / "problems" / "f16gvt"
 
 
 def _load(name):

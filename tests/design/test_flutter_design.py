@@ -1,6 +1,6 @@
 """Flutter suppression over a speed interval on the seed wing's ROM loop (eq. 8-16).
 
-Fixture: ``default_rom_loop`` (``problems/seed_wing/rom_loop_seed0.npz``), Σf (nf = 15) and Σs
+Fixture: ``default_rom_loop`` (``problems/seed_wing_rom/rom_loop_seed0.npz``), Σf (nf = 15) and Σs
 of the default ``casflutter run`` (seed 0), saved once so that the test does not re-identify
 the ROM.
 Truth used: the independent verification layer's exact stable interval (guardian map) and

@@ -1,6 +1,6 @@
 """How far one controller holds the seed wing's ROM loop stable (continuation in speed).
 
-Fixture: ``default_rom_loop`` (``problems/seed_wing/rom_loop_seed0.npz``, Σf and Σs of the
+Fixture: ``default_rom_loop`` (``problems/seed_wing_rom/rom_loop_seed0.npz``, Σf and Σs of the
 default run, seed 0).
 Truth used: the independent verification layer's exact stable interval (guardian map on the
 LFT at Vf) and eigenvalues of the closed loop computed here.

@@ -48,7 +48,7 @@ def test_a_random_start_from_the_low_end_crosses_the_flutter_speed(
     verification layer certifies what it claims."""
     assert np.max(np.linalg.eigvals(family.loop(1.4).A).real) > 1.0
     search = search_random_starts(family, (0.05, 1.4), 3, anchor="low", starts=1, seed=0)
-    assert search.anchor == "low" and search.start_indices == (0,)
+    assert search.anchor == "low" and len(search.reaches) == 1     # the start held its band
     best = search.best
     assert best.reached == (0.05, 1.4) and best.anchor == "low"
     cert = speed_family_interval(lambda V: family.loop(V).flap_to_sensors(), best.controller,
@@ -62,15 +62,17 @@ def test_a_random_start_from_the_low_end_crosses_the_flutter_speed(
 def test_order3_starts_from_the_top_of_the_frozen_rom_loop_stall_above_its_dip(family):
     """The frozen ROM loop's flutter mode is gripped most weakly near V = 1.93 (growth
     6.6 rad/s): order-3 continuations from the top stop above it, 2.03-2.06 with these
-    settings, while the paper's order-3 design from below stops at 1.88."""
+    settings, while the paper's order-3 design from below stops at 1.88.  (Which of the
+    random starts hold the top band is the optimiser's business; every one that does
+    stops above the dip.)"""
     search = search_random_starts(family, (0.05, 2.4), 3, starts=4, seed=0)
-    assert search.start_indices == (3,)
-    (reach,) = search.reaches
-    assert not reach.met and 1.93 < reach.reached[0] < 2.1
-    cert = speed_family_interval(lambda V: family.loop(V).flap_to_sensors(),
-                                 reach.controller, 2.3)
-    assert cert.lower <= reach.reached[0] and cert.upper >= 2.4
-    assert cert.lower > 1.9                # the certified interval, too, stops above the dip
+    assert search.reaches and len(search.start_indices) == len(search.reaches)
+    for reach in search.reaches:
+        assert not reach.met and 1.93 < reach.reached[0] < 2.1
+        cert = speed_family_interval(lambda V: family.loop(V).flap_to_sensors(),
+                                     reach.controller, 2.3)
+        assert cert.lower <= reach.reached[0] and cert.upper >= 2.4
+        assert cert.lower > 1.9            # the certified interval, too, stops above the dip
 
 
 def test_the_starts_depend_on_the_seed_and_the_index_only():
@@ -140,3 +142,25 @@ def test_an_unstable_start_is_refused_when_the_controller_must_stay_stable(famil
     with pytest.raises(ConfigError, match=r"itself is unstable \(a pole with real part 0.5"):
         stabilize_interval(family, K, (2.2, 2.4), anchor="high",
                            stable_controller=True)
+
+
+def test_the_best_reach_does_not_hinge_on_rounding():
+    """Ends that differ only in rounding tie, and the earlier start is kept; a real
+    difference still decides."""
+    from types import SimpleNamespace
+
+    from casflutter.design._interval_search import REACH_TIE, RandomStartSearch
+
+    def search(anchor, ends):
+        reaches = tuple(SimpleNamespace(reached=e) for e in ends)
+        return RandomStartSearch(anchor, 3, len(ends), 0, reaches, tuple(range(len(ends))),
+                                 (40.0, 80.0))
+
+    tiny = 0.1 * REACH_TIE
+    s = search("low", [(0.05, 2.0), (0.05, 2.0 * (1 + tiny))])
+    assert s.best is s.reaches[0]
+    s = search("high", [(1.9, 2.4), (1.9 * (1 - tiny), 2.4)])
+    assert s.best is s.reaches[0]
+    s = search("high", [(1.9, 2.4), (1.8, 2.4), (1.8 * (1 - tiny), 2.4)])
+    assert s.best is s.reaches[1]
+    assert search("low", []).best is None

@@ -1,4 +1,4 @@
-"""The identify API's bad inputs (issue 14): casflutter errors naming the argument and the
+"""The identify API's bad inputs: casflutter errors naming the argument and the
 fix, raised before any work; a property-based suite where only casflutter errors come out."""
 
 import warnings

@@ -1,4 +1,4 @@
-"""Order selection by held-out free-run error (issue 13, item 3)."""
+"""Order selection by held-out free-run error."""
 
 import pytest
 
@@ -71,3 +71,27 @@ def test_select_orders_rejects_bad_arguments_before_work():
         select_orders(data, [TRUE], rel_tol=float("nan"))
     with pytest.raises(ConfigError, match="criterion"):
         select_orders(data, [TRUE], criterion="magic")
+
+
+def _candidate(orders, n_params, score):
+    from casflutter.ident import OrderCandidate
+
+    return OrderCandidate(HWLOrders(*orders), n_params, score, None, None, "Solve_Succeeded",
+                          "", 0.0)
+
+
+def test_equal_sized_candidates_within_the_tie_tolerance_go_to_the_earlier():
+    """The choice does not hinge on the last bits of the scores: of two candidates with the
+    same number of parameters whose scores agree to 1e-6 relative, the first of the grid
+    wins, whichever score is the lower; a clear difference still decides."""
+    from casflutter.ident._select import SCORE_TIE_RTOL, _parsimonious
+
+    a, b = (1, 1, 1, 0, 2, 2), (1, 1, 1, 0, 2, 3)
+    for eps in (1e-15, -1e-15, 0.1 * SCORE_TIE_RTOL, -0.1 * SCORE_TIE_RTOL):
+        first, second = _candidate(a, 10, 1.0), _candidate(b, 10, 1.0 * (1 + eps))
+        assert _parsimonious([first, second], 0.02) is first
+    better = _candidate(b, 10, 0.99)
+    assert _parsimonious([_candidate(a, 10, 1.0), better], 0.02) is better
+    # fewer parameters within rel_tol still win over a lower score
+    small = _candidate(a, 8, 1.015)
+    assert _parsimonious([_candidate(b, 10, 1.0), small], 0.02) is small

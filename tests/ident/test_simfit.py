@@ -1,4 +1,4 @@
-"""Simulation-error identification (issue 13): exact sensitivities, truth recovery by free-run
+"""Simulation-error identification: exact sensitivities, truth recovery by free-run
 error, divergent starts, mu >= 2, offsets, honest costs, time guard, unstable models."""
 
 import warnings

@@ -182,3 +182,38 @@ def test_a_folder_whose_parent_is_not_writable_is_refused_before_the_work(tmp_pa
             check_output_folder(parent / "out", overwrite=True)
     finally:
         parent.chmod(0o755)
+
+
+def stat_mode(path) -> int:
+    """Permission bits of ``path``."""
+    return os.stat(path).st_mode & 0o777
+
+
+@pytest.fixture(params=[0o022, 0o077, 0o002])
+def umask(request):
+    """The process umask set for one test (and restored)."""
+    old = os.umask(request.param)
+    try:
+        yield request.param
+    finally:
+        os.umask(old)
+
+
+def test_folder_and_file_modes_follow_the_umask(tmp_path, umask):
+    """The outputs get the modes of any folder or file the user creates (0755/0644 under
+    umask 022), not the private 0700/0600 of a temporary name."""
+    target = tmp_path / "out"
+    with atomic_folder(target) as tmp:
+        assert stat_mode(tmp) == 0o777 & ~umask          # already while being written
+        (tmp / "summary.json").write_text("{}")
+    assert stat_mode(target) == 0o777 & ~umask
+    assert stat_mode(target / "summary.json") == 0o666 & ~umask
+    one = tmp_path / "model.npz"
+    with atomic_file(one) as tmp:
+        assert stat_mode(tmp) == 0o666 & ~umask
+        tmp.write_bytes(b"x")
+    assert stat_mode(one) == 0o666 & ~umask
+    # replacing a file gives the new one the same ordinary mode
+    with atomic_file(one) as tmp:
+        tmp.write_bytes(b"y")
+    assert stat_mode(one) == 0o666 & ~umask and one.read_bytes() == b"y"

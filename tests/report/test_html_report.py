@@ -56,3 +56,36 @@ def test_lco_amplitudes_of_rom_and_truth_are_stated():
     text = html_report(s, {})
     assert "ROM (124.2, 86.3) at V = 1.248, truth (134.7, 94.5) at V = 1.139" in text
     assert "LCO amplitude per sensor" not in html_report(SUMMARY, {})
+
+
+def test_a_rom_flutter_speed_off_the_truths_is_flagged_with_its_side():
+    """The seed wing's paper route: ROM 1.19999 against the truth's 1.08499 is 10.6 % above,
+    unconservative; within the stated 2 % nothing is flagged; below it is conservative."""
+    from casflutter.report import flutter_speed_flags
+    from casflutter.report._html import VF_FLAG_FRACTION
+
+    flags = flutter_speed_flags(SUMMARY)
+    assert len(flags) == 1
+    assert "10.6 % above the truth's, 1.085: unconservative" in flags[0]
+    assert f"{100 * VF_FLAG_FRACTION:g} %" in flags[0]
+    assert '<li class="flag">' in html_report(SUMMARY, {})
+    close = dict(SUMMARY, flutter={"V": 1.08499 * (1 + 0.5 * VF_FLAG_FRACTION)})
+    assert flutter_speed_flags(close) == [] and "<h2>Flags</h2>" not in html_report(close, {})
+    low = dict(SUMMARY, flutter={"V": 1.0}, flutter_parametric={"V": 1.2})
+    texts = flutter_speed_flags(low)
+    assert "below the truth's, 1.085: conservative" in texts[0] and "parametric" in texts[1]
+    assert flutter_speed_flags(dict(SUMMARY, flutter_truth=None)) == []
+
+
+def test_report_gives_airspeeds_the_version_and_the_units_of_the_amplitudes():
+    s = dict(SUMMARY, casflutter_version="0.1.0",
+             flutter={"V": 1.19999, "mode": 2, "airspeed_m_s": 1.19999 * 28.9},
+             lco=dict(SUMMARY["lco"], amplitude=[124.2, 86.3], V=1.248,
+                      truth_amplitude=[134.7, 94.5], truth_V=1.139,
+                      amplitude_units=["m/s^2", "m/s^2"]))
+    text = html_report(s, {})
+    assert "casflutter 0.1.0" in text
+    assert _row(text, "flutter speed index Vf")[:2] == ["1.2 (34.68 m/s)", "1.085 (31.36 m/s)"]
+    assert _row(text, "nominal speed index V0")[0] == "0.69 (19.94 m/s)"
+    assert "LCO amplitude per sensor [m/s^2]" in text
+    assert "at V = 1.248 (36.07 m/s)" in text

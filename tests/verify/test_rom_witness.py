@@ -1,6 +1,6 @@
 """Two order-4 controllers that together hold the default run's ROM loop over V ∈ (0, 2.4).
 
-The default run's ROM loop is the frozen loop of eq. 8 (``problems/seed_wing/rom_loop_seed0.npz``)
+The default run's ROM loop is the frozen loop of eq. 8 (``problems/seed_wing_rom/rom_loop_seed0.npz``)
 with the flap behind the wing's 40 Hz servo.  ``rom_order4_low_controller.json`` and
 ``rom_order4_high_controller.json`` were found by random starts from either end of the interval
 (:func:`casflutter.design.search_random_starts`; see each file's ``about``).  Whether they hold
@@ -14,11 +14,15 @@ themselves.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
-from casflutter._resources import problems_dir
 from casflutter.verify import load_controller, speed_family_interval
+
+#: the test witnesses (tests/witnesses/README.md): inputs of the tests, each certified here
+WITNESS_DIR = Path(__file__).resolve().parents[1] / "witnesses"
 
 SERVO = 251.3     # rad/s, the seed wing's 40 Hz servo
 
@@ -30,7 +34,7 @@ def family(default_rom_loop):
 
 
 def _controller(name):
-    return load_controller(problems_dir() / "seed_wing" / name)
+    return load_controller(WITNESS_DIR / name)
 
 
 def test_two_order4_controllers_cover_the_paper_interval_on_the_rom_loop(family,

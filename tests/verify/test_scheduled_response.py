@@ -1,7 +1,7 @@
 """Time response of the ROM loop along a speed profile, controllers switched with the speed.
 
 Fixture: ``default_rom_loop`` (the default run's frozen ROM loop of eq. 8) with the flap behind
-the 40 Hz servo, and the order-4 pair ``problems/seed_wing/rom_order4_{low,high}_controller.json``
+the 40 Hz servo, and the order-4 pair ``tests/witnesses/rom_order4_{low,high}_controller.json``
 (certified over (0, 1.9033) and (1.8442, 2.4014), ``tests/verify/test_rom_witness.py``).
 Truth used: python-control's ``forced_response`` of the loop closed by ``control.feedback`` at a
 fixed speed; switch times worked out from the piecewise-linear profile by hand; and the frozen
@@ -11,14 +11,18 @@ the speed stops changing.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import control
 import numpy as np
 import pytest
 from scipy.signal import lfilter
 
-from casflutter._resources import problems_dir
 from casflutter.errors import ConfigError
 from casflutter.verify import load_controller, scheduled_response
+
+#: the test witnesses (tests/witnesses/README.md): inputs of the tests, each certified here
+WITNESS_DIR = Path(__file__).resolve().parents[1] / "witnesses"
 
 SERVO = 251.3
 SWITCH = 1.875              # inside the overlap (1.8442, 1.9033) of the two certificates
@@ -31,7 +35,7 @@ def family(default_rom_loop):
 
 @pytest.fixture(scope="module")
 def pair():
-    return [load_controller(problems_dir() / "seed_wing" / f"rom_order4_{end}_controller.json")
+    return [load_controller(WITNESS_DIR / f"rom_order4_{end}_controller.json")
             for end in ("low", "high")]
 
 

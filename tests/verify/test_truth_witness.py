@@ -1,6 +1,6 @@
 """The witnesses that the seed wing itself admits one linear controller over V ∈ (0, 2.4).
 
-``problems/seed_wing/truth_interval_controller.json`` is a full-order controller (32 states,
+``tests/witnesses/truth_interval_controller.json`` is a full-order controller (32 states,
 minimal order 20) found by continuation on the truth's own linearisation with the flap behind
 its 40 Hz servo (:class:`casflutter.aeroelastic.TruthLoop`);
 ``truth_interval_controller_order8.json`` and ``..._order7.json`` are order-8 and order-7
@@ -15,14 +15,18 @@ single one was found.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import control
 import numpy as np
 import pytest
 
-from casflutter._resources import problems_dir
 from casflutter.aeroelastic import TruthLoop
 from casflutter.truth import SeedWing
 from casflutter.verify import load_controller, speed_family_interval
+
+#: the test witnesses (tests/witnesses/README.md): inputs of the tests, each certified here
+WITNESS_DIR = Path(__file__).resolve().parents[1] / "witnesses"
 
 SERVO = 251.3     # rad/s, the seed wing's 40 Hz servo (run.toml: controller.flap_rate_bandwidth)
 WITNESSES = {"truth_interval_controller.json": 32, "truth_interval_controller_order8.json": 8,
@@ -38,7 +42,7 @@ def plant():
 
 @pytest.fixture(scope="module", params=sorted(WITNESSES))
 def witness(request):
-    K = load_controller(problems_dir() / "seed_wing" / request.param)
+    K = load_controller(WITNESS_DIR / request.param)
     assert K.nstates == WITNESSES[request.param]
     return K
 
@@ -61,7 +65,7 @@ def test_a_dense_scan_agrees(plant, witness):
 def test_the_best_order_3_controller_found_holds_the_wing_to_2_26(plant):
     """The figure the documentation quotes for order 3 (the paper's order): certified, and
     short of the paper's 2.4."""
-    K = load_controller(problems_dir() / "seed_wing" / "truth_best_order3_controller.json")
+    K = load_controller(WITNESS_DIR / "truth_best_order3_controller.json")
     assert K.nstates == 3
     cert = speed_family_interval(plant, K, 1.2)
     assert cert.lower == 0.0 and 2.259 < cert.upper < 2.4
@@ -72,7 +76,7 @@ def test_an_order_3_controller_holds_the_upper_part_through_the_grip_dip(plant):
     V = 1.03 to 2.40, across the dip of the flap's grip on the flutter mode (V ≈ 1.46), and
     loses it lower down, where its resonator destabilises the same mode's low-speed branch
     (the lateral mode); a dense scan agrees."""
-    K = load_controller(problems_dir() / "seed_wing" / "truth_order3_upper_controller.json")
+    K = load_controller(WITNESS_DIR / "truth_order3_upper_controller.json")
     assert K.nstates == 3
     cert = speed_family_interval(plant, K, 2.0)
     assert 1.0 < cert.lower < 1.04 and cert.upper >= 2.4

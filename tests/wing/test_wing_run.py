@@ -43,21 +43,37 @@ def test_example_wing_flutter_equals_the_seed_wing_rom_from_its_own_records(monk
 
 
 def test_example_wing_study_runs_every_stage_and_records_the_skipped_ones(tmp_path, capsys):
-    """identify -> realize -> loop -> flutter -> LCO -> LFT -> synthesis -> verify through
-    ``casflutter run``; the truth's LCO and the suppression run are skipped and listed."""
+    """identify -> realize -> loop -> flutter -> LFT -> synthesis -> verify through
+    ``casflutter run``; the truth's flutter search is skipped and listed (once on stdout
+    with ``-q``, where the log does not say it)."""
     out = tmp_path / "out"
     assert main(["run", str(EXAMPLE_RUN), "--out", str(out), "--quiet", "--json"]) == 0
     s = json.loads(capsys.readouterr().out)
-    assert set(s["skipped"]) == {"flutter_truth", "truth_lco", "suppression"}
+    assert set(s["skipped"]) == {"flutter_truth"}
     assert all("truth simulator" in why for why in s["skipped"].values())
-    assert s["suppression"] is None and s["lco"]["truth_kind"] is None
-    assert s["lco"]["kind"] is not None
+    assert s["suppression"] is None and s["lco"] is None
     # the controller's verified exact stable interval holds the configured [0.9, 1.05] Vf
     c = s["controller"]
     Vf = s["flutter"]["V"]
     assert c["stable"] and c["stable_V"][0] <= 0.9 * Vf and c["stable_V"][1] >= 1.05 * Vf
     assert json.loads((out / "summary.json").read_text())["skipped"] == s["skipped"]
     assert (out / "controller.json").is_file() and not (out / "fig8_flap_pulses.png").exists()
+    assert main(["-q", "run", str(EXAMPLE_RUN), "--out", str(out), "--overwrite"]) == 0
+    text = capsys.readouterr()
+    assert text.out.count("skipped") == 1 and "truth Vf" not in text.err + text.out
+
+
+def test_lco_stage_on_a_linear_rom_is_skipped_with_its_reason(caplog):
+    """A linear ROM has no limit cycle: the LCO stage is skipped before any work, with the
+    reason logged once and recorded, instead of a 'divergence' reported as an LCO."""
+    cfg = load_config(EXAMPLE_RUN, updates={"stages": ["lco"]})
+    with caplog.at_level("INFO", logger="casflutter"):
+        r = run(cfg, quiet=True, write=False)
+    assert r.lco is None and "lco" in r.skipped
+    assert "linear" in r.skipped["lco"] and 'rom.method = "hwl"' in r.skipped["lco"]
+    notes = [m for m in caplog.messages if "lco" in m]
+    assert len(notes) == 1 and "linear" in notes[0] and "has no limit cycle" in notes[0]
+    assert "truth_lco" not in r.skipped              # the whole stage, said once
 
 
 def test_goland_gaf_flutter_through_the_cli_within_one_percent_of_published(capsys):

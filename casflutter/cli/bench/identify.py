@@ -221,11 +221,13 @@ def register(subparsers) -> None:
     p.add_argument("--out", help="JSON file to write (default: print)")
     p.add_argument("--case", default="paper", choices=CASES,
                    help="paper: N = 5, 4000 samples; duffing: SISO, 65,000 samples")
-    p.add_argument("--criterion", default="prediction", choices=["prediction", "simulation"])
+    p.add_argument("--criterion", default="prediction", choices=["prediction", "simulation"],
+                   help="stage-2 criterion: prediction error (default) or free-run "
+                        "simulation error")
     p.add_argument("--samples", type=int, default=None,
                    help="record length (default: 4000 paper, 65000 duffing)")
     p.add_argument("--noise", type=float, default=None,
                    help="relative output noise (default: 0.05 paper, 0.01 duffing)")
-    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--seed", type=int, default=1, help="seed of the synthetic case (default 1)")
     p.add_argument("--repeat", type=int, default=3, help="runs of casflutter (median)")
     p.set_defaults(func=_main)

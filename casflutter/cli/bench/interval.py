@@ -295,7 +295,7 @@ def _handler(args: argparse.Namespace) -> int:
             family = TruthLoop(truth, float(cfg.controller.flap_rate_bandwidth
                                             if args.servo is None else args.servo))
         else:
-            rom = (problems_dir() / "seed_wing" / "rom_loop_seed0.npz" if args.rom is None
+            rom = (problems_dir() / "seed_wing_rom" / "rom_loop_seed0.npz" if args.rom is None
                    else Path(args.rom))
             system, Vf = load_rom_loop(rom)
             family = system if args.servo is None else system.with_servo(float(args.servo))
@@ -395,7 +395,7 @@ def register(subparsers) -> None:
                         "loop with the flap behind a servo (default: no servo)")
     p.add_argument("--rom", default=None,
                    help="ROM loop .npz (default: the seed wing's default run, seed 0: "
-                        "problems/seed_wing/rom_loop_seed0.npz)")
+                        "problems/seed_wing_rom/rom_loop_seed0.npz)")
     p.add_argument("--config", default=None,
                    help="run configuration for the controller settings (default: the seed "
                         "wing's run.toml)")

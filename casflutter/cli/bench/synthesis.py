@@ -16,6 +16,12 @@ lower bound known, ``max(γ*, certificate)``.
 With ``--relaxation-starts N`` such records also get the rank relaxation
 (:func:`casflutter.design.order_relaxation` at ω = 0 and ∞, ``N`` seeded starts): its best
 local minimum, a lower bound when it is the global one.
+
+A plant that fails (a file that cannot be read, a plant the synthesis refuses, no start that
+stabilises it, or an internal error) gets a record per order with ``gamma`` null,
+``stable`` false and ``error`` (``class`` and ``message``); the benchmark goes on with the
+next order and plant, and the exit status is 1 when a plant could not be run at all (its
+file, or an internal error), 0 otherwise.
 """
 
 from __future__ import annotations
@@ -77,16 +83,50 @@ def _hinfsyn_gamma(P, nmeas: int, ncon: int, timeout: float) -> float | None:
         return None
 
 
+def _error(exc: BaseException) -> dict[str, str]:
+    """The ``error`` entry of a record: the exception's class and one-line message."""
+    return {"class": type(exc).__name__, "message": " ".join(str(exc).split())}
+
+
+def _failed_plant(path: Path, orders: list[int], exc: BaseException, on_record
+                  ) -> list[dict[str, Any]]:
+    """One record per order for a plant that could not be run at all."""
+    records = []
+    for order in sorted(orders):
+        rec = {"plant": path.stem, "order": order, "nx": None, "gamma": None, "stable": False,
+               "status": f"error: {type(exc).__name__}", "error": _error(exc),
+               "starts": [], "wall_time_s": 0.0}
+        records.append(rec)
+        if on_record is not None:
+            on_record(rec)
+    print(f"{path.stem:>8s} failed: {type(exc).__name__}: {_error(exc)['message'][:120]}",
+          file=sys.stderr, flush=True)
+    return records
+
+
 def run_plant(path: Path, orders: list[int], starts: int, seed: int, time_limit: float | None,
               hinfsyn_timeout: float, relaxation_starts: int = 0,
               on_record=None) -> list[dict[str, Any]]:
     """All records of one plant file (orders solved in increasing order, warm-started);
-    ``on_record(record)`` is called after each order."""
-    from ...design import (SynthesisOptions, load_compleib, order_relaxation,  # noqa: PLC0415
-                           synthesize)
-    from ...errors import SynthesisError  # noqa: PLC0415
+    ``on_record(record)`` is called after each order.  A failure is recorded (module
+    docstring), never raised."""
+    from ...design import load_compleib  # noqa: PLC0415
+    from ...errors import CasflutterError  # noqa: PLC0415
 
-    P, nmeas, ncon, meta = load_compleib(path)
+    try:
+        P, nmeas, ncon, meta = load_compleib(path)
+    except CasflutterError as exc:
+        return _failed_plant(path, orders, exc, on_record)
+    return _run_orders(P, nmeas, ncon, meta, path, orders, starts, seed, time_limit,
+                       hinfsyn_timeout, relaxation_starts, on_record)
+
+
+def _run_orders(P, nmeas: int, ncon: int, meta: dict, path: Path, orders: list[int],
+                starts: int, seed: int, time_limit: float | None, hinfsyn_timeout: float,
+                relaxation_starts: int, on_record) -> list[dict[str, Any]]:
+    from ...design import SynthesisOptions, synthesize  # noqa: PLC0415
+    from ...errors import CasflutterError, SynthesisError  # noqa: PLC0415
+
     gstar = meta.get("gamma_full_order_lmi", meta.get("gamma_lower_bound"))
     full = _hinfsyn_gamma(P, nmeas, ncon, hinfsyn_timeout) if hinfsyn_timeout > 0 else None
     nx = int(np.asarray(P.A).shape[0])
@@ -113,34 +153,54 @@ def run_plant(path: Path, orders: list[int], starts: int, seed: int, time_limit:
                                 "converged": s.converged, "model_decrease": s.model_decrease
                                 if np.isfinite(s.model_decrease) else None,
                                 "last_qp_status": s.statuses[-1] if s.statuses else None,
+                                "status": s.status, "reason": s.reason,
                                 "wall_time_s": s.wall_time} for s in res.starts])
         except SynthesisError as exc:
             rec.update(gamma=None, stable=False, status=f"SynthesisError: {exc}",
-                       spectral_abscissa=exc.best_spectral_abscissa, starts=[])
+                       spectral_abscissa=exc.best_spectral_abscissa, error=_error(exc),
+                       starts=[{"kind": s.kind, "status": s.status, "reason": s.reason}
+                               for s in exc.starts])
+        except CasflutterError as exc:        # a plant the synthesis refuses (named entry)
+            rec.update(gamma=None, stable=False, status=f"{type(exc).__name__}: {exc}",
+                       error=_error(exc), starts=[])
+        except Exception as exc:  # noqa: BLE001 - a bug on one plant must not end the run
+            rec.update(gamma=None, stable=False, status=f"internal error: {type(exc).__name__}",
+                       error=_error(exc), starts=[])
         rec["wall_time_s"] = time.perf_counter() - t0
-        if relaxation_starts > 0 and order < min(nmeas, ncon):
-            rel = order_relaxation(P, nmeas, ncon, order, (0.0,), starts=relaxation_starts,
-                                   seed=seed)
-            rec["static_direction_relaxation"] = {
-                "value": rel.value, "start_values": list(rel.start_values),
-                "sigma_at_zero": rel.sigma_at_frequencies[0],
-                "sigma_at_infinity": rel.sigma_at_infinity}
-        certificates = _certificates(P, nmeas, ncon, order)
-        held = [c for c in certificates if "value" in c]
-        if held:
-            best = max(held, key=lambda c: c["value"])
-            rec["certified_lower_bound"] = best
-            if rec["gamma"] is not None and best["value"] > 0:
-                rec["ratio_to_certified_bound"] = rec["gamma"] / best["value"]
-        rec["static_direction_certificates"] = certificates
-        if rec["gamma"] is not None and gstar:
-            rec["ratio_to_lower_bound"] = rec["gamma"] / gstar
+        try:
+            _bounds(rec, P, nmeas, ncon, order, gstar, seed, relaxation_starts)
+        except Exception as exc:  # noqa: BLE001 - the bounds are extras of the record
+            rec["bounds_error"] = _error(exc)
         records.append(rec)
         print(f"{rec['plant']:>8s} k={order} gamma={rec['gamma']} gamma*={gstar} "
               f"t={rec['wall_time_s']:.1f}s {rec['status'][:40]}", file=sys.stderr, flush=True)
         if on_record is not None:
             on_record(rec)
     return records
+
+
+def _bounds(rec: dict[str, Any], P, nmeas: int, ncon: int, order: int, gstar, seed: int,
+            relaxation_starts: int) -> None:
+    """Add the relaxation, the static-direction certificates and the ratios to ``rec``."""
+    from ...design import order_relaxation  # noqa: PLC0415
+
+    if relaxation_starts > 0 and order < min(nmeas, ncon):
+        rel = order_relaxation(P, nmeas, ncon, order, (0.0,), starts=relaxation_starts,
+                               seed=seed)
+        rec["static_direction_relaxation"] = {
+            "value": rel.value, "start_values": list(rel.start_values),
+            "sigma_at_zero": rel.sigma_at_frequencies[0],
+            "sigma_at_infinity": rel.sigma_at_infinity}
+    certificates = _certificates(P, nmeas, ncon, order)
+    held = [c for c in certificates if "value" in c]
+    if held:
+        best = max(held, key=lambda c: c["value"])
+        rec["certified_lower_bound"] = best
+        if rec["gamma"] is not None and best["value"] > 0:
+            rec["ratio_to_certified_bound"] = rec["gamma"] / best["value"]
+    rec["static_direction_certificates"] = certificates
+    if rec["gamma"] is not None and gstar:
+        rec["ratio_to_lower_bound"] = rec["gamma"] / gstar
 
 
 def _certificates(P, nmeas: int, ncon: int, order: int) -> list[dict[str, Any]]:
@@ -173,8 +233,9 @@ def summarize(records: list[dict[str, Any]]) -> dict[str, Any]:
         return float(np.median(v)) if v else None
 
     times = [r["wall_time_s"] for r in records]
-    nx = np.array([r["nx"] for r in records], dtype=float)
-    t = np.array(times, dtype=float)
+    ran = [r for r in records if r["nx"] is not None]      # not the plants that failed to load
+    nx = np.array([r["nx"] for r in ran], dtype=float)
+    t = np.array([r["wall_time_s"] for r in ran], dtype=float)
     fit = None
     if len(set(nx.tolist())) >= 2 and np.all(t > 0):
         p, logc = np.polyfit(np.log(nx), np.log(t), 1)
@@ -198,6 +259,7 @@ def summarize(records: list[dict[str, Any]]) -> dict[str, Any]:
                 best3[r["plant"]] = r["gamma"] / max(bounds)
     return {"n_records": len(records),
             "all_stable": all(r["stable"] for r in records),
+            "failed": sorted({r["plant"] for r in records if "error" in r}),
             "median_wall_time_s": med(times),
             "median_ratio_order3": med(r3),
             "max_ratio_order3": max((x for x in r3 if x is not None), default=None),
@@ -252,6 +314,12 @@ def _handler(args: argparse.Namespace) -> int:
         for j in jobs:
             run_plant(*j, on_record=keep)
     print(f"wrote {len(records)} records to {out}", file=sys.stderr)
+    broken = sorted({r["plant"] for r in records
+                     if r["nx"] is None or r["status"].startswith("internal error")})
+    if broken:
+        print(f"casflutter bench synthesis: could not run {', '.join(broken)} (see their "
+              "records' error)", file=sys.stderr)
+        return 1
     return 0
 
 

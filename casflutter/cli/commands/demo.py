@@ -44,6 +44,8 @@ def _main(args) -> int:
 def register(subparsers) -> None:
     p = subparsers.add_parser("demo", help="identify the paper-sized synthetic case",
                               description=__doc__)
-    p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--noise", type=float, default=0.02)
+    p.add_argument("--seed", type=int, default=1,
+                   help="seed of the random truth model (its records use seed + 1; default 1)")
+    p.add_argument("--noise", type=float, default=0.02,
+                   help="relative output noise of the records, in [0, 1) (default 0.02)")
     p.set_defaults(func=_main)

@@ -10,6 +10,10 @@ On a GAF wing file (``kind = "gaf"``: modal data and ``Q(ik)``, e.g. ``problems/
 the route is the rational-function approximation instead: the driver with no optional stage
 fits the RFA, finds the flutter of ΣAE(U) in m/s and rad/s and solves p–k on the same table;
 both are printed side by side with the published reference of the file, if any.
+
+On a plant family file (``kind = "plant_family"``: state-space models at a grid of speeds,
+e.g. ``problems/goland_4flaps``) the route is :mod:`._flutter_family`: every open-loop
+crossing of the interpolated grid, in the family's units.
 """
 
 from __future__ import annotations
@@ -33,8 +37,10 @@ def register(subparsers) -> None:
                     "in the problem's unit (speed index for the typical section, m/s for the "
                     "Goland wing).")
     p.add_argument("problem", help="problem name (see `casflutter problems`), rig TOML file, "
-                                   "or GAF wing file (kind = \"gaf\", e.g. "
-                                   "problems/goland_gaf: RFA flutter in m/s with p-k)")
+                                   "GAF wing file (kind = \"gaf\", e.g. "
+                                   "problems/goland_gaf: RFA flutter in m/s with p-k), or "
+                                   "plant family file (kind = \"plant_family\", e.g. "
+                                   "problems/goland_4flaps: every crossing of the grid)")
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="NAME=VALUE",
                    help="change a problem parameter (repeatable)")
     p.add_argument("--vrange", nargs=2, type=float, metavar=("LO", "HI"), default=None,
@@ -134,19 +140,31 @@ def summarize(result, problem: str) -> dict:
     }
 
 
-def _figure(result, path: str, omega_max: float, xlabel: str) -> None:
+def _figure(result, path: str, omega_max: float) -> None:
+    """The V-g / V-f panels of the truth and the ROMs in the units of the printed table: the
+    problem's speed (m/s where it has a speed scale, with the speed index on a second axis;
+    else the speed index) and the table's frequency unit; one legend, the modes numbered
+    from 1 and named."""
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from ...report import plot_vg_vf
+    from ...lco import speed_convention
+    from ...report import frequency_unit, plot_vg_vf
 
+    truth = result.truth
+    ms = truth.modal_structure()
+    scale, unit = speed_convention(truth)
+    index = f"speed index {ms.speed_index.split(',')[0]}"      # the definition, not its terms
+    airspeed = unit == "m/s"
+    funit = frequency_unit(ms.time_unit) or "rad/s"       # the table's unit
     rom = ("ROM at V0 (time scaled with V)" if result.config.rom.convective
            else "ROM at V0 (V² scaling)")
     panels = [("truth", result.flutter_truth), (rom, result.flutter)]
     if result.parametric is not None:
         panels.append(("parametric ROM", result.parametric.flutter))
-    fig, axes = plt.subplots(2, len(panels), sharex=True, figsize=(5.0 * len(panels), 6.5),
+    fig, axes = plt.subplots(2, len(panels), sharex=True, figsize=(5.0 * len(panels), 7.0),
                              squeeze=False)
+    legend = {}
     for k, (title, res) in enumerate(panels):
         tr = res.tracking
         # the lightly damped oscillatory (structural) branches; not the real aerodynamic
@@ -156,12 +174,18 @@ def _figure(result, path: str, omega_max: float, xlabel: str) -> None:
                 if np.max(np.abs(lam[:, b])) < 3.0 * omega_max
                 and np.min(tr.damping_ratio[:, b]) < 0.9
                 and np.mean(lam[:, b].imag) > 0.02 * omega_max]
-        plot_vg_vf(res, branches=keep, ax=(axes[0, k], axes[1, k]))
-        axes[1, k].set_xlabel(xlabel)
+        plot_vg_vf(res, branches=keep, ax=(axes[0, k], axes[1, k]), hz=False,
+                   frequency_unit=funit, mode_names=ms.mode_names,
+                   speed_scale=scale if airspeed else 1.0, speed_unit="m/s" if airspeed else "",
+                   speed_label="airspeed U [m/s]" if airspeed else index,
+                   index_label=index if airspeed else None)
         axes[0, k].set_title(f"{title}\n{axes[0, k].get_title()}", fontsize="medium")
-        if k:
-            axes[0, k].get_legend() and axes[0, k].get_legend().remove()
-    fig.tight_layout()
+        for h, lab in zip(*axes[0, k].get_legend_handles_labels()):
+            legend.setdefault(lab, h)
+        axes[0, k].get_legend().remove()
+    fig.legend(list(legend.values()), list(legend), loc="lower center", ncol=min(len(legend), 4),
+               fontsize="small", frameon=False)
+    fig.tight_layout(rect=(0, 0.03 * (1 + (len(legend) - 1) // 4), 1, 1))
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
@@ -217,20 +241,27 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
     result = run_config(cfg, quiet=True, write=False)
     doc = summarize_gaf(result, label)
     if fig_path is not None:
-        from ...report import plot_vg_vf
+        import numpy as np
+
+        from ...report import plot_vg_vf, speed_axes
 
         Path(fig_path).parent.mkdir(parents=True, exist_ok=True)
         pk, fl = result.pk, result.rfa_flutter
-        low = [b for b in fl.tracking.upper_branches() if fl.origin[b] in pk.modes]
-        fig = plot_vg_vf(fl, branches=low, hz=False)
+        # the oscillatory branches of the modes p-k follows (not the real aerodynamic roots)
+        lam = fl.tracking.eigenvalues
+        low = [b for b in fl.tracking.upper_branches()
+               if fl.origin[b] in pk.modes and np.mean(np.abs(lam[:, b].imag)) > 0]
+        fig = plot_vg_vf(fl, branches=low, hz=False, speed_unit="m/s",
+                         speed_label="airspeed U [m/s]", mode_names=problem.structure.mode_names)
         ag, af = fig.axes
-        ag.set_title(f"Uf = {fl.Vf:.2f} m/s, {fl.omega_f:.2f} rad/s")
+        speed_axes(ag, problem.U_ref, "speed index V = U / U_ref")
         for j in range(len(pk.modes)):
             ag.plot(pk.U, pk.damping_ratio[:, j], "ko", ms=3, mfc="none",
                     label="p–k" if j == 0 else None)
             af.plot(pk.U, pk.omega[:, j], "ko", ms=3, mfc="none")
-        ag.legend(fontsize=7)
-        af.set_xlabel("airspeed U [m/s]")
+        ag.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0),
+                  borderaxespad=0.0)
+        fig.tight_layout()
         fig.savefig(fig_path, dpi=110)
         doc["figure"] = fig_path
     else:
@@ -265,9 +296,10 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
 
 def run(args) -> int:
     """Handler: run the route, print or write JSON, save the figure."""
-    from ...pipeline import flutter_config, run as run_config
+    from ...data import FamilyFile
     from ...errors import ConfigError
     from ...truth import GAFProblem, WingProblem, load_problem, parse_sets, problem_label
+    from ._flutter_family import run_family
 
     fig_path = None                  # figures only where asked, checked before the work
     if args.figure is not None and args.figure.lower() != "none":
@@ -275,6 +307,8 @@ def run(args) -> int:
     changes = parse_sets(args.sets)
     truth = load_problem(args.problem, changes)
     label = problem_label(args.problem)
+    if isinstance(truth, FamilyFile):
+        return run_family(args, truth, label, fig_path)
     if isinstance(truth, GAFProblem):
         return _run_gaf(args, truth, label, fig_path)
     if isinstance(truth, WingProblem):
@@ -282,6 +316,8 @@ def run(args) -> int:
                           "its flutter speed comes from `casflutter run` with a run "
                           "configuration whose [problem] name is the file (e.g. "
                           "problems/example_wing/run.toml, stages = [] for flutter only)")
+    from ...pipeline import flutter_config, run as run_config
+
     label = problem_label(args.problem)
     _, from_unit, vunit = _speed_conv(truth)
     updates = {"problem.set": changes}
@@ -299,8 +335,7 @@ def run(args) -> int:
     doc = summarize(result, label)
     if fig_path is not None:
         Path(fig_path).parent.mkdir(parents=True, exist_ok=True)
-        _figure(result, fig_path, float(truth.modal_structure().omega.max()),
-                "speed index " + truth.modal_structure().speed_index.split(",")[0])
+        _figure(result, fig_path, float(truth.modal_structure().omega.max()))
         doc["figure"] = fig_path
     else:
         doc["figure"] = None

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..._outputs import atomic_file
-from ...errors import ConfigError
+from ...errors import ConfigError, DataWarning
 
 
 def check_writable(path, flag: str) -> None:
@@ -109,7 +109,11 @@ def _main(args) -> int:
         raise ConfigError(f"--validation {args.validation}: give a fraction in (0, 1)")
     settings = dict(criterion=args.criterion, regularization=reg, offset=args.offset,
                     max_time=args.max_time)
-    data = _load(args)
+    with warnings.catch_warnings(record=True) as caught:   # said before the fit, not after
+        warnings.simplefilter("always", DataWarning)
+        data = _load(args)
+    for w in caught:
+        print(f"casflutter: warning: {w.message}", file=sys.stderr)
     selection = None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", IdentificationWarning)
@@ -166,7 +170,10 @@ def register(subparsers) -> None:
                               description=__doc__)
     p.add_argument("data", help="records: .npz (arrays y,u,v,dt), .csv or .mat")
     p.add_argument("--orders", default="3,1,1,1,2,2", help="mu,na,nb,r,p,q (default: paper)")
-    p.add_argument("--criterion", default="prediction", choices=["prediction", "simulation"])
+    p.add_argument("--criterion", default="prediction", choices=["prediction", "simulation"],
+                   help="stage-2 criterion: mu-step-ahead prediction error (default, the "
+                        "paper's, fast) or free-run simulation error (slower, for a model "
+                        "that must run free, e.g. in the loop)")
     p.add_argument("--regularization", default="0", help="finite number >= 0 (default 0)")
     p.add_argument("--offset", action="store_true",
                    help="fit a constant term (identify on centred data, exact back-transform)")
@@ -178,7 +185,12 @@ def register(subparsers) -> None:
                         "--orders)")
     p.add_argument("--validation", type=float, default=0.3,
                    help="held-out fraction of each record for --search (default 0.3)")
-    p.add_argument("--y", help="output columns/variable"), p.add_argument("--u"), p.add_argument("--v")
+    p.add_argument("--y", help="outputs y, the generalised forces: CSV columns COL1,COL2,... "
+                               "or a .mat variable")
+    p.add_argument("--u", help="modal-displacement inputs u, one per mode: CSV columns "
+                               "COL1,COL2,... or a .mat variable")
+    p.add_argument("--v", help="flap input v: a CSV column or a .mat variable (omit for a "
+                               "record without a flap)")
     p.add_argument("--time", default="t", help="CSV time column")
     p.add_argument("--dt", type=float, help="sampling time [s]")
     p.add_argument("--fs", help=".mat variable holding the sampling frequency")

@@ -46,6 +46,19 @@ def register(subparsers) -> None:
     p.set_defaults(func=run)
 
 
+def _nonlinearity_hint(truth, problem: str) -> str:
+    """How to give a problem with a polynomial pitch stiffness (``kappa1`` ... ``kappa4``, the
+    typical section and rig sections) the cubic term that makes an LCO, when it has none."""
+    params = getattr(truth, "params", None)
+    kappas = [getattr(params, f"kappa{k}", None) for k in (1, 2, 3, 4)]
+    if any(k is None for k in kappas) or any(kappas):
+        return ""
+    return (f"; {problem}'s pitch stiffness is linear (kappa1 = ... = kappa4 = 0): give it a "
+            f"cubic restoring moment k(theta) theta = theta + kappa2 theta^3, e.g. casflutter "
+            f"lco {problem} --set kappa2=3 (hardening: a supercritical branch of stable "
+            "LCOs; kappa2 < 0 softening: subcritical)")
+
+
 def _fmt_amp(amps: dict, names) -> str:
     return "  ".join(f"{amps[n]:10.4g}" for n in names)
 
@@ -81,7 +94,12 @@ def run(args) -> int:
                                 sensor_names=ms.sensor_names, problem=f"{label} (ROM loop)",
                                 speed_scale=scale, speed_unit=unit, time_unit=ms.time_unit)
     else:
-        branch = lco_branch(truth, vrange, settings, problem=label)
+        try:
+            branch = lco_branch(truth, vrange, settings, problem=label)
+        except ConfigError as exc:
+            if "degenerate" not in str(exc):
+                raise
+            raise ConfigError(f"{exc}{_nonlinearity_hint(truth, args.problem)}") from None
     doc = branch.to_dict()
     fig_path = args.figure if args.figure and args.figure.lower() != "none" else None
     if fig_path:
@@ -96,8 +114,11 @@ def run(args) -> int:
         print_json(doc)
         return 0 if branch.completed else 3
     h = doc["hopf"]
+    vunit = (doc["units"]["V"] if doc["units"]["V"] == "m/s"
+             else f"(speed index {doc['units']['V']})")
+    funit = "Hz" if branch.time_unit == "s" else f"cycles per time unit {branch.time_unit}"
     print(f"{label}: {doc['kind']} {'Neimark-Sacker' if branch.hopf.discrete else 'Hopf'} point "
-          f"at V = {h['V']:.6g} {doc['units']['V']}, {h['freq_hz']:.5g} {doc['units']['freq_hz']}")
+          f"at V = {h['V']:.6g} {vunit}, {h['freq_hz']:.5g} {funit}")
     print(f"  first Lyapunov coefficient {h['lyapunov_coefficient']:.4g}; the branch leaves "
           f"towards {'higher' if h['branch_direction'] > 0 else 'lower'} speeds "
           f"({h['kind_from_branch']}; {'consistent' if h['consistent'] else 'INCONSISTENT'})")

@@ -23,10 +23,53 @@ def register(subparsers) -> None:
     p.set_defaults(func=run)
 
 
+def _family_info(name: str, record) -> dict:
+    """The listing of a gridded plant family (roles checked by building the family)."""
+    from ...aeroelastic import load_family
+
+    sig = load_family(record).signals
+    v = record.speeds
+    return {"name": name, "truth": None, "kind": "plant_family",
+            "description": record.description or record.describe(),
+            "n_states": record.n_states, "speed_unit": record.speed_unit,
+            "time_unit": record.time_unit, "feedback": record.feedback,
+            "speeds": {"min": float(v[0]), "max": float(v[-1]), "count": int(v.size),
+                       "interpolation": record.interpolation},
+            "inputs": [{"name": n, "unit": u,
+                        "role": "control" if n in sig.controls else "disturbance"}
+                       for n, u in zip(sig.inputs, sig.input_units)],
+            "outputs": [{"name": n, "unit": u,
+                         "role": "measurement" if n in sig.measurements else "other"}
+                        for n, u in zip(sig.outputs, sig.output_units)],
+            "data_file": str(record.data_path), "reference": record.reference}
+
+
+def _print_family(info: dict) -> None:
+    v = info["speeds"]
+    print(f"{info['name']}  (plant family: {info['n_states']} states, {len(info['inputs'])} "
+          f"inputs, {len(info['outputs'])} outputs, {v['count']} speeds)")
+    print(f"  {info['description']}")
+    print(f"  speeds {v['min']:g} .. {v['max']:g} {info['speed_unit']} ({v['interpolation']} "
+          f"between them);  time unit: {info['time_unit']};  feedback: {info['feedback']}")
+    for key in ("inputs", "outputs"):
+        print(f"  {key}: " + ", ".join(f"{r['name']} [{r['unit']}]" + (
+            f" ({r['role']})" if r["role"] in ("disturbance", "other") else "")
+            for r in info[key]))
+    print(f"  data file: {info['data_file']}")
+    for key, vals in info["reference"].items():
+        items = (", ".join(f"{k}={v}" for k, v in vals.items()) if isinstance(vals, dict)
+                 else vals)
+        print(f"  reference {key} (the file's [reference]): {items}")
+    print()
+
+
 def _info(name: str, sets) -> dict:
+    from ...data import FamilyFile
     from ...truth import load_problem, problem_definition, problem_label
 
     model = load_problem(name, sets)
+    if isinstance(model, FamilyFile):
+        return _family_info(problem_label(name), model)
     params = model.params
     if getattr(model, "definition", None) is None:   # built-in: values beside the defaults
         rows = [{"name": n, "value": getattr(params, n), "default": d, "unit": u, "doc": doc}
@@ -58,6 +101,9 @@ def run(args) -> int:
         print(json.dumps(infos, indent=2))
         return 0
     for info in infos:
+        if info.get("kind") == "plant_family":
+            _print_family(info)
+            continue
         print(f"{info['name']}  ({info['truth']})")
         print(f"  {info['description']}")
         print(f"  speed index: {info['speed_index']};  time unit: {info['time_unit']}")

@@ -11,19 +11,46 @@ from __future__ import annotations
 import json
 import sys
 
+from ..._format import sig
 from ..._outputs import check_output_path
 
 
 def _speed(block) -> str:
-    """``V = 1.2 (speed index), U = 34.7 m/s, q = 737 Pa`` of a flutter block."""
+    """``V = 1.2 (speed index), U = 34.68 m/s, q = 736.6 Pa`` of a flutter block."""
     if block is None or block.get("V") is None:
         return "V = None"
-    text = f"V = {block['V']:.6g} (speed index)"
+    text = f"V = {sig(block['V'])} (speed index)"
     if block.get("airspeed_m_s") is not None:
-        text += f", U = {block['airspeed_m_s']:.6g} m/s"
+        text += f", U = {sig(block['airspeed_m_s'])} m/s"
     if block.get("dynamic_pressure_Pa") is not None:
-        text += f", q = {block['dynamic_pressure_Pa']:.6g} Pa"
+        text += f", q = {sig(block['dynamic_pressure_Pa'], 4)} Pa"
     return text
+
+
+def _controller_lines(c: dict, res) -> list[str]:
+    """The controller's verified numbers, γ said for what it is (eq. 16)."""
+    syn = res.synthesis
+    lines = [f"controller order {c['order']}: verified γ = {sig(c['gamma'])} (‖T_w̄z‖∞ of the "
+             "LFT at Vf, eq. 16)"]
+    if syn is not None and res.config.controller.flap_rate_weight > 0:
+        lines.append(f"  the synthesis's γ {sig(syn.gamma)} is of its design plants, which add "
+                     "the flap-rate output (controller.flap_rate_weight = "
+                     f"{sig(res.config.controller.flap_rate_weight)})")
+    lines.append(f"  stable V (speed index): small gain {sig(c['small_gain_V'])}, exact "
+                 f"{sig(c['stable_V'])}")
+    if c.get("rom_servo_omega") is not None:
+        lines.append(f"  the ROM's time scales with V: that interval is its scaled loop's "
+                     f"(servo {sig(c['rom_servo_omega'])} rad/s); the LFT frozen at Vf holds "
+                     f"V in {sig(c['stable_V_frozen_at_Vf'])}")
+    if c.get("truth_servo_omega") is not None:
+        lines.append(f"  on the truth's own linearisation (servo {sig(c['truth_servo_omega'])} "
+                     f"rad/s): exact stable V in {sig(c['truth_stable_V'], none='unbounded')}")
+    air = (c.get("certified") or {}).get("exact_V") or {}
+    if air.get("airspeed_m_s") is not None:
+        lines.append(f"  exact stable airspeed in {sig(air['airspeed_m_s'], 4)} m/s")
+    for w in (c.get("poles") or {}).get("warnings", ()):
+        lines.append(f"  warning: {w}")
+    return lines
 
 
 def _main(args) -> int:
@@ -34,16 +61,15 @@ def _main(args) -> int:
     # imported; the driver then refuses a non-empty folder without --overwrite, before any
     # work, and writes the outputs atomically at the end
     check_output_path(args.out, what="--out", kind="dir")
-    res = run(cfg, out_dir=args.out, seed=args.seed,
-              quiet=args.quiet or bool(getattr(args, "log_quiet", False)),
-              overwrite=args.overwrite)
+    log_quiet = args.quiet or bool(getattr(args, "log_quiet", False))
+    res = run(cfg, out_dir=args.out, seed=args.seed, quiet=log_quiet, overwrite=args.overwrite)
     s = res.summary()
     fl, ft = s["flutter"], s["flutter_truth"]
     if s["orders"] is not None:
         lines = [
             f"problem {s['problem']}: orders {tuple(s['orders'])}, {s['n_params']} parameters, "
             f"nf = {s['nf']}, ns = {s['ns']}, nae = {s['nae']}",
-            "ROM fit error per mode [%]: " + ", ".join(f"{e:.3f}"
+            "ROM fit error per mode [%]: " + ", ".join(sig(e, 4)
                                                        for e in s["fit_error_percent"])]
     else:                            # a GAF wing file: the RFA of Q(ik) in place of the ROM
         r = s["rfa"]
@@ -52,38 +78,26 @@ def _main(args) -> int:
         for key, label in (("flutter", "RFA ΣAE(U)"), ("pk", "p-k")):
             b = r[key]
             if b is not None:
-                lines.append(f"flutter ({label}): U = {b['airspeed_m_s']:.6g} m/s, "
-                             f"{b['omega_rad_s']:.6g} rad/s, mode {b['mode']}")
+                lines.append(f"flutter ({label}): U = {sig(b['airspeed_m_s'])} m/s, "
+                             f"{sig(b['omega_rad_s'])} rad/s, mode {b['mode']}")
     lines.append(f"speeds: V is the {s['units']['V']}")
+    hz = s["units"].get("freq_hz") or "Hz"     # cycles per time unit in nondimensional time
     if fl is not None:
         what = "ROM" if s["orders"] is not None else "ΣAE(V), Σf frozen at Uf"
-        lines.append(f"flutter ({what}):   {_speed(fl)}, {fl['freq_hz']} Hz, mode {fl['mode']}")
+        lines.append(f"flutter ({what}):   {_speed(fl)}, {sig(fl['freq_hz'])} {hz}, "
+                     f"mode {fl['mode']}")
     if ft is not None:
-        lines.append(f"flutter (truth): {_speed(ft)}, {ft['freq_hz']} Hz, mode {ft['mode']}")
+        lines.append(f"flutter (truth): {_speed(ft)}, {sig(ft['freq_hz'])} {hz}, "
+                     f"mode {ft['mode']}")
     if s["lco"] is not None:
-        lines.append(f"LCO: {s['lco']['freq_hz']} Hz ({s['lco']['kind']})")
+        lines.append(f"LCO: {sig(s['lco']['freq_hz'])} {hz} ({s['lco']['kind']})")
     if s["controller"] is not None:
-        c = s["controller"]
-        lines.append(f"controller order {c['order']}: verified gamma = {c['gamma']}, small-gain "
-                     f"V in {c['small_gain_V']}, exact stable V in {c['stable_V']} (speed "
-                     "index)")
-        if c.get("rom_servo_omega") is not None:
-            lines.append(f"  the ROM's time scales with V: that interval is its scaled loop's "
-                         f"(servo {c['rom_servo_omega']} rad/s); the LFT frozen at Vf holds "
-                         f"V in {c['stable_V_frozen_at_Vf']}")
-        if c.get("truth_servo_omega") is not None:
-            lines.append(f"  on the truth's own linearisation (servo {c['truth_servo_omega']} "
-                         f"rad/s): exact stable V in {c['truth_stable_V']}")
-        air = (c.get("certified") or {}).get("exact_V") or {}
-        if air.get("airspeed_m_s") is not None:
-            lines.append(f"  exact stable airspeed in {air['airspeed_m_s']} m/s")
-        for w in (c.get("poles") or {}).get("warnings", ()):
-            lines.append(f"  warning: {w}")
+        lines += _controller_lines(s["controller"], res)
     if s["suppression"] is not None:
-        lines.append(f"suppression: attenuation {s['suppression']['attenuation_percent']} %, LCO "
-                     f"returns on release: {s['suppression']['lco_returns']}")
-    for stage, why in s.get("skipped", {}).items():
-        lines.append(f"skipped {stage}: {why}")
+        lines.append(f"suppression: attenuation {sig(s['suppression']['attenuation_percent'], 4)} "
+                     f"%, LCO returns on release: {s['suppression']['lco_returns']}")
+    if log_quiet:                    # otherwise the log said it once already
+        lines += res.skipped_notes()
     if res.interval_ok is not None or res.closed_loop is not None:
         lines.append(f"checks passed: {res.success}")
     lines.append(f"total {s['timings_s']['total']:.1f} s; outputs in {res.out_dir}/")

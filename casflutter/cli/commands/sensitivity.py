@@ -185,7 +185,7 @@ def _gamma(cfg: dict, args) -> int:
                           "multipliers": gs.multipliers, "kkt_residual": gs.kkt_residual,
                           "method": gs.method, "sensitivities": rows}, indent=2))
         return 0
-    print(f"gamma* = {gs.gamma:.8g} (order {res.order}, {len(gs.peaks)} active peak(s), "
+    print(f"gamma* = {gs.gamma:.6g} (order {res.order}, {len(gs.peaks)} active peak(s), "
           f"stationarity residual {gs.kkt_residual:.1e}; {gs.method})")
     print(f"{'rank':>4}  {'parameter':<12} {'value':>11} {'dgamma/dp':>13} {'normalised':>11}")
     for i, r in enumerate(rows, 1):
@@ -230,6 +230,6 @@ def run(args) -> int:
         print("\nfinite-difference check (central differences of the refined Vf):")
         print(f"  {'parameter':<12} {'derivative':>14} {'finite diff.':>14} {'|diff|':>10}")
         for row in data["sensitivities"]:
-            print(f"  {row['name']:<12} {row['dVf_dp']:>+14.7g} {row['dVf_dp_fd']:>+14.7g} "
+            print(f"  {row['name']:<12} {row['dVf_dp']:>+14.6g} {row['dVf_dp_fd']:>+14.6g} "
                   f"{row['fd_difference']:>10.2e}")
     return 0

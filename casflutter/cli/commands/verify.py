@@ -16,8 +16,10 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 from ...errors import ConfigError
+from .. import _verify_family
 
 __all__ = ["register", "run", "verdict"]
 
@@ -48,6 +50,7 @@ def register(subparsers) -> None:
                    help="speed-index range over which the loop must stay stable (exact "
                         "interval, eq. 10-15); not covered -> exit code 1")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
+    _verify_family.add_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -107,11 +110,55 @@ def _strict(obj):
     return obj
 
 
+def _peek(path: str) -> dict:
+    """The JSON object of a file, or ``{}`` when it is not one (the loaders then say why)."""
+    try:
+        doc = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}
+    return doc if isinstance(doc, dict) else {}
+
+
+#: keys only a plant file has (the partition, the ΔV channel, COMPleib's blocks)
+_PLANT_KEYS = {"nmeas", "ncon", "n_delta", "Vf", "B1", "C1", "D11"}
+
+
+def _check_order(plant: str, controller: str, pdoc: dict, kdoc: dict) -> None:
+    """Refuse a controller file given as PLANT (the two files swapped, or twice the same
+    kind), before any work."""
+    p_is_k = pdoc.get("format") == "casflutter-controller/1" or (
+        pdoc and not _PLANT_KEYS & set(pdoc) and _PLANT_KEYS & set(kdoc))
+    k_is_p = kdoc.get("format") == "casflutter-plant/1" or bool(_PLANT_KEYS & set(kdoc))
+    if p_is_k and k_is_p:
+        raise ConfigError(f"the two files look swapped: {plant} is a controller file and "
+                          f"{controller} a plant file; give the plant first: casflutter "
+                          f"verify {controller} {plant}")
+    if p_is_k:
+        what = pdoc.get("format") or "no partition nmeas/ncon"
+        raise ConfigError(f"PLANT {plant} is a controller file ({what}); give the plant file "
+                          "first (casflutter run writes plant.json beside controller.json)")
+
+
+def _speed_scale(pdoc: dict) -> float | None:
+    """Airspeed [m/s] per speed index from a plant file written by ``casflutter run``
+    (its ``Vf_speeds``), else ``None``."""
+    v = pdoc.get("Vf_speeds")
+    if isinstance(v, dict):
+        V, U = v.get("speed_index"), v.get("airspeed_m_s")
+        if isinstance(V, (int, float)) and isinstance(U, (int, float)) and V > 0:
+            return float(U) / float(V)
+    return None
+
+
 def run(args) -> int:
     """Handler of ``casflutter verify``: 0 when the verdict passes, 1 when the loop is not
     stable or not robust over ``--require-v``."""
+    if _verify_family.is_family(args.plant):
+        return _verify_family.run(args)
     from ...verify import load_controller, load_plant, verify_controller
 
+    pdoc = _peek(args.plant)
+    _check_order(args.plant, args.controller, pdoc, _peek(args.controller))
     plant = load_plant(args.plant)
     K = load_controller(args.controller)
     nmeas = args.nmeas if args.nmeas is not None else plant.nmeas
@@ -142,6 +189,6 @@ def run(args) -> int:
         doc = _strict({**report.to_dict(), "verdict": v})
         print(json.dumps(doc, indent=1, allow_nan=False))
     else:
-        print(report.format())
+        print(report.format(speed_scale=_speed_scale(pdoc)))
         print(f"  verdict: {'PASSED' if v['passed'] else 'FAILED'}, {v['reason']}")
     return 0 if v["passed"] else 1

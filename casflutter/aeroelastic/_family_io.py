@@ -1,0 +1,175 @@
+"""Plant families to and from gridded family files.
+
+:func:`load_family` reads a problem file ``kind = "plant_family"`` (the layout is that of
+:mod:`casflutter.data`'s :class:`~casflutter.data.FamilyFile`) into a
+:class:`~casflutter.aeroelastic.GriddedFamily`; :func:`write_family` samples any
+:class:`~casflutter.aeroelastic.PlantFamily` at a grid of speeds and writes the problem file
+and its data file (``.npz`` or MATLAB ``.mat``), so that a model built here (a truth's
+linearisation, a ROM loop, a strip-theory wing) can be handed to another tool, or come back
+as a grid.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .._resources import problems_dir
+from ..data import FamilyFile, read_family_file
+from ..errors import ConfigError, DataError
+from ._family import FamilySignals, GriddedFamily, PlantFamily
+
+__all__ = ["load_family", "write_family", "family_record"]
+
+
+def load_family(source) -> GriddedFamily:
+    """The gridded plant family of a family file.
+
+    Parameters
+    ----------
+    source : str, Path or casflutter.data.FamilyFile
+        The problem file (TOML, ``kind = "plant_family"``), a folder holding it as
+        ``problem.toml``, the name of such a folder of the package's ``problems/`` (e.g.
+        ``"goland_4flaps"``), or a record already read.
+
+    Returns
+    -------
+    GriddedFamily
+        Signals named, roles and units as the file says; interpolated linearly between
+        the grid speeds.
+
+    Raises
+    ------
+    ConfigError
+        A missing file or key, an unknown key, an unknown role name (with the closest
+        signal name).
+    DataError
+        A data file that is missing or does not fit (the message names the file).
+
+    Examples
+    --------
+    >>> from casflutter.aeroelastic import load_family
+    >>> fam = load_family("goland_4flaps")
+    >>> fam.n_states, len(fam.signals.controls), len(fam.signals.measurements)
+    (50, 4, 8)
+    """
+    if isinstance(source, FamilyFile):
+        rec = source
+    else:
+        path = Path(source)
+        if not path.exists() and path.suffix != ".toml" and len(path.parts) == 1 and \
+                (problems_dir() / path).is_dir():
+            path = problems_dir() / path
+        if path.is_dir():
+            path = path / "problem.toml"
+        rec = read_family_file(path)
+    where = rec.path if rec.path is not None else rec.name
+    try:
+        signals = FamilySignals(rec.input_names, rec.output_names, controls=rec.controls,
+                                measurements=rec.measurements, input_units=rec.input_units,
+                                output_units=rec.output_units)
+    except ConfigError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
+    return GriddedFamily(rec.speeds, rec.A, rec.B, rec.C, rec.D, signals,
+                         speed_unit=rec.speed_unit, time_unit=rec.time_unit,
+                         feedback=rec.feedback, name=rec.name)
+
+
+def family_record(family: PlantFamily, speeds, *, name: str | None = None,
+                  description: str = "", source: str = "",
+                  reference: dict | None = None) -> FamilyFile:
+    """A family sampled at a grid of speeds, as a file record.
+
+    Parameters
+    ----------
+    family : PlantFamily
+        Any family (its plants must have the same number of states at every speed).
+    speeds : array_like
+        Grid speeds inside the family's range, strictly increasing (at least two).
+    name, description, source : str, optional
+        Written to the file's ``[problem]`` table (default name: the family's).
+    reference : dict, optional
+        Written to the file's ``[reference]`` table.
+
+    Returns
+    -------
+    casflutter.data.FamilyFile
+
+    Raises
+    ------
+    ConfigError
+        A speed outside the family's range, speeds not increasing.
+    DataError
+        Plants whose sizes change along the grid.
+    """
+    if not isinstance(family, PlantFamily):
+        raise ConfigError(f"family must be a casflutter.aeroelastic.PlantFamily, got "
+                          f"{type(family).__name__}")
+    v = np.asarray(speeds, dtype=float).ravel()
+    v = np.array([family.check_speed(x, "speeds") for x in v])
+    sig = family.signals
+    mats: list[list[np.ndarray]] = [[], [], [], []]
+    for x in v:
+        P = family.plant(float(x))
+        for store, M in zip(mats, (P.A, P.B, P.C, P.D)):
+            store.append(np.atleast_2d(np.asarray(M, dtype=float)))
+    shapes = {tuple(M.shape for M in (a, b, c, d)) for a, b, c, d in zip(*mats)}
+    if len(shapes) != 1:
+        raise DataError(f"{family.name}: the plant's sizes change along the speeds "
+                        f"({sorted(shapes)}); a gridded family needs the same states at every "
+                        "speed")
+    return FamilyFile(v, *(np.stack(M) for M in mats), speed_unit=family.speed_unit,
+                      feedback=family.feedback, time_unit=family.time_unit,
+                      name=family.name if name is None else name, description=description,
+                      source=source, input_names=sig.inputs, output_names=sig.outputs,
+                      controls=sig.controls, measurements=sig.measurements,
+                      input_units=sig.input_units, output_units=sig.output_units,
+                      reference=reference or {})
+
+
+def write_family(family: PlantFamily, path, speeds, format: str = "npz", *,
+                 data_file: str | None = None, name: str | None = None,
+                 description: str = "", source: str = "", reference: dict | None = None,
+                 overwrite: bool = True) -> Path:
+    """Sample a plant family at a grid of speeds and write a family file.
+
+    Writes the problem file ``path`` (TOML, ``kind = "plant_family"``) and its data file
+    beside it, each atomically (a failure leaves no half-written file); the result loads
+    with :func:`load_family` and gives the family's plants at the grid speeds exactly.
+
+    Parameters
+    ----------
+    family : PlantFamily
+        Any family: a :class:`GriddedFamily`, a loop family, a strip-theory wing.
+    path : str or Path
+        The problem file (``.toml``).
+    speeds : array_like
+        Grid speeds inside the family's range.
+    format : {"npz", "mat"}
+        The data file's format (``.mat``: MATLAB v5, matrices as pages ``n x n x k``).
+    data_file : str, optional
+        The data file's name (default the problem file's stem with the format's suffix).
+    name, description, source, reference :
+        See :func:`family_record`.
+    overwrite : bool
+        Replace existing files.
+
+    Returns
+    -------
+    pathlib.Path
+        The problem file.
+
+    Raises
+    ------
+    ConfigError, DataError, OutputError
+        Bad speeds or format, plants of changing size, a path that cannot be written (all
+        checked before the files are written).
+
+    See Also
+    --------
+    load_family : the file back as a :class:`GriddedFamily`.
+    """
+    rec = family_record(family, speeds, name=name, description=description, source=source,
+                        reference=reference)
+    return rec.write(path, format=format, data_file=data_file, overwrite=overwrite)
