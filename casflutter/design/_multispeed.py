@@ -49,6 +49,7 @@ import control
 import numpy as np
 from scipy.optimize import minimize
 
+from .._format import result_repr
 from .._settings import finite_numbers
 from .._threads import single_threaded
 from ..errors import ConfigError, DimensionError, SynthesisError
@@ -66,6 +67,8 @@ _TAUS = (6.0, 2.0, 0.6, None)
 @dataclass(frozen=True)
 class MultiSpeedSettings:
     """Settings of :func:`design_over_speeds` (checked on construction)."""
+
+    __repr__ = result_repr
 
     decay: float = 0.05
     """Decay rate [rad per time unit] the closed loop needs at every speed of the interval."""
@@ -152,6 +155,8 @@ class HoldRecord:
         Seconds.
     """
 
+    __repr__ = result_repr
+
     kind: str
     order: int
     reached: tuple
@@ -194,6 +199,8 @@ class MultiSpeedDesign:
     wall_time : float
         Seconds.
     """
+
+    __repr__ = result_repr
 
     controller: control.StateSpace
     order: int

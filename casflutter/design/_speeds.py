@@ -31,6 +31,7 @@ from typing import Sequence
 import numpy as np
 import scipy.linalg as sla
 
+from .._format import result_repr
 from ..errors import ConfigError, DimensionError
 from ._plant import Partition
 from ._problem import _balance, _io_scales, _time_scale
@@ -49,6 +50,8 @@ class DesignChannels:
     rate_bandwidth : float
         ``a`` [rad per time unit] of their filter (> 0).
     """
+
+    __repr__ = result_repr
 
     rate_weight: float = 0.0
     rate_bandwidth: float = 1.0
@@ -106,6 +109,8 @@ def design_partition(family, V: float, channels: DesignChannels = DesignChannels
 class Scaling:
     """Input, output and time scales of a design (:mod:`._problem`'s): ``u = su u~``,
     ``y~ = y / sy``, ``t~ = w0 t``."""
+
+    __repr__ = result_repr
 
     su: np.ndarray
     sy: np.ndarray
