@@ -30,7 +30,7 @@ import numpy as np
 import pytest
 
 import casflutter
-import casflutter.pipeline._run as pipeline_run
+import casflutter.pipeline._model as pipeline_model
 from casflutter.cli.bench.synthesis import run_plant
 from casflutter.data import IOData, Record
 
@@ -80,7 +80,7 @@ def _conclusions(res) -> dict:
             "design gamma (the synthesis' objective)": (
                 "rel 1e-2", getattr(res.synthesis, "gamma", None)),
             "certified ROM stable interval": ("ends 1e-3", _ends(res.rom_stable_V)),
-            "certified truth stable interval": ("ends 1e-3", _ends(res.truth_interval)),
+            "certified truth stable interval": ("ends 1e-3", _ends(res.truth_stable_V)),
             "required interval held": ("same", res.interval_ok)})
     if res.suppression is not None:
         out["LCO returns after the controller is released"] = (
@@ -112,8 +112,8 @@ def test_default_study_certifies_the_same_with_records_perturbed(monkeypatch):
     config = casflutter.load_config()
     reference = casflutter.run(config, write=False, quiet=True)
     rng = np.random.default_rng(20240)
-    real = pipeline_run.truth_records
-    monkeypatch.setattr(pipeline_run, "truth_records",
+    real = pipeline_model.truth_records
+    monkeypatch.setattr(pipeline_model, "truth_records",
                         lambda *a, **k: _perturbed_records(real(*a, **k), rng))
     perturbed = casflutter.run(config, write=False, quiet=True)
     ref, new = _conclusions(reference), _conclusions(perturbed)

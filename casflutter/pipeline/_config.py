@@ -57,7 +57,7 @@ STAGES = ("frozen", "parametric", "lco", "controller", "closed_loop", "suppressi
 
 #: Keys that were renamed: old dotted name -> new one.
 _RENAMED = {"data.band_hz": "data.band", "flutter.vrange": "flutter.V_range",
-            }
+            "controller.speed_factors": "controller.speeds"}
 
 
 def _positive(name: str, value) -> None:
@@ -261,6 +261,10 @@ class ControllerSettings(SynthesisOptions):
     reduction_orders: tuple = (20, 14, 10, 8, 6)
     """Intermediate orders of that order continuation (those between ``order`` and the full
     order are used, highest first)."""
+    speeds: tuple = (1.0,)
+    """The paper's design (``method = "paper"``): the speeds of its design plants as
+    multiples of Vf, containing 1.0 (the plant the verification checks); the LFT (eq. 14) is
+    built at each and the worst-case norm minimised.  ``[1.0]`` is the paper's design."""
     servo_omega: float = 251.3
     """Natural frequency [rad per time unit] of the flap servo in front of a ROM loop and of
     the truth's linearisation in the design and the verification (the seed wing's 40 Hz);
@@ -282,9 +286,6 @@ class ControllerSettings(SynthesisOptions):
     """H∞ iterations per start (:class:`casflutter.design.SynthesisOptions`)."""
     max_stab_rounds: int = 300
     """Stabilisation rounds per start (:class:`casflutter.design.SynthesisOptions`)."""
-    full_order_start: bool = False
-    """The H∞ phase starts from the design that holds the interval, not from a full-order
-    controller (:class:`casflutter.design.SynthesisOptions`)."""
     flap_rate_weight: float = 0.003
     """Weight ``w`` of the flap rate in the H∞ plants (per rad/s of flap rate); 0: none.  The
     seed wing's servo saturates at 300°/s; without the weight a controller asks far more to
@@ -305,6 +306,12 @@ class ControllerSettings(SynthesisOptions):
                               "> 0 when flap_rate_weight > 0")
         _integer("starts", self.starts, 1)
         _integer("random_starts", self.random_starts, 0)
+        sp = finite_numbers("speeds", self.speeds, what="a non-empty list of positive "
+                            "multiples of Vf, containing 1.0")
+        if not sp or not all(x > 0 for x in sp) or 1.0 not in sp:
+            raise ConfigError(f"speeds = {list(sp)!r}: a non-empty list of positive multiples "
+                              "of Vf, containing 1.0 (the nominal plant)")
+        object.__setattr__(self, "speeds", sp)
         _integer("hinf_speeds", self.hinf_speeds, 0)
         iv = finite_numbers("interval", self.interval, what="[lo, hi] speeds")
         if len(iv) != 2 or not 0 <= iv[0] < iv[1]:

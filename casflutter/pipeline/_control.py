@@ -27,6 +27,7 @@ from dataclasses import dataclass, field, replace
 from typing import Mapping
 
 import control
+import numpy as np
 
 from .._format import result_repr
 from .._settings import settings_as
@@ -34,7 +35,8 @@ from ..aeroelastic import AeroelasticLFT, build_lft
 from ..design import (MultiSpeedDesign, MultiSpeedSettings, SynthesisOptions,
                       SynthesisResult, design_over_speeds, synthesize, with_flap_rate)
 from ..errors import CasflutterError
-from ..verify import FamilyVerification, VerificationReport, verify_controller, verify_family
+from ..verify import (FamilyVerification, SpeedSweep, VerificationReport, speed_sweep,
+                      verify_controller, verify_family)
 from ._config import RunConfig
 
 __all__ = ["ControllerStage", "controller_stage"]
@@ -68,6 +70,9 @@ class ControllerStage:
         and, with a truth, ``"truth"`` (its own linearisation, flap behind the servo).
     design_time_s : float
         Seconds spent designing (the verification not included).
+    sweep : SpeedSweep or None
+        The dense eigenvalue sweep of the LFT's loop over ``verify.sweep`` x Vf
+        (:func:`casflutter.verify.speed_sweep`), when asked.
     """
 
     __repr__ = result_repr
@@ -81,6 +86,7 @@ class ControllerStage:
     verification: VerificationReport | None = None
     checks: Mapping[str, FamilyVerification] = field(default_factory=dict)
     design_time_s: float = float("nan")
+    sweep: SpeedSweep | None = None
 
     @property
     def order(self) -> int:
@@ -89,14 +95,19 @@ class ControllerStage:
 
 
 def _paper_plant(system, Vf: float, cfg: RunConfig):
-    """The LFT at Vf (eq. 14) and the H∞ plant of the paper's design (with the flap-rate
-    output when ``controller.flap_rate_weight > 0``)."""
-    lft = build_lft(system, Vf)
-    P = lft.P
+    """The LFT at Vf (eq. 14) and the H∞ plants of the paper's design, the LFTs at
+    ``controller.speeds`` x Vf (with the flap-rate output when ``controller.flap_rate_weight
+    > 0``)."""
     c = cfg.controller
-    if c.flap_rate_weight > 0:
-        P = with_flap_rate(P, lft.nmeas, c.flap_rate_weight, c.flap_rate_bandwidth)
-    return lft, P
+    lft = build_lft(system, Vf)
+
+    def plant(factor: float):
+        P = lft.P if factor == 1.0 else build_lft(system, factor * Vf).P
+        if c.flap_rate_weight > 0:
+            P = with_flap_rate(P, lft.nmeas, c.flap_rate_weight, c.flap_rate_bandwidth)
+        return P
+
+    return lft, [plant(float(f)) for f in c.speeds]
 
 
 def _multispeed(cfg: RunConfig, family) -> MultiSpeedDesign:
@@ -188,9 +199,13 @@ def controller_stage(cfg: RunConfig, family, *, system=None, Vf: float | None = 
     for name, ref in dict(references).items():
         checks[name] = verify_family(ref, K, speed_range=verification_range(ref, cfg),
                                      margins=c.margins)
-    ver = None
+    ver = sweep = None
     if lft is not None:
         ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
+        if cfg.verify.sweep:
+            lo, hi = cfg.verify.sweep
+            sweep = speed_sweep(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta,
+                                V=np.linspace(lo * Vf, hi * Vf, cfg.verify.n_sweep))
     return ControllerStage(controller=K, method=c.method, family=family, design=design,
                            synthesis=syn, lft=lft, verification=ver, checks=checks,
-                           design_time_s=t_design)
+                           design_time_s=t_design, sweep=sweep)

@@ -336,11 +336,10 @@ def _controller(cfg: RunConfig, model: ModelStage, flutters: FlutterStage, truth
     system = model.system if model.system is not None and flutters.Vf is not None else None
     stage = controller_stage(cfg, controlled_family(cfg, model), system=system,
                              Vf=flutters.Vf, references=references)
-    for name, check in stage.checks.items():
-        iv = check.stable_interval
-        log.info("controller on the %s: certified stable over %s", name,
-                 "nothing (unstable at the range's start)" if iv is None
-                 else f"[{iv[0]:.5g}, {iv[1]:.5g}]")
+    log.info("controller certified stable over: %s", "; ".join(
+        f"{name} " + ("nothing (unstable at the range's start)" if check.stable_interval is None
+                      else "[{:.5g}, {:.5g}]".format(*check.stable_interval))
+        for name, check in stage.checks.items()))
     return stage
 
 

@@ -35,6 +35,7 @@ def test_defaults_are_the_paper_choices():
     ("stages = ['lco', 'dance']\n", r"stages: unknown stage 'dance'"),
     ("stages = ['suppression']\n", r"'suppression' needs the 'controller' stage"),
     ("[controller]\nmethod = 'hifoo'\n", r"controller.method = 'hifoo': allowed 'auto'"),
+    ("[controller]\nspeeds = [0.5, 1.2]\n", r"controller.speeds .*containing 1.0"),
     ("[controller]\nmax_stab_rounds = 0\n",
      r"\[controller\] invalid SynthesisOptions.*max_stab_rounds"),
     ("[controller]\ninterval = [2.0, 1.0]\n", r"controller.interval"),
