@@ -43,7 +43,7 @@ from ..structure import ModalStructure
 from ._flutter import FlutterResult, find_flutter
 from ._loop import AeroelasticSystem
 from ._residues import ControlReversal, control_reversal
-from ._simulate import check_hold
+from ._simulate import check_hold, loop_sample_time
 
 __all__ = ["SpeedFollowingROM", "speed_following_rom"]
 
@@ -94,7 +94,7 @@ class SpeedFollowingROM:
         -------
         float
         """
-        return float(self.model.dt) * self.V0 / float(V)
+        return float(loop_sample_time(float(self.model.dt), float(V), self.V0))
 
     def control_reversal(self, speeds, servo_omega: float,
                          servo_zeta: float = 0.7) -> ControlReversal | None:

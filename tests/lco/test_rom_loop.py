@@ -34,6 +34,21 @@ def branch(loop):
                           problem="seed_wing (ROM loop)", speed_scale=28.9, speed_unit="m/s")
 
 
+def _map_state(sim, k, L, Ly):
+    """The map's state at sample k of a simulate_loop record: ``[x_s, u_{k-1..k-L},
+    y_{k-1..k-Ly}]`` (inputs held at u_0 and outputs zero before the release)."""
+    uh = [sim.u[k - d] if k - d >= 0 else sim.u[0] for d in range(1, L + 1)]
+    yh = [sim.y[k - d] if k - d >= 0 else np.zeros(sim.y.shape[1]) for d in range(1, Ly + 1)]
+    return np.concatenate([sim.xs[k], *uh, *yh])
+
+
+def _assert_map_steps_the_record(F, sim, V, L, Ly):
+    for k in (Ly + 1, 50, 200, 398):
+        nxt = np.asarray(F(_map_state(sim, k, L, Ly), V)).ravel()
+        ref = _map_state(sim, k + 1, L, Ly)
+        assert np.max(np.abs(nxt - ref)) <= 1e-12 * np.max(np.abs(ref))
+
+
 def test_map_is_one_step_of_simulate_loop(loop):
     """The CasADi map reproduces simulate_loop's recursion along a simulated record."""
     rom, st, _ = loop
@@ -43,16 +58,7 @@ def test_map_is_one_step_of_simulate_loop(loop):
     xs0 = np.zeros(2 * N)
     xs0[2] = 0.05
     sim = simulate_loop(rom, st, V, 400, xs0=xs0)
-
-    def state(k):
-        uh = [sim.u[max(k - d, 0)] if k - d >= 0 else sim.u[0] for d in range(1, L + 1)]
-        yh = [sim.y[k - d] if k - d >= 0 else np.zeros(N) for d in range(1, L + 1)]
-        return np.concatenate([sim.xs[k], *uh, *yh])
-
-    for k in (L + 1, 50, 200, 398):
-        nxt = np.asarray(F(state(k), V)).ravel()
-        ref = state(k + 1)
-        assert np.max(np.abs(nxt - ref)) <= 1e-12 * np.max(np.abs(ref))
+    _assert_map_steps_the_record(F, sim, V, L, L)
 
 
 def test_neimark_sacker_point_against_simulated_growth(loop, branch):
@@ -127,16 +133,7 @@ def test_the_speed_following_map_is_one_step_of_simulate_loop(loop):
     xs0[2] = 0.05
     sim = simulate_loop(rom, st, V, 400, xs0=xs0, convective_V0=0.69, hold="foh")
     assert sim.dt == pytest.approx(rom.dt * 0.69 / V)
-
-    def state(k):
-        uh = [sim.u[k - d] if k - d >= 0 else sim.u[0] for d in range(1, L + 1)]
-        yh = [sim.y[k - d] if k - d >= 0 else np.zeros(N) for d in range(1, Ly + 1)]
-        return np.concatenate([sim.xs[k], *uh, *yh])
-
-    for k in (Ly + 1, 50, 200, 398):
-        nxt = np.asarray(F(state(k), V)).ravel()
-        ref = state(k + 1)
-        assert np.max(np.abs(nxt - ref)) <= 1e-12 * np.max(np.abs(ref))
+    _assert_map_steps_the_record(F, sim, V, L, Ly)
 
 
 def test_the_speed_following_loop_flutters_where_its_continuous_loop_does(loop):
