@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from .._format import result_repr
-from ..errors import DataError, DimensionError
+from ..errors import DataError, DimensionError, OrderError
 from ._kernels import free_run
 from ._orders import HWLOrders
 from ._structure import HWLStructure, _ar_part, _input_part, ar_weight_array
