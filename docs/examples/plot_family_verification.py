@@ -1,6 +1,6 @@
 """
 A controller on a grid of state-space models: certified interval, absolute and robust flutter speeds
-===================================================================================================
+====================================================================================================
 
 An aeroelastic model usually reaches an engineer as linear state-space models at a grid of
 flight speeds.  This example loads such a grid from a family file, the package's
