@@ -243,6 +243,8 @@ class ControlReversal:
         The scan over the whole speed range (the mode, its residues and its phase turn).
     """
 
+    __repr__ = result_repr
+
     V: float
     eigenvalue: complex
     grip: float

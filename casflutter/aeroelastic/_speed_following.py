@@ -36,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._format import result_repr
 from ..errors import ConfigError
 from ..ident import HWLModel
 from ..realize import realize
@@ -69,6 +70,8 @@ class SpeedFollowingROM:
     hold : str
         The force's hold of the nonlinear loop (``"foh"``: predictive first-order).
     """
+
+    __repr__ = result_repr
 
     model: HWLModel
     V0: float

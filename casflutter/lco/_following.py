@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._format import result_repr
 from ..aeroelastic import LoopSimulation, SpeedFollowingROM, simulate_loop
 from ..errors import ConfigError
 from ..structure import ModalStructure
@@ -80,6 +81,8 @@ class LcoComparison:
     truth : TruthLco
         The wing's.
     """
+
+    __repr__ = result_repr
 
     speed_factor: float
     V: float

@@ -415,7 +415,8 @@ def label_summary(summary: dict, result) -> dict:
         return _provenance_flags(summary, result, check)
     scale = speed_scale(_problem(result))
     summary["units"] = units_block(scale)
-    for key in ("flutter", "flutter_truth", "flutter_frozen", "flutter_parametric"):
+    for key in ("flutter", "flutter_truth", "flutter_frozen", "flutter_parametric",
+                "flutter_convective"):
         block = summary.get(key)
         if isinstance(block, dict) and block.get("V") is not None:
             sv = speed_values(block["V"], scale)

@@ -21,18 +21,20 @@ on) and a :class:`FlutterStage` (every flutter search of the route).
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from typing import Mapping
 
 import numpy as np
 
 from .._format import result_repr
 from .._settings import settings_as
 from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, PKResult,
-                           RFASystem, TruthLoop, family_flutter, find_flutter, load_family,
-                           pk_flutter)
+                           RFASystem, SpeedFollowingROM, TruthLoop, control_reversal,
+                           family_flutter, find_flutter, load_family, pk_flutter,
+                           speed_following_rom)
 from ..data import IOData
 from ..errors import CasflutterError, ConfigError
-from ..ident import (CommonDenominatorResult, FitReport, IdentificationResult,
+from ..ident import (CommonDenominatorResult, FitReport, HWLModel, IdentificationResult,
                      IdentificationSettings, fit_report, identify, identify_common_denominator)
 from ..realize import (ParametricROM, RationalApproximation, Realization, RFASettings, fit_rfa,
                        realize, speed_nodes)
@@ -94,6 +96,10 @@ class ModelStage:
         Its ΣAE(U) in the airspeed [m/s].
     V0 : float or None
         The identification speed (the records' speed).
+    speed_following : SpeedFollowingROM or None
+        The HWL ROM made to follow the wing over speed (records' coupling delay removed, Σf's
+        time scaled by V / V0, :func:`casflutter.aeroelastic.speed_following_rom`), beside
+        the paper's frozen loop of eq. 8; ``None`` for other ROMs and routes.
     """
 
     __repr__ = result_repr
@@ -108,6 +114,7 @@ class ModelStage:
     rfa: RationalApproximation | None = None
     rfa_system: RFASystem | None = None
     V0: float | None = None
+    speed_following: SpeedFollowingROM | None = None
 
 
 @dataclass(frozen=True)
@@ -132,6 +139,12 @@ class FlutterStage:
     Vf : float or None
         The speed the LFT is built at: the ROM loop's flutter speed (a GAF file's ``Uf /
         U_ref``, where Σf is frozen).
+    convective : FlutterResult or None
+        Of the speed-following ROM (:attr:`ModelStage.speed_following`).
+    reversals : mapping of str to ControlReversal or None
+        The flutter mode's control reversal (:func:`casflutter.aeroelastic.control_reversal`,
+        flap behind the servo of ``controller.servo_omega``) on ``"speed_following"``,
+        ``"rom"`` (the paper's loop) and ``"truth"``; ``None`` where the mode has none.
     """
 
     __repr__ = result_repr
@@ -143,6 +156,8 @@ class FlutterStage:
     rfa: FlutterResult | None = None
     pk: PKResult | None = None
     Vf: float | None = None
+    convective: FlutterResult | None = None
+    reversals: Mapping[str, object] = field(default_factory=dict)
 
 
 # ---------------------------------------------------------------------------- routes
@@ -290,9 +305,44 @@ def rom_model(cfg: RunConfig, problem, structure, progress, *, needs_vf: bool
         note += (f"; truth Vf = {flutter_truth.Vf:.5g}" if flutter_truth.flutter is not None
                  else "; truth: no flutter in flutter.V_range")
     log.info(note)
+    sf, reversals = None, {}
+    if isinstance(model, HWLModel) and not cfg.rom.convective:
+        with progress.stage("flutter"):
+            sf, reversals = _speed_following(cfg, model, structure, V0, system, truth)
     stage = ModelStage(family=system, system=system, data=data, identification=ident,
-                       identification_history=tuple(history), fit=fit, realization=real, V0=V0)
-    return stage, FlutterStage(rom=flutter, truth=flutter_truth, Vf=Vf)
+                       identification_history=tuple(history), fit=fit, realization=real, V0=V0,
+                       speed_following=sf)
+    return stage, FlutterStage(rom=flutter, truth=flutter_truth, Vf=Vf,
+                               convective=None if sf is None else sf.flutter,
+                               reversals=reversals)
+
+
+def _speed_following(cfg: RunConfig, model: HWLModel, structure, V0: float, system, truth):
+    """The ROM that follows the wing over speed and the flutter mode's control reversal on
+    it, on the paper's loop and on the truth (flap behind ``controller.servo_omega``);
+    ``(None, {})`` with a note when the ROM's input delay is shorter than the records'
+    coupling delay."""
+    delay = cfg.data.coupling_delay if truth is not None else 0
+    if model.orders.r < delay:
+        log.info("no speed-following ROM: the ROM's input delay r = %d is shorter than the "
+                 "records' coupling delay %d", model.orders.r, delay)
+        return None, {}
+    fl = cfg.flutter
+    sf = speed_following_rom(model, structure, V0, coupling_delay=delay, V_range=fl.V_range,
+                             n_grid=fl.n_grid, max_refine=fl.max_refine)
+    servo = cfg.controller.servo_omega
+    families = {"speed_following": sf.system, "rom": system}
+    if servo > 0:
+        families = {name: fam.with_servo(servo) for name, fam in families.items()}
+        if truth is not None:
+            families["truth"] = TruthLoop(truth, servo, sensors=structure)
+    speeds = np.linspace(*fl.V_range, 48)
+    reversals = {name: control_reversal(fam, speeds) for name, fam in families.items()}
+    V = sf.flutter.Vf
+    log.info("speed-following ROM Vf = %s; control reversal %s",
+             "none" if V is None else f"{V:.5g}",
+             ", ".join(f"{k} {r.V:.4g}" for k, r in reversals.items() if r is not None))
+    return sf, reversals
 
 
 def frozen_flutter(cfg: RunConfig, truth, V0: float) -> FlutterResult:

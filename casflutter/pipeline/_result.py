@@ -489,8 +489,10 @@ class RunResult:
             ``lco``, ``controller``, ``suppression`` (``None`` when the stage did not run),
             ``timings_s``, ``seed``; ``skipped`` (stage -> reason) when a stage was
             skipped; and, for the stages that ran, ``v0_history``, ``flutter_frozen``,
-            ``flutter_parametric``, ``verification``, ``rfa``, ``family`` and
-            ``closed_loop``.
+            ``flutter_parametric``, ``verification``, ``rfa``, ``family``,
+            ``closed_loop``, and, on an HWL ROM, ``flutter_convective`` (the ROM that
+            follows the wing over speed; ``flutter`` stays the paper's frozen route of
+            Table I) and ``control_reversal_V`` (the flutter mode's, per loop).
         """
         cfg = self.config
         out = {"problem": cfg.problem.name, "route": self.route, **self._model_summary(),
@@ -505,6 +507,10 @@ class RunResult:
             out["convective_V0"] = float(self.convective_V0)
         if cfg.rom.v0_iterations > 1 and self.route in ("truth", "wing"):
             out["v0_history"] = [list(map(float, p)) for p in self.identification_history]
+        if self.flutters.convective is not None:
+            out["flutter_convective"] = _flutter_summary(self.flutters.convective)
+            out["control_reversal_V"] = {name: None if r is None else float(r.V)
+                                         for name, r in self.flutters.reversals.items()}
         if self.flutter_frozen is not None:
             out["flutter_frozen"] = _flutter_summary(self.flutter_frozen)
         if self.parametric is not None:

@@ -107,9 +107,18 @@ def _main(args) -> int:
             what = "ROM" if s["orders"] is not None else "ΣAE(V), Σf frozen at Uf"
             lines.append(f"flutter ({what}):   {_speed(fl)}, {sig(fl['freq_hz'])} {hz}, "
                          f"mode {fl['mode']}")
+        fc = s.get("flutter_convective")
+        if fc is not None:
+            lines.append(f"flutter (ROM following the wing over speed): {_speed(fc)}, "
+                         f"{sig(fc['freq_hz'])} {hz}, mode {fc['mode']}")
         if ft is not None:
             lines.append(f"flutter (truth): {_speed(ft)}, {sig(ft['freq_hz'])} {hz}, "
                          f"mode {ft['mode']}")
+        rev = s.get("control_reversal_V") or {}
+        if any(v is not None for v in rev.values()):
+            lines.append("flutter mode's control reversal (flap behind the servo): " + ", ".join(
+                f"{name.replace('_', '-')} V = {sig(v, 4)}" for name, v in rev.items()
+                if v is not None))
         if s["lco"] is not None:
             lines.append(f"LCO: {sig(s['lco']['freq_hz'])} {hz} ({s['lco']['kind']})")
     if s["controller"] is not None:
