@@ -13,7 +13,8 @@ hinfstruct/systune (the worst case over a set of models), with the speeds as the
 1. **Hold the interval.**  The worst closed-loop spectral abscissa over ``n_speeds`` speeds of
    an interval, smoothed by a log-sum-exp of decreasing temperature, is minimised over the
    controller's matrices by BFGS with the exact gradient of the rightmost eigenvalues
-   (:class:`._speeds.SpeedLoops`).  An interval counts as held when a dense scan (8x as many
+   (:class:`._speeds.SpeedLoops`) and the weak Wolfe line search of Lewis and Overton, which
+   is made for the kinks of such a maximum (:func:`._bfgs.nonsmooth_bfgs`).  An interval counts as held when a dense scan (8x as many
    speeds) finds the rate ``decay`` everywhere; a peak the scan finds between the objective's
    speeds joins them and the interval is tried again.  This is continued in speed: starting
    where a controller already decays, one end is pushed towards the target, the step growing
@@ -47,12 +48,12 @@ from typing import Any, Mapping, Sequence
 
 import control
 import numpy as np
-from scipy.optimize import minimize
 
 from .._format import result_repr
 from .._settings import finite_numbers
 from .._threads import single_threaded
 from ..errors import ConfigError, DimensionError, SynthesisError
+from ._bfgs import nonsmooth_bfgs
 from ._problem import verify_closed_loop
 from ._speeds import DesignChannels, Scaling, SpeedLoops, design_partition
 from ._synthesis import SynthesisOptions, SynthesisResult, synthesize
@@ -63,6 +64,8 @@ log = logging.getLogger("casflutter.design")
 
 #: BFGS temperatures of the smoothed maximum in multiples of the decay rate, last the maximum
 _TAUS = (6.0, 2.0, 0.6, None)
+#: a BFGS run stops when 20 iterations lowered its objective by less than this many decay rates
+_STALL = 0.01
 
 
 @dataclass(frozen=True)
@@ -302,9 +305,10 @@ class _Engine:
         for tau in _TAUS:
             if best <= good:
                 break
-            res = minimize(loops.smoothed, q, args=(None if tau is None else tau * unit,),
-                           jac=True, method="BFGS",
-                           options={"maxiter": int(self.settings.max_iter)})
+            scale = None if tau is None else tau * unit
+            res = nonsmooth_bfgs(lambda p: loops.smoothed(p, scale), q,
+                                 max_iter=int(self.settings.max_iter),
+                                 stall=_STALL * unit)
             if not np.all(np.isfinite(res.x)):
                 continue
             worst = loops.smoothed(res.x, None)[0]
@@ -357,6 +361,7 @@ class _Engine:
         step, smallest, rounds = s.first_step * (hi - lo), s.min_step * (hi - lo), 0
         while cur != (lo, hi) and step >= smallest and rounds < s.max_rounds:
             rounds += 1
+            step = min(step, (hi - cur[1]) if anchor == "low" else (cur[0] - lo))
             trial = ((cur[0], min(hi, cur[1] + step)) if anchor == "low"
                      else (max(lo, cur[0] - step), cur[1]))
             Kn, worst, ok = self.hold(K, *trial)

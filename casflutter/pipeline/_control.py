@@ -110,8 +110,13 @@ def _paper_plant(system, Vf: float, cfg: RunConfig):
     return lft, [plant(float(f)) for f in c.speeds]
 
 
-def _multispeed(cfg: RunConfig, family) -> MultiSpeedDesign:
+def _multispeed(cfg: RunConfig, family, lft_plants=None) -> MultiSpeedDesign:
     c = cfg.controller
+    if c.hinf_objective == "lft" and lft_plants is None:
+        raise CasflutterError("controller.hinf_objective = \"lft\" needs the LFT at the ROM "
+                              "loop's flutter speed (eq. 14); this problem has no ROM loop "
+                              "with a flutter speed: use \"sensors\" or \"auto\"")
+    hinf = lft_plants if c.hinf_objective in ("lft", "auto") and c.hinf_speeds else None
     settings = MultiSpeedSettings(
         decay=c.interval_decay, n_speeds=c.n_speeds, hinf_speeds=c.hinf_speeds,
         rate_weight=c.flap_rate_weight, rate_bandwidth=c.flap_rate_bandwidth,
@@ -120,7 +125,7 @@ def _multispeed(cfg: RunConfig, family) -> MultiSpeedDesign:
         synthesis=replace(settings_as(c, SynthesisOptions), ipopt={**cfg.solver.ipopt,
                                                                    **c.ipopt}))
     return design_over_speeds(family, tuple(c.interval), c.order, settings=settings,
-                              seed=cfg.seed)
+                              seed=cfg.seed, hinf_plants=hinf)
 
 
 def _paper(cfg: RunConfig, P, lft) -> SynthesisResult:
@@ -189,7 +194,7 @@ def controller_stage(cfg: RunConfig, family, *, system=None, Vf: float | None = 
                        syn.controller.D, inputs=list(sig.measurements),
                        outputs=list(sig.controls), name="K")
     else:                       # design_over_speeds names K after the family
-        design = _multispeed(cfg, family)
+        design = _multispeed(cfg, family, P)
         K = design.controller
         if not design.held:
             log.warning("controller: %s", design.message)
