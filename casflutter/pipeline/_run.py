@@ -146,6 +146,10 @@ def _checked(cfg: RunConfig, route: Route, problem) -> RunConfig:
                               f"the wing file {problem.path} are taken at one speed (V0 = "
                               f"{problem.V0:g}); set rom.v0_iterations = 1")
         cfg = replace(cfg, data=replace(cfg.data, V0=float(problem.V0)))
+    if route.kind == "family" and cfg.controller.hinf_objective == "lft":
+        raise ConfigError("controller.hinf_objective = \"lft\" needs the LFT at a ROM loop's "
+                          "flutter speed (eq. 14); a plant family file has none: use "
+                          "\"sensors\" or \"auto\"")
     if route.kind == "family" and set(cfg.stages) - {"controller"}:
         log.info("a plant family file has no records or simulator: only the 'controller' "
                  "stage runs")
