@@ -31,7 +31,9 @@ hinfstruct/systune (the worst case over a set of models), with the speeds as the
    ``hinf_speeds`` speeds (the disturbance-to-sensor channels, with the control-rate weight
    where a servo saturates, or plants the caller gives, e.g. the paper's LFT at Vf) while the
    loops at the stability speeds keep their decay rate; the dense scan checks the result and
-   the held controller is kept if the H∞ phase lost the interval.
+   where it finds a loop slower than the decay rate between the stability speeds, its peaks
+   join them and the phase starts again from the held controller; the held controller is
+   kept if the H∞ phase still loses the interval.
 
 Every budget is counted in iterations and every random choice takes the seed, so the same seed
 gives the same controller.  The interval the design reports is its own dense scan's; the
@@ -650,6 +652,41 @@ def _controller(eng: _Engine, K: np.ndarray) -> control.StateSpace:
     return control.ss(Ak, Bk, Ck, Dk)
 
 
+def _hinf_phase(eng: _Engine, hinf: list, dims: tuple, K: np.ndarray, Kss, lo: float,
+                e: float, order: int, rounds: int = 3):
+    """The H∞ phase from the held controller (module docstring, step 3): ``(synthesis or
+    None, K, Kss)``.  The synthesis keeps the decay rate at the stability speeds only; where
+    the dense scan finds a loop slower than that between them, its peaks join the stability
+    speeds and the synthesis starts again from the held controller (``rounds`` times at
+    most).  ``None`` keeps the held controller."""
+    s, models = eng.settings, eng.models
+    opts = replace(s.synthesis, decay=float(s.decay), strictly_proper=eng.strictly_proper,
+                   zero_start=False, full_order_start=False)
+    speeds = np.linspace(lo, e, s.n_speeds)
+    for _ in range(rounds):
+        stab = [_padded(P, dims) for V in speeds for P in models.parts(V)]
+        try:
+            syn = synthesize(hinf, models.ny, models.nu, order, starts=0, initial=Kss,
+                             stability_plants=stab, options=opts)
+        except SynthesisError as exc:
+            log.info("H-infinity phase: %s; the held controller is kept", exc)
+            return None, K, Kss
+        Kh = models.scaling.gain(*(np.atleast_2d(np.asarray(M, dtype=float)).reshape(r, c)
+                                   for M, (r, c) in zip(
+            (syn.controller.A, syn.controller.B, syn.controller.C, syn.controller.D),
+            ((order, order), (order, models.ny), (models.nu, order), (models.nu, models.ny)))))
+        scan, values = eng.worst(Kh, lo, e)
+        if float(np.max(values)) <= -eng.decay:
+            return syn, Kh, syn.controller
+        log.info("H-infinity phase: the dense scan finds abscissa %.4g > %.4g between the "
+                 "stability speeds; they join them", float(np.max(values)) * models.scaling.w0,
+                 -s.decay)
+        speeds = np.union1d(speeds, scan[_peaks(values, -eng.decay)])
+    log.info("H-infinity phase: the decay rate was lost between the stability speeds %d "
+             "times; the held controller is kept", rounds)
+    return None, K, Kss
+
+
 def _finish(eng: _Engine, fams, K: np.ndarray, order: int, interval: tuple, reached: tuple,
             held: bool, records: list, hinf_plants, t0: float) -> MultiSpeedDesign:
     """The H∞ phase on the interval held (module docstring) and the result."""
@@ -672,30 +709,9 @@ def _finish(eng: _Engine, fams, K: np.ndarray, order: int, interval: tuple, reac
                                  f"{hinf[0].noutputs} outputs: they need [w, u] with "
                                  f"{models.nu} controls and [z, y] with {models.ny} "
                                  "measurements, and at least one w and one z")
-        speeds = np.linspace(lo, e, s.n_speeds)
-        stab = [_padded(P, (nw, nz)) for V in speeds for P in models.parts(V)]
-        opts = replace(s.synthesis, decay=float(s.decay), strictly_proper=eng.strictly_proper,
-                       zero_start=False, full_order_start=False)
-        try:
-            syn = synthesize(hinf, models.ny, models.nu, order, starts=0, initial=Kss,
-                             stability_plants=stab, options=opts)
-        except SynthesisError as exc:
-            log.info("H-infinity phase: %s; the held controller is kept", exc)
-        if syn is not None:
-            Kh = models.scaling.gain(*(np.atleast_2d(np.asarray(M, dtype=float)).reshape(r, c)
-                                       for M, (r, c) in zip(
-                (syn.controller.A, syn.controller.B, syn.controller.C, syn.controller.D),
-                ((order, order), (order, models.ny), (models.nu, order),
-                 (models.nu, models.ny)))))
-            worst = float(np.max(eng.worst(Kh, lo, e)[1]))
-            if worst <= -eng.decay:
-                K, Kss, gamma = Kh, syn.controller, float(syn.gamma)
-            else:
-                log.info("H-infinity phase: the dense scan finds abscissa %.4g > %.4g; the "
-                         "held controller is kept", worst * models.scaling.w0, -s.decay)
-                syn = None
-        if syn is None:
-            gamma = max(verify_closed_loop(P, Kss, models.ny, models.nu)[0] for P in hinf)
+        syn, K, Kss = _hinf_phase(eng, hinf, (nw, nz), K, Kss, lo, e, order)
+        gamma = (float(syn.gamma) if syn is not None else
+                 max(verify_closed_loop(P, Kss, models.ny, models.nu)[0] for P in hinf))
     worst = float(np.max(eng.worst(K, lo, e)[1])) * models.scaling.w0
     what = f"order {order} holds [{lo:.5g}, {e:.5g}]"
     if held:
