@@ -61,6 +61,7 @@ _LAZY = {
     "find_flutter": "aeroelastic", "FlutterResult": "aeroelastic",
     "track_eigenvalues": "aeroelastic", "simulate_loop": "aeroelastic",
     "build_lft": "aeroelastic", "AeroelasticLFT": "aeroelastic",
+    "speed_following_rom": "aeroelastic",
     "lco_branch": "lco", "rom_lco_branch": "lco", "LCOBranch": "lco", "LCOSettings": "lco",
     # synthesis and verification
     "synthesize": "design", "SynthesisOptions": "design", "SynthesisResult": "design",

@@ -19,8 +19,14 @@
   :func:`family_flutter` — every crossing of a plant family, exact derivatives on its
   polynomial pieces.
 - :func:`mode_residues` — a mode's residues in the flap-to-sensor loop along V: the flap's
-  grip on the flutter mode and the phase a controller needs to damp it.
-- :func:`simulate_loop` — the nonlinear discrete ROM in feedback with Σs (paper Fig. 9).
+  grip on the flutter mode and the phase a controller needs to damp it;
+  :func:`control_reversal` — the speed at which that grip dips (the mode's control reversal).
+- :func:`simulate_loop` — the nonlinear discrete ROM in feedback with Σs (paper Fig. 9),
+  stepped at the ROM's sample time or at the speed's own (``convective_V0``: the
+  aerodynamic time scale follows the reduced frequency); :func:`structure_step` — the exact
+  step of Σs over any (symbolic) step.
+- :func:`speed_following_rom` — a ROM identified at one speed whose aerodynamic time scale
+  follows the reduced frequency (linear and nonlinear loops), the ROM that follows the wing.
 - :func:`build_lft` — the uncertainty LFT of eq. 10-15 (Lemmas 1-2).
 - :class:`RFASystem` — ΣAE(U) in the airspeed from a rational-function approximation of
   Q(ik), and :func:`pk_flutter`, the p-k flutter solution on a Q(ik) table.
@@ -35,10 +41,12 @@ from ._lft import AeroelasticLFT, build_lft
 from ._loop import (AeroelasticLoop, AeroelasticSystem, LoopFamily, ParametricSystem,
                     ServoSystem, aeroelastic_loop, split_sigma_f)
 from ._pk import PKResult, pk_flutter
-from ._residues import ModeResidues, mode_residues
+from ._residues import ControlReversal, ModeResidues, control_reversal, mode_residues
 from ._rfa_system import RFASystem
 from ._rom_loop_file import load_rom_loop
-from ._simulate import LoopSimulation, simulate_loop
+from ._speed_following import SpeedFollowingROM, speed_following_rom
+from ._simulate import (HOLDS, LoopSimulation, check_convective_V0, check_hold,
+                        loop_sample_time, simulate_loop, structure_step)
 from ._tracking import EigenTracking, eig_sorted_by_reference, track_eigenvalues
 from ._truth_loop import TruthLoop
 
@@ -51,6 +59,8 @@ __all__ = [
     "EigenTracking", "track_eigenvalues", "eig_sorted_by_reference",
     "Crossing", "FlutterResult", "find_flutter", "origin_modes",
     "AeroelasticLFT", "build_lft", "RFASystem", "PKResult", "pk_flutter",
-    "LoopSimulation", "simulate_loop", "TruthLoop", "ModeResidues", "mode_residues",
-    "load_rom_loop",
+    "LoopSimulation", "simulate_loop", "structure_step", "loop_sample_time",
+    "check_convective_V0", "check_hold", "HOLDS", "TruthLoop", "ModeResidues", "mode_residues",
+    "ControlReversal", "control_reversal",
+    "load_rom_loop", "SpeedFollowingROM", "speed_following_rom",
 ]

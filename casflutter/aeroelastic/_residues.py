@@ -15,6 +15,8 @@ moves, a controller that damps the mode on one side of the turn pushes it the wr
 the other, to first order; only a controller whose phase changes fast enough in frequency, or
 a large enough gain to move the mode far, holds both sides.  The turn comes with a dip in
 ``|r|``: near it the flap hardly reaches the mode (the mode's own control reversal).
+:func:`control_reversal` locates that dip where the mode is unstable: the speed at which a
+ROM loop must put it to stand for the wing's controllability.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ from .._format import result_repr
 from ..errors import ConfigError
 from ._tracking import _eig
 
-__all__ = ["ModeResidues", "mode_residues"]
+__all__ = ["ModeResidues", "mode_residues", "ControlReversal", "control_reversal"]
 
 
 @dataclass(frozen=True)
@@ -220,3 +222,95 @@ def mode_residues(family, speeds, *, mode: complex | None = None, min_score: flo
         res.append((w @ lp.B2) * (lp.C2 @ R[:, b]))
     return ModeResidues(np.array([p[0] for p in points]),
                         np.array([p[1][0][p[2]] for p in points]), np.array(res), worst)
+
+
+@dataclass(frozen=True)
+class ControlReversal:
+    """Outcome of :func:`control_reversal`: where the flap's grip on an unstable mode dips.
+
+    Attributes
+    ----------
+    V : float
+        Speed index of the weakest grip (:attr:`ModeResidues.grip`) among the speeds at which
+        the mode is unstable.
+    eigenvalue : complex
+        The mode's open-loop eigenvalue there.
+    grip : float
+        ``‖r‖`` there.
+    grip_at_onset : float
+        ``‖r‖`` at the first unstable speed of the scan (near the flutter speed).
+    residues : ModeResidues
+        The scan over the whole speed range (the mode, its residues and its phase turn).
+    """
+
+    __repr__ = result_repr
+
+    V: float
+    eigenvalue: complex
+    grip: float
+    grip_at_onset: float
+    residues: ModeResidues
+
+
+def control_reversal(family, speeds, *, mode: complex | None = None,
+                     n_fine: int = 41) -> ControlReversal | None:
+    """The control reversal speed of a mode of ΣAE(V): the speed, among those where the mode
+    is unstable, at which the flap's grip on it is weakest.
+
+    The residues of :func:`mode_residues` are scanned over ``speeds``; the smallest grip
+    ``‖r‖`` where ``Re λ > 0`` is then located on a finer grid of ``n_fine`` speeds between
+    the scan's neighbours of that point (the mode followed up from the lower neighbour).  The
+    dip comes with the residue's turn through 180° (module docstring), so this is where a
+    controller that damps the mode below it pushes it the wrong way above it.
+
+    Parameters
+    ----------
+    family : LoopFamily
+        ΣAE(V) with ``loop(V)`` (a ROM loop, a :class:`TruthLoop`, either behind a servo:
+        ``family.with_servo(omega)``).
+    speeds : array_like
+        Increasing, finite speed indices of the scan (at least 3).
+    mode : complex, optional
+        The mode, as for :func:`mode_residues` (default: the flutter mode, the most unstable
+        one at the last speed).
+    n_fine : int
+        Points of the refinement grid (at least 3).
+
+    Returns
+    -------
+    ControlReversal or None
+        ``None`` when the mode is stable at every speed of the scan.
+
+    Raises
+    ------
+    ConfigError
+        As :func:`mode_residues`, or ``n_fine < 3``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from casflutter.aeroelastic import TruthLoop, control_reversal
+    >>> from casflutter.truth import SeedWing
+    >>> rev = control_reversal(TruthLoop(SeedWing(), 251.3), np.linspace(0.05, 2.4, 48))
+    >>> 1.4 < rev.V < 1.5                      # the wing's flutter mode reverses near 1.46
+    True
+    """
+    if isinstance(n_fine, bool) or not isinstance(n_fine, (int, np.integer)) or n_fine < 3:
+        raise ConfigError(f"n_fine = {n_fine!r}: give an integer >= 3")
+    grid = np.asarray(speeds, dtype=float).ravel()
+    if grid.size < 3:
+        raise ConfigError("speeds must hold at least 3 finite, strictly increasing speed "
+                          "indices")
+    scan = mode_residues(family, grid, mode=mode)
+    k = scan.weakest_index(unstable_only=True)
+    if k is None:
+        return None
+    unstable = np.flatnonzero(scan.eigenvalue.real > 0)
+    lo, hi = max(k - 1, 0), min(k + 1, len(scan.V) - 1)
+    fine = mode_residues(family, np.linspace(scan.V[lo], scan.V[hi], int(n_fine)),
+                         mode=scan.eigenvalue[lo])
+    j = fine.weakest_index(unstable_only=True)
+    best = (fine.V[j], fine.eigenvalue[j], fine.grip[j]) if j is not None and (
+        fine.grip[j] < scan.grip[k]) else (scan.V[k], scan.eigenvalue[k], scan.grip[k])
+    return ControlReversal(V=float(best[0]), eigenvalue=complex(best[1]), grip=float(best[2]),
+                           grip_at_onset=float(scan.grip[unstable[0]]), residues=scan)

@@ -2,22 +2,48 @@
 
 Coupling (sampled-data, exact for the structure)
 -----------------------------------------------
-The ROM is discrete with sample time ``dt``; Σs (eq. 6-7) is continuous.  At each
-sample ``t_k = k dt``:
+The ROM is discrete with one sample per step ``h`` (its sample time ``dt``, or the speed's
+own step below); Σs (eq. 6-7) is continuous.  At each sample ``t_k = k h``:
 
 1. the modal displacements ``u_k = Cs x_s(t_k)`` are sampled;
-2. the sensors are read, ``zm_k = Hx x_s(t_k) + Hf F_{k-1}`` — for accelerometers the
-   forcing term is the value held just before ``t_k`` (left limit), so the measurement
-   never depends on the flap command it produces (no algebraic loop);
+2. the sensors are read, ``zm_k = Hx x_s(t_k) + Hf F(t_k^-)`` — for accelerometers the
+   forcing term is the value of the hold just before ``t_k`` (left limit), so the
+   measurement never depends on the flap command it produces (no algebraic loop);
 3. the controller (if any) gives ``v_k = v_ext(t_k) + g(t_k) · K_d(zm)_k``;
 4. the ROM gives ``y_k = rom.step(y_hist, u_hist, v_hist)`` (rows: time k, k−1, …);
-5. the structural forcing ``F_k = V² y_k + w(t_k)`` is held constant (ZOH) on
-   ``[t_k, t_{k+1})`` and Σs is propagated exactly,
-   ``x_s(t_{k+1}) = Ad x_s(t_k) + Bd F_k`` with ``[Ad Bd] = expm([[As, Bs], [0, 0]] dt)``.
+5. the structural forcing ``F_k = V² y_k + w(t_k)`` is held on ``[t_k, t_{k+1})`` and Σs is
+   propagated exactly (:func:`structure_step`):
+
+   - ``hold = "zoh"`` (zero-order hold, the loose coupling of a CFD time march):
+     ``F(t) = F_k``, ``x_s(t_{k+1}) = Ad x_s(t_k) + B0 F_k``;
+   - ``hold = "foh"`` (predictive first-order hold): ``F(t) = F_k + (t − t_k)/h ·
+     (F_k − F_{k−1})``, ``x_s(t_{k+1}) = Ad x_s(t_k) + B0 F_k + B1 (F_k − F_{k−1})``, and
+     the accelerometers' left limit is ``2 F_{k−1} − F_{k−2}``.
+
+   A zero-order hold delays the force by half a step on average, a phase lag ``ω h / 2``
+   that the lightly damped flutter mode feels: on the seed wing it moves the sampled loop's
+   flutter by several per cent from that of the continuous ΣAE of the same ROM (eq. 8).  The
+   first-order hold extrapolates the force's slope, cancelling the lag to first order, and
+   the sampled loop then flutters within a few tenths of a per cent of ΣAE.
 
 The controller ``K`` (continuous ``control.StateSpace``, inputs zm, output v) is
 discretised with ZOH at the same ``dt``, consistent with the held flap command; its
 state evolves whatever the gain ``g(t)`` (paper Fig. 11 ramps g from 0 to 1).
+
+Speed-following time step (reduced frequency)
+---------------------------------------------
+The ROM is identified at ``V0`` from records sampled every ``dt`` seconds.  Linear unsteady
+aerodynamics depend on the reduced frequency ``k = ω b / U``: they live in reduced time
+``s = U t / b``, and one sample of the identified recursion spans ``U0 dt / b`` of it.  At
+another speed the same recursion describes the same flow when each of its samples spans the
+same reduced time, i.e. ``dt · V0 / V`` seconds.  With ``convective_V0 = V0`` the loop is
+stepped so: the ROM advances one sample per ``h = dt V0 / V``, the structure is propagated
+exactly over ``h`` (:func:`structure_step`) and the forces still scale with ``V²``.  This is
+the discrete counterpart of Σf's dynamics scaled by ``V / V0``
+(:class:`~casflutter.aeroelastic.AeroelasticSystem` ``convective_V0``): the Tustin image of
+the recursion at step ``h`` is Σf with ``Af, Bf, bf`` times ``V / V0``.  Without it (the
+paper's eq. 8) the recursion runs at ``dt`` at every speed and its time scale stays that of
+``V0``.
 
 The records are classified (decay, LCO, divergence) and the LCO measured by
 :func:`casflutter.data.analyze_response`.
@@ -28,16 +54,17 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
+import casadi as ca
 import control
 import numpy as np
-from scipy.linalg import expm
 
 from .._format import result_repr
 from ..data import ResponseAnalysis, analyze_response
 from ..errors import ConfigError, DimensionError
 from ..structure import ModalStructure
 
-__all__ = ["LoopSimulation", "simulate_loop"]
+__all__ = ["LoopSimulation", "simulate_loop", "structure_step", "loop_sample_time",
+           "check_convective_V0", "check_hold", "HOLDS"]
 
 
 @dataclass(frozen=True)
@@ -59,7 +86,10 @@ class LoopSimulation:
         Disturbance.
     gain : ndarray (n,)
         Controller gain schedule g(t_k) (zeros without controller).
-    V, dt : float
+    V : float
+        Speed index.
+    dt : float
+        The loop's step: the ROM's sample time, or ``dt · V0 / V`` when it follows the speed.
     stopped_early : bool
         True when the record blew up (non-finite or above ``blowup``) and was truncated.
     modes : ResponseAnalysis
@@ -88,6 +118,127 @@ class LoopSimulation:
     def kind(self) -> str:
         """``"decay"``, ``"lco"`` or ``"divergence"`` (from the modal displacements)."""
         return self.modes.kind
+
+
+def structure_step(structure: ModalStructure) -> ca.Function:
+    """The exact step of Σs (eq. 7) over a step ``h`` with a force that is constant or ramps.
+
+    Over ``[t_k, t_k + h)`` with the force ``F(t) = F0 + (t − t_k)/h · F1``,
+    ``x(t_k + h) = Ad x(t_k) + B0 F0 + B1 F1``.  Mode by mode, ``ü + 2σu̇ + ω² u = α F``
+    with ``σ = ζω``, ``κ = ω²(1 − ζ²)``, ``C(h) = cos(√κ h)``, ``S(h) = sin(√κ h)/√κ`` (their
+    hyperbolic forms for ``κ < 0``; ``1`` and ``h`` for ``κ = 0``):
+
+    .. math:: A_d = e^{-σh} \\begin{bmatrix} C + σS & S \\\\ -ω^2 S & C - σS \\end{bmatrix},
+              \\quad B_0 = (I - A_d) \\begin{bmatrix} α/ω^2 \\\\ 0 \\end{bmatrix},
+              \\quad B_1 = (I - A_d) \\begin{bmatrix} b \\\\ a \\end{bmatrix}
+              + \\begin{bmatrix} a h \\\\ 0 \\end{bmatrix},
+
+    ``a = α / (ω² h)``, ``b = −2σ α / (ω⁴ h)`` (the ramp's particular solution ``a t + b``),
+    i.e. ``[Ad, B0, B1]`` is ``expm`` of the loop with a held and a ramping input, in closed
+    form; ``h`` may be symbolic (the speed-following loop map differentiates it in V).
+
+    Parameters
+    ----------
+    structure : ModalStructure
+        Σs.
+
+    Returns
+    -------
+    casadi.Function
+        ``(h) -> (Ad, B0, B1)`` of shapes ``(2N, 2N)``, ``(2N, N)``, ``(2N, N)``.
+    """
+    N = structure.n_modes
+    h = ca.SX.sym("h")
+    Ad = ca.SX.zeros(2 * N, 2 * N)
+    B0 = ca.SX.zeros(2 * N, N)
+    B1 = ca.SX.zeros(2 * N, N)
+    alpha = float(structure.alpha)
+    for i, (w, z) in enumerate(zip(structure.omega, structure.zeta)):
+        w, z = float(w), float(z)
+        sig, kap = z * w, w * w * (1.0 - z * z)
+        if kap > 0:
+            r = np.sqrt(kap)
+            C, S = ca.cos(r * h), ca.sin(r * h) / r
+        elif kap < 0:
+            r = np.sqrt(-kap)
+            C, S = ca.cosh(r * h), ca.sinh(r * h) / r
+        else:
+            C, S = 1.0, h
+        e = ca.exp(-sig * h)
+        i0, i1 = 2 * i, 2 * i + 1
+        A = ca.vertcat(ca.horzcat(e * (C + sig * S), e * S),
+                       ca.horzcat(-w * w * e * S, e * (C - sig * S)))
+        Ad[i0:i1 + 1, i0:i1 + 1] = A
+        a, b = alpha / (w * w * h), -2.0 * sig * alpha / (w ** 4 * h)
+        B0[i0:i1 + 1, i] = ca.mtimes(ca.SX.eye(2) - A, ca.vertcat(alpha / (w * w), 0.0))
+        B1[i0:i1 + 1, i] = ca.mtimes(ca.SX.eye(2) - A, ca.vertcat(b, a)) + ca.vertcat(a * h, 0.0)
+    return ca.Function("structure_step", [h], [Ad, B0, B1], ["h"], ["Ad", "B0", "B1"])
+
+
+def loop_sample_time(dt: float, V, convective_V0: float | None):
+    """The physical duration of one ROM sample in the loop at speed index V.
+
+    Parameters
+    ----------
+    dt : float
+        The ROM's sample time (that of its records at ``convective_V0``).
+    V : float or casadi.SX
+        Speed index.
+    convective_V0 : float or None
+        The identification speed index: the step is ``dt · V0 / V`` (module docstring);
+        ``None``: ``dt`` at every speed (eq. 8 as the paper writes it).
+
+    Returns
+    -------
+    float or casadi.SX
+    """
+    return dt if convective_V0 is None else dt * float(convective_V0) / V
+
+
+def check_convective_V0(convective_V0, V=None) -> None:
+    """Refuse a speed-following reference speed (and speed) that is not finite and > 0.
+
+    Parameters
+    ----------
+    convective_V0 : float or None
+        The identification speed index (``None``: eq. 8's frozen time scale).
+    V : float, optional
+        The speed index the loop is stepped at.
+
+    Raises
+    ------
+    ConfigError
+    """
+    if convective_V0 is None:
+        return
+    if (isinstance(convective_V0, bool) or not isinstance(convective_V0, (int, float, np.floating))
+            or not (np.isfinite(convective_V0) and convective_V0 > 0)):
+        raise ConfigError(f"convective_V0 = {convective_V0!r}: the ROM's identification speed "
+                          "index (> 0), or None for eq. 8's frozen time scale")
+    if V is not None and not (np.isfinite(V) and V > 0):
+        raise ConfigError(f"V = {V!r}: the speed-following loop (convective_V0 set) is "
+                          "stepped at dt V0 / V and needs a speed index > 0")
+
+
+#: the holds of the force between samples (module docstring)
+HOLDS = ("zoh", "foh")
+
+
+def check_hold(hold) -> None:
+    """Refuse a hold that is not one of :data:`HOLDS`.
+
+    Parameters
+    ----------
+    hold : str
+        ``"zoh"`` or ``"foh"``.
+
+    Raises
+    ------
+    ConfigError
+    """
+    if hold not in HOLDS:
+        raise ConfigError(f"hold = {hold!r}: use 'zoh' (zero-order hold, the force held over "
+                          "each step) or 'foh' (predictive first-order hold)")
 
 
 def _signal(sig, n: int, dt: float, width: int | None, name: str) -> np.ndarray:
@@ -120,7 +271,8 @@ def _check_rom(rom, n_modes: int) -> None:
 def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0=None,
                   w=None, v=None, controller: control.StateSpace | None = None,
                   gain: Callable[[float], float] | None = None, window: float = 0.3,
-                  tol: float = 0.05, blowup: float = 1e6) -> LoopSimulation:
+                  tol: float = 0.05, blowup: float = 1e6,
+                  convective_V0: float | None = None, hold: str = "zoh") -> LoopSimulation:
     """Simulate the nonlinear ROM in feedback with Σs at speed index V (module docstring).
 
     Parameters
@@ -152,6 +304,14 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
         Classification settings, see :func:`analyze_response`.
     blowup : float
         ``|u|`` above which the run is stopped and classified as divergence.
+    convective_V0 : float, optional
+        The ROM's identification speed index: step the loop at ``rom.dt · V0 / V`` (the
+        aerodynamic time scale follows the reduced frequency, module docstring); the
+        samples of ``w``, ``v``, the controller's discretisation and the record are on that
+        step.  Default: ``rom.dt`` at every speed (eq. 8).
+    hold : {"zoh", "foh"}
+        How the force is held between samples (module docstring): zero-order (default) or
+        predictive first-order.
 
     Returns
     -------
@@ -176,13 +336,15 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
     _check_rom(rom, N)
     if n_steps < 2:
         raise ConfigError(f"n_steps must be >= 2, got {n_steps}")
-    dt = float(rom.dt)
+    check_convective_V0(convective_V0, V)
+    check_hold(hold)
+    dt = float(loop_sample_time(float(rom.dt), float(V), convective_V0))
     W = _signal(w, n_steps, dt, N, "w")
     Vext = _signal(v, n_steps, dt, None, "v")
     Kd = None if controller is None else _discrete_controller(controller, m, dt)
     g = (lambda t: 1.0) if gain is None else gain
     xs = s.layout.initial(xs0, s.n_states)
-    rec, stopped = _run_loop(rom, s, float(V), xs, W, Vext, Kd, g, n_steps, blowup)
+    rec, stopped = _run_loop(rom, s, float(V), xs, W, Vext, Kd, g, n_steps, blowup, dt, hold)
     n = len(rec["u"])
     tpts = dt * np.arange(n)
     U = np.asarray(rec["u"])
@@ -199,27 +361,29 @@ def simulate_loop(rom, structure: ModalStructure, V: float, n_steps: int, *, xs0
 
 
 def _discrete_controller(controller: control.StateSpace, m: int, dt: float):
-    """The controller's ``(A, B, C, D)`` sampled with a zero-order hold at the ROM's ``dt``
-    (as given when it is already discrete at that ``dt``)."""
+    """The controller's ``(A, B, C, D)`` sampled with a zero-order hold at the loop's step
+    ``dt`` (as given when it is already discrete at that ``dt``)."""
     if controller.ninputs != m or controller.noutputs != 1:
         raise DimensionError(f"the controller has {controller.ninputs} inputs and "
                              f"{controller.noutputs} outputs; it needs {m} inputs (sensors) and 1 output (flap)")
     if controller.dt not in (0, None) and not np.isclose(controller.dt, dt):
-        raise ConfigError(f"the discrete controller has dt={controller.dt} but the ROM has "
-                          f"dt={dt}; give a continuous controller or one sampled at the ROM's dt")
+        raise ConfigError(f"the discrete controller has dt={controller.dt} but the loop is "
+                          f"stepped at dt={dt}; give a continuous controller or one sampled "
+                          "at the loop's step")
     Kd = control.sample_system(controller, dt, method="zoh") if controller.dt == 0 else controller
     return tuple(np.atleast_2d(np.asarray(M, dtype=float)) for M in (Kd.A, Kd.B, Kd.C, Kd.D))
 
 
 def _run_loop(rom, s: ModalStructure, V: float, xs, W, Vext, Kd, g, n_steps: int,
-              blowup: float):
+              blowup: float, dt: float, hold: str):
     """The sample-by-sample recursion of the module docstring (steps 1-5) from the
-    structural state ``xs``: the records per key and whether the run blew up."""
-    N, L, dt = s.n_modes, int(rom.max_lag), float(rom.dt)
+    structural state ``xs``, stepped at ``dt`` with the force held as ``hold`` says: the
+    records per key and whether the run blew up."""
+    N, L = s.n_modes, int(rom.max_lag)
     V2 = V ** 2
     nx = s.n_states
-    E = expm(np.block([[s.As, s.Bs], [np.zeros((N, nx + N))]]) * dt)
-    Ad, Bd = E[:nx, :nx], E[:nx, nx:]
+    Ad, B0, B1 = (np.asarray(M, dtype=float) for M in structure_step(s)(dt))
+    foh = hold == "foh"
     Hx, Hf = s.sensor_matrices()
     Cs = s.Cs
     if Kd is not None:
@@ -227,12 +391,12 @@ def _run_loop(rom, s: ModalStructure, V: float, xs, W, Vext, Kd, g, n_steps: int
         xk = np.zeros(Ak.shape[0])
     y_hist, v_hist = np.zeros((L + 1, N)), np.zeros(L + 1)
     u_hist = np.tile(Cs @ xs, (L + 1, 1))  # held at the initial deflection before release
-    F_prev = np.zeros(N)
+    F_prev, F_prev2 = np.zeros(N), np.zeros(N)    # F_{k-1}, F_{k-2}
     rec = {k: [] for k in ("xs", "u", "y", "zm", "v", "g")}
     for k in range(n_steps):
         t = k * dt
         uk = Cs @ xs
-        zk = Hx @ xs + Hf @ F_prev
+        zk = Hx @ xs + Hf @ (2.0 * F_prev - F_prev2 if foh else F_prev)
         vk = Vext[k]
         gk = 0.0
         if Kd is not None:
@@ -251,6 +415,7 @@ def _run_loop(rom, s: ModalStructure, V: float, xs, W, Vext, Kd, g, n_steps: int
             rec[key].append(val)
         if not (np.all(np.isfinite(yk)) and np.all(np.abs(uk) < blowup)):
             return rec, True
-        F_prev = V2 * yk + W[k]
-        xs = Ad @ xs + Bd @ F_prev
+        Fk = V2 * yk + W[k]
+        xs = Ad @ xs + B0 @ Fk + (B1 @ (Fk - F_prev) if foh else 0.0)
+        F_prev, F_prev2 = Fk, F_prev
     return rec, False

@@ -7,8 +7,8 @@ structure, unsteady-lag states and the flap) with the flap behind a second-order
 that the controller commands the servo as it would on the wind-tunnel model.  The result is
 an :class:`~casflutter.aeroelastic.AeroelasticLoop` at every speed, with the same sensors
 (the problem's rows, read as the truth's sensor kind) and the same modal disturbance
-inputs, so everything that takes the ROM loop (:func:`casflutter.design.stabilize_interval`,
-:func:`casflutter.design.full_order_start`, closed-loop pole maps) takes this one.
+inputs, so everything that takes the ROM loop (:func:`casflutter.design.design_over_speeds`,
+:func:`casflutter.verify.verify_family`, closed-loop pole maps) takes this one.
 """
 
 from __future__ import annotations

@@ -77,6 +77,10 @@ class OrderBound:
         σ̄ T(j∞) at the best point.
     sigma_at_frequencies : tuple of float
         σ̄ T(jω_i) at the best point.
+    start_converged : tuple of bool
+        Per start: every BFGS run of its sharpening sequence met scipy's convergence test
+        (a start that did not still gives a point of the relaxation, just not a
+        stationary one).
     trivial : bool
         True when the order is large enough for the rank structure to constrain nothing
         (``k >= min(ncon, nmeas)`` with one frequency, ``k >= max(ncon, nmeas)`` with more):
@@ -92,6 +96,7 @@ class OrderBound:
     sigma_at_infinity: float
     sigma_at_frequencies: tuple
     trivial: bool
+    start_converged: tuple = ()
 
 
 def _blocks(P: Partition, w: float) -> list[np.ndarray]:
@@ -250,18 +255,21 @@ def order_relaxation(plant: control.StateSpace | Partition, nmeas: int, ncon: in
     order = int(order)
     rel = _Relaxation(P, order, freqs)
     rng = np.random.default_rng(seed)
-    best, best_x, values = np.inf, None, []
+    best, best_x, values, converged = np.inf, None, [], []
     for s in range(starts):
         x = rng.standard_normal(rel.n) * (0.1, 0.3, 1.0)[s % 3]
+        ok = True
         for p in _P_STEPS:
             r = minimize(rel.fun_grad, x, args=(p,), jac=True, method="BFGS",
                          options={"maxiter": 4000, "gtol": 1e-10})
+            ok = ok and bool(r.success)
             if np.all(np.isfinite(r.x)):
                 x = r.x
         v = max(float(sv[0]) for sv in rel.sigmas(x))
         values.append(v)
-        log.debug("order relaxation (order %d, %d frequencies): start %d ends at %.6g", order,
-                  len(freqs), s, v)
+        converged.append(ok)
+        log.debug("order relaxation (order %d, %d frequencies): start %d ends at %.6g%s", order,
+                  len(freqs), s, v, "" if ok else " (BFGS stopped before convergence)")
         if v < best:
             best, best_x = v, x
     sv = rel.sigmas(best_x)
@@ -271,7 +279,7 @@ def order_relaxation(plant: control.StateSpace | Partition, nmeas: int, ncon: in
                       start_values=tuple(float(v) for v in values),
                       sigma_at_infinity=float(sv[0][0]),
                       sigma_at_frequencies=tuple(float(s[0]) for s in sv[1:]),
-                      trivial=bool(trivial))
+                      trivial=bool(trivial), start_converged=tuple(converged))
 
 
 # -- the static-direction certificate -----------------------------------------------------
@@ -458,6 +466,65 @@ class _ExactStaticDirectionForms:
                                                    _exact.transpose(self.W))), (-one, self.N)])
 
 
+class _DirectionCertificate:
+    """The multiplier search of :func:`static_direction_bound`: the best ``t`` at a level γ,
+    whether it proves the bound, and the bisection for the largest such γ."""
+
+    def __init__(self, forms: list, exact_forms: list | None, m: int, rtol: float):
+        self.forms, self.exact_forms, self.m, self.rtol = forms, exact_forms, m, rtol
+        self.tol = 100.0 * np.finfo(float).eps * max(f.kappa for f in forms)
+        self.floor = max(f.floor for f in forms)    # any controller: γ >= σ̄ A0(jω) at each ω
+        self.scale = max(float(np.linalg.norm(f.W, 2)) for f in forms)
+
+    def multiplier(self, g):
+        """Best ``(t, λ_m, weights)`` at γ = g (λ_m = -inf where rounding overwhelms)."""
+        try:
+            with np.errstate(over="ignore", invalid="ignore"):
+                phis = [f.phi(g) for f in self.forms]
+            if not all(np.all(np.isfinite(p)) for p in phis):
+                return 0.0, -np.inf, None
+            return _multiplier(phis, self.m)
+        except np.linalg.LinAlgError:
+            return 0.0, -np.inf, None
+
+    def certified(self, g, t, lam, weights) -> bool:
+        """The multiplier at γ = g proves the bound: in exact arithmetic, or past rounding."""
+        if self.exact_forms is None:
+            return lam > self.tol
+        if not lam > 0:
+            return False
+        gf = Fraction(g)
+        try:
+            phis = [f.phi(gf) for f in self.exact_forms]
+        except ZeroDivisionError:           # γ² is an eigenvalue of A0ᵀA0: not certified
+            return False
+        neg = _exact.negative_eigenvalues(
+            _exact.combine([(Fraction(w), ph) for w, ph in zip(weights, phis)]))
+        return neg is not None and neg < self.m
+
+    def largest(self, accept):
+        """Bisection for the largest γ whose best multiplier is accepted:
+        ``(γ, first γ that failed, t, λ_m)``; γ = floor (t None) when none is."""
+        lo, hi, t_lo, lam_lo = self.floor, np.inf, None, np.nan
+        g = max(1.01 * self.floor, 1e-6 * self.scale, 1e-300)
+        cap = 1e12 * g
+        while g < cap:      # double until the multiplier fails
+            t, lam, wts = self.multiplier(g)
+            if not accept(g, t, lam, wts):
+                hi = g
+                break
+            lo, t_lo, lam_lo = g, t, lam
+            g *= 2.0
+        while np.isfinite(hi) and hi - lo > self.rtol * hi and hi > 1e-12 * self.scale:
+            mid = 0.5 * (lo + hi)
+            t, lam, wts = self.multiplier(mid)
+            if accept(mid, t, lam, wts):
+                lo, t_lo, lam_lo = mid, t, lam
+            else:
+                hi = mid
+        return lo, hi, t_lo, lam_lo
+
+
 def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, ncon: int, *,
                            order: int | None = None, side: str = "control",
                            frequencies: Sequence[float] = (0.0, np.inf),
@@ -558,63 +625,11 @@ def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, nc
     k = int(k)
     m = n_dir - k
     Pd = P if side == "control" else _transposed(P)
-    forms = [_StaticDirectionForms(Pd, w, side) for w in freqs]
-    exact_forms = [_ExactStaticDirectionForms(Pd, w) for w in freqs] if exact else None
-    tol = 100.0 * np.finfo(float).eps * max(f.kappa for f in forms)
-
-    def multiplier(g):
-        """Best ``(t, λ_m, weights)`` at γ = g (λ_m = -inf where rounding overwhelms)."""
-        try:
-            with np.errstate(over="ignore", invalid="ignore"):
-                phis = [f.phi(g) for f in forms]
-            if not all(np.all(np.isfinite(p)) for p in phis):
-                return 0.0, -np.inf, None
-            return _multiplier(phis, m)
-        except np.linalg.LinAlgError:
-            return 0.0, -np.inf, None
-
-    def certified(g, t, lam, weights):
-        """The multiplier at γ = g proves the bound: in exact arithmetic, or past rounding."""
-        if not exact:
-            return lam > tol
-        if not lam > 0:
-            return False
-        gf = Fraction(g)
-        try:
-            phis = [f.phi(gf) for f in exact_forms]
-        except ZeroDivisionError:           # γ² is an eigenvalue of A0ᵀA0: not certified
-            return False
-        neg = _exact.negative_eigenvalues(
-            _exact.combine([(Fraction(w), ph) for w, ph in zip(weights, phis)]))
-        return neg is not None and neg < m
-
-    floor = max(f.floor for f in forms)     # any controller: γ >= σ̄ A0(jω) at each ω
-    scale = max(float(np.linalg.norm(f.W, 2)) for f in forms)
-
-    def largest(accept):
-        """Bisection for the largest γ whose best multiplier is accepted:
-        ``(γ, first γ that failed, t, λ_m)``; γ = floor (t None) when none is."""
-        lo, hi, t_lo, lam_lo = floor, np.inf, None, np.nan
-        g = max(1.01 * floor, 1e-6 * scale, 1e-300)
-        cap = 1e12 * g
-        while g < cap:      # double until the multiplier fails
-            t, lam, wts = multiplier(g)
-            if not accept(g, t, lam, wts):
-                hi = g
-                break
-            lo, t_lo, lam_lo = g, t, lam
-            g *= 2.0
-        while np.isfinite(hi) and hi - lo > rtol * hi and hi > 1e-12 * scale:
-            mid = 0.5 * (lo + hi)
-            t, lam, wts = multiplier(mid)
-            if accept(mid, t, lam, wts):
-                lo, t_lo, lam_lo = mid, t, lam
-            else:
-                hi = mid
-        return lo, hi, t_lo, lam_lo
-
-    value, _, t_val, lam_val = largest(certified)
-    estimate, upper, _, _ = largest(lambda g, t, lam, w: lam > 0)
+    cert = _DirectionCertificate([_StaticDirectionForms(Pd, w, side) for w in freqs],
+                                 [_ExactStaticDirectionForms(Pd, w) for w in freqs]
+                                 if exact else None, m, rtol)
+    value, _, t_val, lam_val = cert.largest(cert.certified)
+    estimate, upper, _, _ = cert.largest(lambda g, t, lam, w: lam > 0)
     log.info("static-direction bound (%s side, order <= %d, ω = %s): γ >= %.6g certified%s "
              "(without margin %.6g)", side, k, freqs, value, " exactly" if exact else "",
              estimate)
@@ -622,6 +637,6 @@ def static_direction_bound(plant: control.StateSpace | Partition, nmeas: int, nc
                                 upper=float(upper), side=side, order=k, directions=m,
                                 frequencies=freqs,
                                 multiplier=() if t_val is None else (1.0 - t_val, t_val),
-                                margin=float(lam_val), tolerance=float(tol),
+                                margin=float(lam_val), tolerance=float(cert.tol),
                                 exact=bool(exact and t_val is not None),
-                                per_frequency=tuple(f.floor for f in forms))
+                                per_frequency=tuple(f.floor for f in cert.forms))

@@ -27,10 +27,11 @@ import numpy as np
 import scipy.linalg as sla
 
 from .._linalg import spectral_abscissa
-from ..errors import DataError, DimensionError
+from ..errors import ConfigError, DataError, DimensionError
 from ._norm import hinf_norm
 
-__all__ = ["Partition", "partition", "load_compleib", "exact_hinf_norm", "spectral_abscissa"]
+__all__ = ["Partition", "partition", "load_compleib", "exact_hinf_norm", "spectral_abscissa",
+           "with_flap_rate"]
 
 
 @dataclass(frozen=True)
@@ -262,3 +263,46 @@ def sigma_max_grid(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray,
     X = np.linalg.solve(M, np.broadcast_to(B.astype(complex), (len(omega),) + B.shape))
     H = C[None] @ X + D[None]
     return np.linalg.svd(H, compute_uv=False)[:, 0]
+
+
+def with_flap_rate(P: control.StateSpace, nmeas: int, weight: float,
+                   bandwidth: float) -> control.StateSpace:
+    """``P`` with one more performance output, the weighted flap rate ``z_r = w v̇``.
+
+    The rate is taken through a first-order filter, ``ẋ_r = a (v − x_r)``,
+    ``z_r = w a (v − x_r)`` (``v̇`` below the bandwidth ``a``), inserted after the existing
+    performance outputs; the measurements stay the last ``nmeas`` outputs and the flap
+    ``v`` the last input, as :func:`synthesize` expects.
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        Partitioned plant (inputs ``[w, v]``, outputs ``[z, zm]``), e.g. the LFT's ``P``
+        (eq. 14).
+    nmeas : int
+        Number of measurements (the last outputs).
+    weight : float
+        ``w`` [1 / (rad per time unit)]: how much one unit of flap rate counts against the
+        plant's performance outputs (> 0).
+    bandwidth : float
+        ``a`` [rad per time unit] (> 0), e.g. the flap servo's bandwidth.
+
+    Returns
+    -------
+    control.StateSpace
+        One state and one output more than ``P``.
+    """
+    if not (weight > 0 and bandwidth > 0):
+        raise ConfigError(f"flap-rate weight {weight!r} and bandwidth {bandwidth!r} must be > 0")
+    A, B, C, D = (np.asarray(M, dtype=float) for M in (P.A, P.B, P.C, P.D))
+    n, m, nz = A.shape[0], B.shape[1], C.shape[0] - nmeas
+    ev = np.zeros((1, m))
+    ev[0, -1] = 1.0                                       # the flap command v
+    a, w = float(bandwidth), float(weight)
+    Aa = np.block([[A, np.zeros((n, 1))], [np.zeros((1, n)), np.full((1, 1), -a)]])
+    Ba = np.vstack([B, a * ev])
+    Ca = np.vstack([np.hstack([C[:nz], np.zeros((nz, 1))]),
+                    np.hstack([np.zeros((1, n)), np.full((1, 1), -w * a)]),
+                    np.hstack([C[nz:], np.zeros((nmeas, 1))])])
+    Da = np.vstack([D[:nz], w * a * ev, D[nz:]])
+    return control.ss(Aa, Ba, Ca, Da)

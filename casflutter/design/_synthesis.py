@@ -419,7 +419,59 @@ class _Phase:
     def done(self, f: float) -> bool:
         return self.kind == "stab" and f <= 0.0
 
-    def run(self, K: np.ndarray, label: str, max_iter: int) -> dict:
+    def _stop(self, it: int, f: float, history: list, history_at: list, label: str) -> bool:
+        """The H∞ phase's stall and abandon tests (counted in iterations: deterministic)."""
+        opts = self.opts
+        if self.kind == "hinf" and len(history) > 1 and it > opts.stall_window and \
+                history_at[-1] >= it - 1 and _stalled(history, history_at, it,
+                                                      opts.stall_window,
+                                                      min(opts.stall_tol, 10 * opts.tol)):
+            log.debug("%s: stalled at gamma %.6g (less than %.1e relative decrease in %d "
+                      "iterations)", label, f, opts.stall_tol, opts.stall_window)
+            return True
+        if it > opts.abandon_after and f > self.abandon_above:
+            log.debug("%s: abandoned at gamma %.6g (another start is far better)", label, f)
+            return True
+        return False
+
+    def _curvature(self, fv: np.ndarray, G: np.ndarray, f: float, delta0: float) -> np.ndarray:
+        """The first model's curvature, a multiple of the identity.  In the stabilisation
+        phase its scale comes from the eigenvalue cuts active now (within 1 % of the top
+        value) when a far-away ill-conditioned eigenvalue has a gradient 1e3 times larger,
+        which would otherwise shrink every step to nothing."""
+        top = float(np.max(fv))
+        act = fv >= top - 0.01 * max(abs(f), abs(top), 1e-12) if self.kind == "stab" \
+            else np.ones(fv.size, bool)
+        gnorm = np.linalg.norm(G, axis=1)
+        gscale = float(np.max(gnorm))
+        if gscale > 1e3 * float(np.max(gnorm[act])):
+            gscale = float(np.max(gnorm[act]))
+        return max(1e-8, 0.1 * gscale / delta0) * np.eye(self.prob.n)
+
+    def _updated(self, H: np.ndarray, step, obj: list, con: list, Kn: np.ndarray
+                 ) -> tuple[np.ndarray, bool]:
+        """The damped BFGS update of the Lagrangian's curvature after an accepted step, and
+        whether it changed."""
+        y = np.zeros(self.prob.n)
+        for lam, c in list(zip(step.mu, obj)) + list(zip(step.nu, con)):
+            if lam > 1e-9:
+                cn = self.prob.reevaluate(Kn, c, self.margin)
+                if cn is not None:
+                    y += lam * (cn.grad - c.grad)
+        s = step.d
+        Hs = H @ s
+        sHs, sy = float(s @ Hs), float(s @ y)
+        if sHs <= 0:
+            return H, False
+        if sy < 0.2 * sHs:
+            th = 0.8 * sHs / (sHs - sy)
+            y = th * y + (1 - th) * Hs
+            sy = float(s @ y)
+        return H - np.outer(Hs, Hs) / sHs + np.outer(y, y) / sy, True
+
+    def run(self, K: np.ndarray, label: str, max_iter: int) -> "_PhaseResult":
+        """The trust-region bundle iteration from ``K`` (module docstring): at most
+        ``max_iter`` QP steps, each accepted only when the exact objective decreased."""
         prob, opts = self.prob, self.opts
         free = np.ones(prob.shape)
         if opts.strictly_proper:
@@ -428,50 +480,27 @@ class _Phase:
             K[:prob.nu, :prob.ny] = 0.0
         free = prob.vec(free)
         f, info = self.value(K)
-        history = [f]
-        history_at = [0]
+        history, history_at = [f], [0]
         memory: list[list[float]] = [[] for _ in prob.aug]
         delta0 = delta = opts.trust_region * max(1.0, float(np.max(np.abs(K))))
-        H = None
-        fresh = True
+        H, fresh, cuts = None, True, None
         converged, it, pred_rel = False, 0, np.inf
-        cuts_cache = None
         for it in range(1, max_iter + 1):
-            if self.done(f) or time.perf_counter() > self.deadline:
+            if self.done(f) or time.perf_counter() > self.deadline or \
+                    self._stop(it, f, history, history_at, label):
                 break
-            if self.kind == "hinf" and len(history) > 1 and it > opts.stall_window and \
-                    history_at[-1] >= it - 1 and _stalled(history, history_at, it,
-                                                          opts.stall_window,
-                                                          min(opts.stall_tol, 10 * opts.tol)):
-                log.debug("%s: stalled at gamma %.6g (less than %.1e relative decrease in %d "
-                          "iterations)", label, f, opts.stall_tol, opts.stall_window)
-                break
-            if it > opts.abandon_after and f > self.abandon_above:
-                log.debug("%s: abandoned at gamma %.6g (another start is far better)", label, f)
-                break
-            if cuts_cache is None:
-                cuts_cache = self.cuts(K, f, info, delta, memory)
-            obj, con = cuts_cache
+            if cuts is None:
+                cuts = self.cuts(K, f, info, delta, memory)
+            obj, con = cuts
             if not obj:
                 break
             G = np.array([c.grad for c in obj])
             fv = np.array([c.value for c in obj]) - f
-            Hc = np.array([c.grad for c in con]).reshape(len(con), prob.n)
-            cv = np.minimum(np.array([c.value for c in con]), 0.0)
             if H is None:
-                # stabilisation: curvature scale from the eigenvalue cuts active now (within
-                # 1 % of the top value) when some far-away ill-conditioned eigenvalue has a
-                # gradient 1e3 times larger, which would otherwise shrink every step to nothing
-                top = float(np.max(fv))
-                act = fv >= top - 0.01 * max(abs(f), abs(top), 1e-12) \
-                    if self.kind == "stab" else np.ones(fv.size, bool)
-                gnorm = np.linalg.norm(G, axis=1)
-                gscale = float(np.max(gnorm))
-                if gscale > 1e3 * float(np.max(gnorm[act])):
-                    gscale = float(np.max(gnorm[act]))
-                H = max(1e-8, 0.1 * gscale / delta0) * np.eye(prob.n)
-                fresh = True
-            step = self.qp.solve(H, fv, G, cv, Hc, delta * free)
+                H, fresh = self._curvature(fv, G, f, delta0), True
+            step = self.qp.solve(H, fv, G, np.minimum(np.array([c.value for c in con]), 0.0),
+                                 np.array([c.grad for c in con]).reshape(len(con), prob.n),
+                                 delta * free)
             self.statuses.append(step.status)
             pred = -step.model
             scale = max(abs(f), 1e-12) if self.kind == "hinf" else max(abs(f), self.margin)
@@ -482,61 +511,50 @@ class _Phase:
                     break
                 # the quasi-Newton curvature may hide a descent direction (kinks inflate it):
                 # decide on a fresh model before stopping
-                H = None
-                delta = max(delta, 0.1 * delta0)
+                H, delta = None, max(delta, 0.1 * delta0)
                 continue
             Kn = K + prob.mat(step.d)
             fn, info_n = self.value(Kn)
             ratio = (f - fn) / pred if np.isfinite(fn) else -np.inf
             dmax = float(np.max(np.abs(step.d)))
+            cuts = None
             if ratio > 1e-2:
-                # quasi-Newton update of the Lagrangian's curvature (damped BFGS)
-                y = np.zeros(prob.n)
-                for lam, c in list(zip(step.mu, obj)) + list(zip(step.nu, con)):
-                    if lam > 1e-9:
-                        cn = prob.reevaluate(Kn, c, self.margin)
-                        if cn is not None:
-                            y += lam * (cn.grad - c.grad)
-                s = step.d
-                Hs = H @ s
-                sHs = float(s @ Hs)
-                sy = float(s @ y)
-                if sHs > 0:
-                    if sy < 0.2 * sHs:
-                        th = 0.8 * sHs / (sHs - sy)
-                        y = th * y + (1 - th) * Hs
-                        sy = float(s @ y)
-                    H = H - np.outer(Hs, Hs) / sHs + np.outer(y, y) / sy
-                    fresh = False
+                H, changed = self._updated(H, step, obj, con, Kn)
+                fresh = fresh and not changed
                 K, f, info = Kn, fn, info_n
                 history.append(f)
                 history_at.append(it)
-                cuts_cache = None
                 if ratio > 0.75 and dmax > 0.9 * delta:
                     delta = min(2.0 * delta, opts.max_trust_region * max(1.0, np.max(np.abs(K))))
                 elif ratio < 0.25:
                     delta = 0.5 * dmax
                 log.debug("%s %s it %d: %s %.6g (ratio %.2f, radius %.3g)", label, self.kind, it,
                           "gamma" if self.kind == "hinf" else "abscissa", f, ratio, delta)
-            else:
-                delta = 0.5 * dmax
-                if self.kind == "hinf" and info_n is not None:
-                    # the trial point's peaks join the model (cutting planes)
-                    gams_n, peaks_n = info_n
-                    for j, w in enumerate(peaks_n):
-                        if gams_n[j] >= opts.active_ratio * f:
-                            memory[j] = _merge([w], memory[j])
-                    cuts_cache = None
-                elif self.kind == "hinf":
-                    cuts_cache = None
-                else:
-                    cuts_cache = None
-                log.debug("%s %s it %d: rejected (ratio %.3g), radius %.3g", label, self.kind,
-                          it, ratio, delta)
-                if delta < 1e-10 * max(1.0, float(np.max(np.abs(K)))):
-                    break
-        return dict(K=K, f=f, history=history, converged=converged, iterations=it,
-                    pred=pred_rel)
+                continue
+            delta = 0.5 * dmax
+            if self.kind == "hinf" and info_n is not None:
+                # the trial point's peaks join the model (cutting planes)
+                for j, (gj, w) in enumerate(zip(*info_n)):
+                    if gj >= opts.active_ratio * f:
+                        memory[j] = _merge([w], memory[j])
+            log.debug("%s %s it %d: rejected (ratio %.3g), radius %.3g", label, self.kind, it,
+                      ratio, delta)
+            if delta < 1e-10 * max(1.0, float(np.max(np.abs(K)))):
+                break
+        return _PhaseResult(K, float(f), tuple(history), converged, it, float(pred_rel))
+
+
+@dataclass(frozen=True)
+class _PhaseResult:
+    """Where a phase ended: the gain, its objective, the accepted objectives, whether the
+    stopping test was met, the iterations and the last model's relative decrease."""
+
+    K: np.ndarray
+    f: float
+    history: tuple
+    converged: bool
+    iterations: int
+    pred: float
 
 
 def _stalled(history: list, at: list, it: int, window: int, tol: float) -> bool:
@@ -766,7 +784,7 @@ def _run_start(prob: Problem, qp: CutQP, opts: SynthesisOptions, s: int, kind: s
             m_start = min(m_start, 0.5 * -a0)
     stab = _Phase(prob, qp, opts, "stab", m_start, deadline, statuses)
     r1 = stab.run(K0, label, opts.max_stab_rounds)
-    K, phi = r1["K"], r1["f"]
+    K, phi = r1.K, r1.f
     a_h = float(np.max(prob.alphas(K)[0])) * prob.w0
     best_alpha = a_h
     # the decay rates reached, or at least a stable, well-posed loop (the H∞ phase then
@@ -782,13 +800,13 @@ def _run_start(prob: Problem, qp: CutQP, opts: SynthesisOptions, s: int, kind: s
             log.debug("%s: stabilisation failed (abscissa %.4g rad/s); retried from the "
                      "random gain shrunk towards zero", label, a_h)
             r1b = stab.run(K1, label, opts.max_stab_rounds)
-            K, phi = r1b["K"], r1b["f"]
-            r1 = dict(r1b, iterations=r1["iterations"] + r1b["iterations"])
+            K, phi = r1b.K, r1b.f
+            r1 = replace(r1b, iterations=r1.iterations + r1b.iterations)
             a_h = float(np.max(prob.alphas(K)[0])) * prob.w0
             best_alpha = min(best_alpha, a_h)
             ok = prob.feasible(K) and (phi <= 0.0 or (a_h < 0 and np.isfinite(phi)))
     log.debug("%s: stabilisation %s after %d iterations (abscissa %.4g rad/s)", label,
-             "reached the decay rates" if ok else "failed", r1["iterations"], a_h)
+             "reached the decay rates" if ok else "failed", r1.iterations, a_h)
     status, reason = "not-stabilized", "the stabilisation phase ended with an unstable or " \
         "ill-posed loop"
     if ok:
@@ -799,9 +817,8 @@ def _run_start(prob: Problem, qp: CutQP, opts: SynthesisOptions, s: int, kind: s
                       abandon_above=np.inf if kind == "full-order-reduced"
                       else opts.abandon_ratio * best_g)
         r2 = hinf.run(K, label, opts.max_outer)
-        K, gam = r2["K"], r2["f"]
-        hist, conv, outer, pred = tuple(r2["history"]), r2["converged"], r2["iterations"], \
-            r2["pred"]
+        K, gam = r2.K, r2.f
+        hist, conv, outer, pred = r2.history, r2.converged, r2.iterations, r2.pred
         a_h = float(np.max(prob.alphas(K)[0])) * prob.w0
         log.debug("%s: gamma %.6g after %d H-inf iterations (%s)", label, gam, outer,
                  "converged" if conv else "budget spent")
@@ -814,7 +831,7 @@ def _run_start(prob: Problem, qp: CutQP, opts: SynthesisOptions, s: int, kind: s
     rec = StartRecord(start=s, kind=kind, stabilized=bool(ok), spectral_abscissa=a_h,
                       gamma=float(gam), gamma_history=tuple(float(h) for h in hist),
                       model_decrease=float(pred), statuses=tuple(statuses),
-                      stab_iterations=r1["iterations"], outer_iterations=outer,
+                      stab_iterations=r1.iterations, outer_iterations=outer,
                       converged=bool(conv), wall_time=0.0, status=status, reason=reason)
     return rec, K, best_alpha
 

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from .._format import result_repr
-from ..errors import DataError, DimensionError
+from ..errors import DataError, DimensionError, OrderError
 from ._kernels import free_run
 from ._orders import HWLOrders
 from ._structure import HWLStructure, _ar_part, _input_part, ar_weight_array
@@ -406,6 +406,38 @@ class HWLModel:
             kw["c"] = c["c"]
         return HWLModel.from_coefficients(lin, dt=self.dt, output_names=self.output_names,
                                           u_names=self.u_names, v_name=self.v_name, **kw)
+
+    def advanced(self, samples: int) -> "HWLModel":
+        """The same coefficients with the input delay ``r`` lowered by ``samples``.
+
+        Records whose forces lag the motion by a known number of samples (a loosely coupled
+        CFD time march computes the flow of step ``k`` on the grid of step ``k - 1``:
+        :attr:`casflutter.truth.RecordSettings.coupling_delay`) give a model whose ``r``
+        holds that lag.  It belongs to the records, not to the flow: the model of the
+        aerodynamics alone is the identified one with its inputs ``samples`` steps earlier,
+        ``z^{-(r - samples)}`` in place of ``z^{-r}`` in eq. 2.
+
+        Parameters
+        ----------
+        samples : int
+            From 0 to ``r``.
+
+        Returns
+        -------
+        HWLModel
+
+        Raises
+        ------
+        OrderError
+            ``samples`` negative or larger than the model's ``r``.
+        """
+        o = self.orders
+        if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or not (
+                0 <= samples <= o.r):
+            raise OrderError(f"samples = {samples!r}: the model's input delay is r = {o.r}; "
+                             f"advance it by an integer from 0 to {o.r}")
+        orders = replace(o, r=o.r - int(samples))
+        return replace(self, structure=replace(self.structure, orders=orders), _weights=None)
 
     def rescaled(self, y_scale, u_scale=None, v_scale=None) -> "HWLModel":
         """The same input--output map expressed in scaled signals

@@ -1,15 +1,27 @@
 """LCO branches of the sampled-data ROM loop: invariant circles of a discrete map.
 
 The nonlinear loop of :func:`casflutter.aeroelastic.simulate_loop` -- the HWL ROM of
-eq. (3) (sample time ``dt``) in feedback with Σs of eq. (7), coupled by a zero-order hold
-and propagated exactly -- is the map ``s_{k+1} = F(s_k, V)`` of the state
+eq. (3) (one sample per step ``h``) in feedback with Σs of eq. (7), coupled by a zero-order
+hold and propagated exactly -- is the map ``s_{k+1} = F(s_k, V)`` of the state
 
-    s_k = [x_s(t_k), u_{k-1}, ..., u_{k-L}, y_{k-1}, ..., y_{k-L}]
+    s_k = [x_s(t_k), u_{k-1}, ..., u_{k-L}, y_{k-1}, ..., y_{k-Ly}]
 
-(``L`` the ROM's largest lag; flap at rest):
+(``L`` the ROM's largest lag, ``Ly = max(L, 1)``, or ``max(L, 2)`` with the first-order hold;
+flap at rest):
 
     u_k = Cs x_s(t_k),   y_k = HWL(y_{k-L..k-1}, u_{k-L..k}),
-    x_s(t_{k+1}) = Ad x_s(t_k) + Bd V^2 y_k,   [Ad Bd] = expm([[As, Bs], [0, 0]] dt).
+    x_s(t_{k+1}) = Ad x_s(t_k) + B0 V^2 y_k [+ B1 V^2 (y_k - y_{k-1})],
+
+the force held over the step ``h`` by a zero-order hold or, with the bracket, a predictive
+first-order hold (:func:`casflutter.aeroelastic.simulate_loop` explains both;
+``Ad, B0, B1`` from :func:`casflutter.aeroelastic.structure_step`).
+
+The step is the ROM's sample time ``h = dt`` at every speed (eq. 8 as the paper writes it),
+or, with ``convective_V0 = V0``, ``h = dt V0 / V``: the aerodynamic recursion advances one
+sample per the same reduced time at every speed, so its time scale follows the reduced
+frequency (:func:`casflutter.aeroelastic.loop_sample_time`); ``Ad, Bd`` then depend on V
+(:func:`casflutter.aeroelastic.structure_step`, in closed form, so ``F`` is differentiable
+in V).
 
 Its flutter is a Neimark--Sacker bifurcation of the fixed point ``s = 0`` and its LCO is an
 invariant circle, not a periodic orbit: the LCO period is not a whole number of samples.
@@ -20,7 +32,7 @@ The circle is solved as a closed curve ``s(theta)``, a truncated Fourier series 
 
 the rotation number ``rho`` (samples per LCO period ``1 / rho``) unknown, closed by the
 integral phase condition against the previous circle and the continuation's linear
-condition.  The LCO frequency is ``rho / dt``.
+condition.  The LCO frequency is ``rho / h``.
 
 Stability: a perturbation of the circle is carried by the linearised cocycle
 ``DF(s(theta))`` over the rotation ``theta -> theta + 2 pi rho``; its exponents (the radii of
@@ -40,9 +52,10 @@ import time
 import casadi as ca
 import numpy as np
 import scipy.sparse as sp
-from scipy.linalg import expm
+from scipy.optimize import brentq
 
 from .._nlp import RootResult, solve_newton
+from ..aeroelastic import check_convective_V0, check_hold, loop_sample_time, structure_step
 from ..errors import ConfigError, ConvergenceError, DimensionError
 from ..ident import HWLModel, hwl_predict_function
 from ..structure import ModalStructure
@@ -50,9 +63,16 @@ from ._branch import BranchStart, run_from_hopf
 from ._normal_form import MultilinearForms, find_neimark_sacker, lyapunov_map
 from ._results import LCOBranch, LCOPoint, LCOSettings
 
-__all__ = ["rom_loop_map", "InvariantCircle", "rom_lco_branch"]
+__all__ = ["rom_loop_map", "rom_loop_flutter", "InvariantCircle", "rom_lco_branch"]
 
-def rom_loop_map(rom: HWLModel, structure: ModalStructure) -> ca.Function:
+def _history(rom: HWLModel, hold: str) -> tuple[int, int]:
+    """``(L, Ly)``: the input and output history lengths of the map's state."""
+    L = int(rom.max_lag)
+    return L, max(L, 2 if hold == "foh" else 1)
+
+
+def rom_loop_map(rom: HWLModel, structure: ModalStructure, *,
+                 convective_V0: float | None = None, hold: str = "zoh") -> ca.Function:
     """The sampled-data ROM loop as a CasADi map ``F(s, V) -> s_next`` (module docstring).
 
     Parameters
@@ -61,24 +81,31 @@ def rom_loop_map(rom: HWLModel, structure: ModalStructure) -> ca.Function:
         Discrete HWL ROM (eq. 3); its flap input, if any, is held at zero.
     structure : ModalStructure
         Σs (eq. 7) with as many modes as the ROM.
+    convective_V0 : float, optional
+        The ROM's identification speed index: the loop is stepped at ``rom.dt · V0 / V``
+        (module docstring); default ``rom.dt`` at every speed (eq. 8).
+    hold : {"zoh", "foh"}
+        The force's hold between samples (module docstring).
 
     Returns
     -------
     casadi.Function
-        ``F(s, V)`` with ``s`` of length ``2N + 2 L N``.
+        ``F(s, V)`` with ``s`` of length ``2N + (L + Ly) N``.
     """
-    N, L, dt = rom.n_modes, rom.max_lag, float(rom.dt)
+    N, dt = rom.n_modes, float(rom.dt)
     if structure.n_modes != N:
         raise DimensionError(f"the ROM has {N} modes but Σs has {structure.n_modes}")
+    check_convective_V0(convective_V0)
+    check_hold(hold)
+    L, Ly = _history(rom, hold)
     nx = 2 * N
-    E = expm(np.block([[structure.As, structure.Bs], [np.zeros((N, nx + N))]]) * dt)
-    Ad, Bd = ca.DM(E[:nx, :nx]), ca.DM(E[:nx, nx:])
     pred = hwl_predict_function(rom.structure, L + 1)
-    s = ca.SX.sym("s", nx + 2 * L * N)
+    s = ca.SX.sym("s", nx + (L + Ly) * N)
     V = ca.SX.sym("V")
+    Ad, B0, B1 = structure_step(structure)(loop_sample_time(dt, V, convective_V0))
     xs = s[:nx]
     uh = [s[nx + d * N:nx + (d + 1) * N] for d in range(L)]           # u_{k-1-d}
-    yh = [s[nx + L * N + d * N:nx + L * N + (d + 1) * N] for d in range(L)]
+    yh = [s[nx + L * N + d * N:nx + L * N + (d + 1) * N] for d in range(Ly)]
     uk = ca.mtimes(ca.DM(structure.Cs), xs)
     U = ca.vertcat(*[uh[d].T for d in reversed(range(L))], uk.T)      # rows k-L .. k
     Y = ca.vertcat(*[yh[d].T for d in reversed(range(L))], ca.DM.zeros(1, N))
@@ -88,14 +115,64 @@ def rom_loop_map(rom: HWLModel, structure: ModalStructure) -> ca.Function:
     if rom.has_v:
         args.append(ca.DM.zeros(L + 1, 1))
     yk = pred(*args).T
-    nxt = ca.vertcat(ca.mtimes(Ad, xs) + ca.mtimes(Bd, V * V * yk), uk, *uh[:L - 1], yk,
-                     *yh[:L - 1])
+    xs_next = ca.mtimes(Ad, xs) + ca.mtimes(B0, V * V * yk)
+    if hold == "foh":
+        xs_next += ca.mtimes(B1, V * V * (yk - yh[0]))
+    nxt = ca.vertcat(xs_next, uk, *uh[:L - 1], yk, *yh[:Ly - 1])
     return ca.Function("rom_loop_map", [s, V], [nxt], ["s", "V"], ["s_next"])
 
 
-def _rom_outputs(rom, structure, sensor_kind, mode_names, sensor_names):
-    N, L = rom.n_modes, rom.max_lag
-    s = ca.SX.sym("s", 2 * N + 2 * L * N)
+def rom_loop_flutter(rom: HWLModel, structure: ModalStructure, vrange, *, n_grid: int = 111,
+                     convective_V0: float | None = None, hold: str = "zoh") -> float | None:
+    """The flutter speed of the sampled-data ROM loop: its first Neimark--Sacker point in
+    ``vrange``, where the spectral radius of the map's linearisation at rest (its oscillatory
+    multipliers) crosses one.
+
+    Parameters
+    ----------
+    rom : HWLModel
+        Discrete HWL ROM (eq. 3).
+    structure : ModalStructure
+        Σs (eq. 7).
+    vrange : (float, float)
+        Speed-index range, scanned on ``n_grid`` points, the crossing refined by Brent's
+        method.
+    n_grid : int
+        Points of the scan (at least 3).
+    convective_V0, hold :
+        The loop (:func:`rom_loop_map`).
+
+    Returns
+    -------
+    float or None
+        ``None`` when the loop is unstable at the low end or does not flutter in the range.
+    """
+    F = rom_loop_map(rom, structure, convective_V0=convective_V0, hold=hold)
+    n = int(F.size1_in(0))
+    s, V = ca.SX.sym("s", n), ca.SX.sym("V")
+    jac = ca.Function("loop_jacobian", [s, V], [ca.jacobian(F(s, V), s)])
+    zero = np.zeros(n)
+
+    def radius(v: float) -> float:
+        lam = np.linalg.eigvals(np.asarray(jac(zero, v), float))
+        osc = lam[np.abs(lam.imag) > 1e-9]
+        return float(np.max(np.abs(osc))) - 1.0 if osc.size else -1.0
+
+    grid = np.linspace(max(float(vrange[0]), 1e-3), float(vrange[1]), int(n_grid))
+    r = np.array([radius(v) for v in grid])
+    if r[0] >= 0:
+        return None
+    up = np.flatnonzero((r[:-1] < 0) & (r[1:] >= 0))
+    if up.size == 0:
+        return None
+    k = int(up[0])
+    return float(brentq(radius, grid[k], grid[k + 1], xtol=1e-10))
+
+
+def _rom_outputs(rom, structure, sensor_kind, mode_names, sensor_names, hold):
+    N = rom.n_modes
+    L, Ly = _history(rom, hold)
+    s = ca.SX.sym("s", 2 * N + (L + Ly) * N)
     V = ca.SX.sym("V")
     xs = s[:2 * N]
     u = ca.mtimes(ca.DM(structure.Cs), xs)
@@ -104,9 +181,11 @@ def _rom_outputs(rom, structure, sensor_kind, mode_names, sensor_names):
         raise ConfigError("the LCO outputs need modal sensor rows (sensor kind 'displacement', "
                           "'velocity' or 'acceleration'), not the paper's literal state rows")
     if sensor_kind == "acceleration":
-        # left limit at t_k, as simulate_loop reads accelerometers: the held force V^2 y_{k-1}
-        y_prev = s[2 * N + L * N:2 * N + L * N + N]
-        acc = ca.mtimes(ca.DM(structure.Cv @ structure.As), xs) + structure.alpha * V * V * y_prev
+        # left limit at t_k, as simulate_loop reads accelerometers: the held force V^2 y_{k-1},
+        # or its first-order extrapolation V^2 (2 y_{k-1} - y_{k-2})
+        y1 = s[2 * N + L * N:2 * N + L * N + N]
+        y_left = 2 * y1 - s[2 * N + (L + 1) * N:2 * N + (L + 2) * N] if hold == "foh" else y1
+        acc = ca.mtimes(ca.DM(structure.Cv @ structure.As), xs) + structure.alpha * V * V * y_left
         z = ca.mtimes(H, acc)
     else:
         z = ca.mtimes(H, u)
@@ -340,12 +419,12 @@ def _convergent(rho: float, tol: float, max_q: int) -> tuple[int, float]:
 class _MapDisc:
     """Adaptor of :class:`InvariantCircle` for the continuation engine."""
 
-    def __init__(self, circ: InvariantCircle, names, outputs: ca.Function, dt: float,
+    def __init__(self, circ: InvariantCircle, names, outputs: ca.Function, step,
                  n_fine: int = 256):
         self.circ = circ
         self.iV = circ.iV
         self.names = names
-        self.dt = dt
+        self.step = step                   # V -> the loop's step h [s]
         self._theta = 2.0 * np.pi * np.arange(n_fine) / n_fine
         self._h = outputs.map(n_fine)
         self.w2 = np.ones((circ.n, 1))     # state weights of size(); set from the mode shape
@@ -371,7 +450,7 @@ class _MapDisc:
         amp = 0.5 * (Y.max(axis=1) - Y.min(axis=1))
         mean = Y.mean(axis=1)
         normal, tang, mults, _ = circ.normal_multiplier(X)
-        period = self.dt / abs(rho)
+        period = self.step(V) / abs(rho)
         return LCOPoint(V=V, period=period, freq_hz=1.0 / period,
                         amplitude={n: float(a) for n, a in zip(self.names, amp)},
                         mean={n: float(a) for n, a in zip(self.names, mean)},
@@ -382,7 +461,8 @@ class _MapDisc:
 def rom_lco_branch(rom: HWLModel, structure: ModalStructure, vrange, settings: LCOSettings | None = None,
                    *, mode_names=None, sensor_names=None, problem: str = "rom",
                    speed_scale: float = 1.0, speed_unit: str = "speed index",
-                   time_unit: str = "s") -> LCOBranch:
+                   time_unit: str = "s", convective_V0: float | None = None,
+                   hold: str = "zoh") -> LCOBranch:
     """LCO branch (invariant circles) of the sampled-data ROM loop from its flutter point.
 
     Parameters
@@ -402,12 +482,19 @@ def rom_lco_branch(rom: HWLModel, structure: ModalStructure, vrange, settings: L
         Output names (default ``u1..``, ``z1..``).
     problem, speed_scale, speed_unit, time_unit :
         Labels of the result.
+    convective_V0 : float, optional
+        The ROM's identification speed index: the loop is stepped at ``rom.dt · V0 / V``,
+        its aerodynamic time scale following the reduced frequency (:func:`rom_loop_map`);
+        default ``rom.dt`` at every speed (eq. 8).
+    hold : {"zoh", "foh"}
+        The force's hold between samples (:func:`rom_loop_map`).
 
     Returns
     -------
     LCOBranch
         ``system == "rom_loop"``; ``hopf.discrete`` is True and ``hopf.lyapunov`` is the
-        Neimark--Sacker coefficient ``d``; ``freq_hz`` is ``rho / dt``.
+        Neimark--Sacker coefficient ``d``; ``freq_hz`` is ``rho / h``, ``h`` the loop's step
+        at the point's speed.
 
     Raises
     ------
@@ -435,9 +522,9 @@ def rom_lco_branch(rom: HWLModel, structure: ModalStructure, vrange, settings: L
     if not 0 < lo < hi:
         raise ConfigError(f"vrange = ({lo}, {hi}) must satisfy 0 < lo < hi")
     t0 = time.perf_counter()
-    F = rom_loop_map(rom, structure)
+    F = rom_loop_map(rom, structure, convective_V0=convective_V0, hold=hold)
     names, units, hfun = _rom_outputs(rom, structure, settings.sensor_kind, mode_names,
-                                      sensor_names)
+                                      sensor_names, hold)
     forms = MultilinearForms(F)
     cp = find_neimark_sacker(forms, (lo, hi), settings.n_grid, speed_scale=speed_scale,
                              speed_unit=speed_unit)
@@ -453,15 +540,19 @@ def rom_lco_branch(rom: HWLModel, structure: ModalStructure, vrange, settings: L
     qhat = cp.q * np.exp(-1j * np.angle(cp.q[dom])) / abs(cp.q[dom])
     circ = InvariantCircle(F, settings.harmonics, tol=settings.tol,
                            max_newton=settings.max_newton)
-    disc = _MapDisc(circ, names, hfun, float(rom.dt))
+    def step(V: float) -> float:
+        return float(loop_sample_time(float(rom.dt), float(V), convective_V0))
+
+    disc = _MapDisc(circ, names, hfun, step)
+    h0 = step(cp.V)
     rho0 = theta0 / (2.0 * np.pi)
     # the critical mode as a circle: s(theta) = Re(qhat e^{i theta})
     mode_vals = np.real(qhat[:, None] * np.exp(1j * circ.theta)[None, :])
     phi = circ.from_values(mode_vals, 0.0, 0.0)
     phi[circ.irho] = phi[circ.iV] = 0.0
     start = BranchStart(
-        cp=cp, lyapunov=d, radial=d, omega=theta0 / float(rom.dt),
-        freq_hz=rho0 / float(rom.dt), discrete=True, qhat=qhat, dominant=dom,
+        cp=cp, lyapunov=d, radial=d, omega=theta0 / h0,
+        freq_hz=rho0 / h0, discrete=True, qhat=qhat, dominant=dom,
         guess=lambda eps, V: circ.from_values(eps * mode_vals, rho0, V), phi=phi,
         ref=circ.reference(phi), n_points=circ.M, period0=rho0, hint="try more harmonics")
     t1b = time.perf_counter()

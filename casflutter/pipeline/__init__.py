@@ -1,7 +1,11 @@
 """The study run: every stage of the paper wired by one validated configuration.
 
-- :func:`run` — ``run(config) -> RunResult``: the stages of :mod:`._run` on a truth problem;
-  the result has a typed field per stage and :meth:`RunResult.summary` (``summary.json``).
+- :func:`run` — ``run(config) -> RunResult``: the stages of :mod:`._run` on any problem (a
+  truth, a wing or GAF file, a plant family file), each route chosen in one place
+  (:data:`ROUTES`); the result has a typed result per stage (:class:`ModelStage`,
+  :class:`FlutterStage`, :class:`LcoResult`, :class:`ControllerStage`, ...) and
+  :meth:`RunResult.summary` (``summary.json``).
+- :func:`design_family` — the family a configuration's controller stage designs on.
 - :func:`load_config` / :class:`RunConfig` — the TOML configuration; each table is the
   settings class of its stage.
 """
@@ -10,11 +14,15 @@ from ._config import (STAGES, ClosedLoopSection, ControllerSettings, DataSection
                       FlutterSection, LcoSection, ParametricSection, ProblemSection, RomSection,
                       RunConfig, SensorsSection, SolverSection, VerifySection, config_path,
                       default_config_path, flutter_config, load_config)
-from ._result import ClosedLoopChecks, LcoResult, ParametricResult, RunResult, SimulationCheck
-from ._run import run
+from ._control import ControllerStage
+from ._model import ROUTES, FlutterStage, ModelStage, ParametricResult, Route
+from ._result import ClosedLoopChecks, LcoResult, RunResult, SimulationCheck
+from ._run import design_family, model_stages, run
 
 __all__ = [
     "run", "RunResult", "LcoResult", "ParametricResult", "SimulationCheck", "ClosedLoopChecks",
+    "ModelStage", "FlutterStage", "ControllerStage", "ROUTES", "Route", "design_family",
+    "model_stages",
     "RunConfig", "load_config", "default_config_path", "config_path", "flutter_config",
     "STAGES",
     "ProblemSection", "DataSection", "RomSection", "FlutterSection", "LcoSection",

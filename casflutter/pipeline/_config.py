@@ -34,7 +34,7 @@ impossible values fail with a :class:`~casflutter.errors.ConfigError` naming the
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 from .._nlp import check_solver_options
@@ -229,63 +229,74 @@ class LcoSection:
 
 @dataclass(frozen=True)
 class ControllerSettings(SynthesisOptions):
-    """``[controller]``: the fixed-order robust synthesis on the LFT at Vf (paper §III.C):
-    :class:`casflutter.design.SynthesisOptions` with the controller order, the starts and the
-    design speeds."""
+    """``[controller]``: the fixed-order controller and its design (paper §III.C), with the
+    H∞ settings of :class:`casflutter.design.SynthesisOptions`."""
 
+    method: str = "auto"
+    """``"multispeed"``: one controller that keeps the run's loop family decaying over
+    ``interval`` with the smallest worst H∞ objective over the speeds
+    (:func:`casflutter.design.design_over_speeds`).  ``"paper"``: the paper's design, γ of
+    the LFT at Vf (eq. 14-16) with the flap-rate weight, its interval only measured.
+    ``"auto"``: ``"multispeed"`` on a plant family and on a ROM whose time follows the
+    speed (``rom.convective``), ``"paper"`` on the paper's frozen ROM of eq. 8."""
     order: int = 3
-    """Controller order."""
-    method: str = "hinf"
-    """``"hinf"``: the paper's design, γ of the LFT at Vf (eq. 14-16), with ``interval`` a
-    continuation of its stable interval (:func:`casflutter.design.design_flutter_controller`).
-    ``"interval"``: stability over ``interval`` first, the order second
-    (:func:`casflutter.design.design_interval_controller`): a full-order controller of the
-    ROM loop with the flap behind the servo of ``flap_rate_bandwidth``, continued down over
-    the interval, then reduced through ``reduction_orders`` to ``order``; γ is measured, not
-    optimised.  Needs ``interval`` and ``rom.convective = true`` (a loop that stands for the
-    wing at every speed).  Minutes, not seconds: the full order is continued first."""
-    reduction_orders: tuple = (20, 14, 10, 8)
-    """Intermediate orders of ``method = "interval"`` (those between ``order`` and the full
-    order are used, highest first)."""
-    starts: int = 4
-    """Starts of the synthesis (the first is the zero controller unless ``zero_start`` is
-    false, the others seeded random)."""
-    speeds: tuple = (1.0,)
-    """Nominal speeds of the design plants as multiples of Vf (must contain 1.0, the plant
-    the verification checks): the LFT (eq. 14) is built at each and the worst-case norm is
-    minimised; ``[1.0]`` is the paper's design."""
-    interval: tuple = ()
-    """Speed-index interval ``[lo, hi]`` over which the ROM loop ΣAE(V) must stay stable (the
-    interval design of :func:`casflutter.design.design_flutter_controller`); ``[]`` for the
-    paper's design on the LFT alone."""
-    n_speeds: int = 40
-    """Stability constraints spread over ``interval``."""
+    """Controller order (the paper's 3)."""
+    interval: tuple = (0.05, 2.4)
+    """``[lo, hi]`` over which the loop must decay (``method = "multispeed"``), in the
+    family's speed unit (the speed index for a ROM loop)."""
     interval_decay: float = 0.05
-    """Decay rate [rad/s] required of ΣAE(V) at those speeds."""
-    steps: int = 4
-    """Continuation steps of the interval's upper end."""
+    """Decay rate [rad per time unit] required of the closed loop at every speed of
+    ``interval``."""
+    n_speeds: int = 16
+    """Speeds of the stability objective on each interval the design tries (its dense
+    check uses 8x as many)."""
+    hinf_speeds: int = 5
+    """Speeds of the multi-speed H∞ objective (each speed's disturbance-to-sensor channels
+    with the flap-rate weight); 0: stability only."""
+    random_starts: int = 2
+    """Seeded random starts of the multi-speed design at the target order."""
+    full_order: bool = False
+    """When no start at the target order holds the interval: continue a full-order LQG
+    controller down from the top and lower its order (minutes, not seconds)."""
+    reduction_orders: tuple = (20, 14, 10, 8, 6)
+    """Intermediate orders of that order continuation (those between ``order`` and the full
+    order are used, highest first)."""
+    speeds: tuple = (1.0,)
+    """The paper's design (``method = "paper"``): the speeds of its design plants as
+    multiples of Vf, containing 1.0 (the plant the verification checks); the LFT (eq. 14) is
+    built at each and the worst-case norm minimised.  ``[1.0]`` is the paper's design."""
+    servo_omega: float = 251.3
+    """Natural frequency [rad per time unit] of the flap servo in front of a ROM loop and of
+    the truth's linearisation in the design and the verification (the seed wing's 40 Hz);
+    0: the flap is ideal."""
+    margins: tuple = (6.0, 45.0)
+    """Gain (dB) and phase (degrees) margins of the robust flutter speed
+    (:func:`casflutter.verify.verify_family`)."""
+    starts: int = 4
+    """Starts of the paper's synthesis (the first is the zero controller unless
+    ``zero_start`` is false, the others seeded random)."""
     strictly_proper: bool = True
     """``Dk = 0`` (:class:`casflutter.design.SynthesisOptions`): the seed wing's
     accelerometers see the flap directly, and any ``Dk`` makes its loop algebraically
     singular at some speed above Vf."""
     zero_start: bool = False
-    """The first start is the zero controller (otherwise every start is seeded random)."""
+    """The first start of the paper's synthesis is the zero controller (otherwise every start
+    is seeded random)."""
     max_outer: int = 80
-    """Outer iterations per start (:class:`casflutter.design.SynthesisOptions`)."""
+    """H∞ iterations per start (:class:`casflutter.design.SynthesisOptions`)."""
     max_stab_rounds: int = 300
     """Stabilisation rounds per start (:class:`casflutter.design.SynthesisOptions`)."""
     flap_rate_weight: float = 0.003
-    """Weight ``w`` of the flap rate in the H∞ plants (:func:`casflutter.design.with_flap_rate`,
-    per rad/s of flap rate); 0: the paper's design without it.  The seed wing's servo
-    saturates at 300°/s; without the weight its order-3 design needs far more to hold the
-    established LCO."""
+    """Weight ``w`` of the flap rate in the H∞ plants (per rad/s of flap rate); 0: none.  The
+    seed wing's servo saturates at 300°/s; without the weight a controller asks far more to
+    hold the established LCO."""
     flap_rate_bandwidth: float = 251.3
     """Bandwidth of the flap-rate filter [rad per time unit] (the seed wing's 40 Hz servo)."""
 
     def __post_init__(self):
         super().__post_init__()
         _integer("order", self.order, 0)
-        for key in ("flap_rate_weight", "flap_rate_bandwidth"):
+        for key in ("flap_rate_weight", "flap_rate_bandwidth", "servo_omega"):
             value = getattr(self, key)
             if not (isinstance(value, (int, float)) and not isinstance(value, bool)
                     and math.isfinite(value) and value >= 0):
@@ -294,32 +305,38 @@ class ControllerSettings(SynthesisOptions):
             raise ConfigError(f"controller.flap_rate_bandwidth = {self.flap_rate_bandwidth!r}: "
                               "> 0 when flap_rate_weight > 0")
         _integer("starts", self.starts, 1)
+        _integer("random_starts", self.random_starts, 0)
         sp = finite_numbers("speeds", self.speeds, what="a non-empty list of positive "
                             "multiples of Vf, containing 1.0")
         if not sp or not all(x > 0 for x in sp) or 1.0 not in sp:
             raise ConfigError(f"speeds = {list(sp)!r}: a non-empty list of positive multiples "
                               "of Vf, containing 1.0 (the nominal plant)")
         object.__setattr__(self, "speeds", sp)
-        iv = finite_numbers("interval", self.interval, what="[] or [lo, hi] speed indices")
-        if iv and (len(iv) != 2 or not 0 <= iv[0] < iv[1]):
-            raise ConfigError(f"controller.interval = {list(iv)!r}: [] or [lo, hi] speed "
-                              "indices with 0 <= lo < hi")
+        _integer("hinf_speeds", self.hinf_speeds, 0)
+        iv = finite_numbers("interval", self.interval, what="[lo, hi] speeds")
+        if len(iv) != 2 or not 0 <= iv[0] < iv[1]:
+            raise ConfigError(f"controller.interval = {list(iv)!r}: [lo, hi] speeds with "
+                              "0 <= lo < hi")
         object.__setattr__(self, "interval", iv)
         _integer("n_speeds", self.n_speeds, 2)
-        _integer("steps", self.steps, 1)
-        if self.method not in ("hinf", "interval"):
-            raise ConfigError(f"controller.method = {self.method!r}: allowed 'hinf', 'interval'")
-        if self.method == "interval" and (not iv or self.order < 1):
-            raise ConfigError("controller.method = \"interval\" holds controller.interval = "
-                              "[lo, hi] with a dynamic controller: give the interval and "
-                              f"order >= 1 (got interval {list(iv)!r}, order {self.order!r})")
+        if self.method not in ("auto", "multispeed", "paper"):
+            raise ConfigError(f"controller.method = {self.method!r}: allowed 'auto', "
+                              "'multispeed', 'paper'")
+        if self.method == "multispeed" and self.strictly_proper and self.order < 1:
+            raise ConfigError("controller.method = \"multispeed\" with strictly_proper = true "
+                              f"needs order >= 1 (got {self.order!r})")
         ro = self.reduction_orders
         if isinstance(ro, (str, bytes)) or not all(
                 isinstance(o, int) and not isinstance(o, bool) and o >= 1 for o in ro):
             raise ConfigError(f"controller.reduction_orders = {ro!r}: a list of integers >= 1")
         object.__setattr__(self, "reduction_orders", tuple(ro))
-        if not self.interval_decay >= 0:
+        if not (isinstance(self.interval_decay, (int, float)) and self.interval_decay >= 0):
             raise ConfigError(f"interval_decay = {self.interval_decay!r}: must be >= 0")
+        mg = finite_numbers("margins", self.margins, 2, what="[gain margin dB, phase margin deg]")
+        if not (mg[0] >= 0 and 0 <= mg[1] <= 180):
+            raise ConfigError(f"controller.margins = {list(mg)!r}: a gain margin >= 0 dB and a "
+                              "phase margin in [0, 180] degrees")
+        object.__setattr__(self, "margins", mg)
         object.__setattr__(self, "ipopt", check_solver_options(self.ipopt, "ipopt"))
 
 
@@ -529,9 +546,14 @@ class RunConfig:
                               f"{frozen_only[0]!r} simulates the sampled ROM loop, whose "
                               "time is frozen at V0; set rom.convective = false or leave "
                               f"{', '.join(map(repr, frozen_only))} out of stages")
-        if (self.controller.method == "interval" and "controller" in stages
-                and not self.rom.convective):
-            raise ConfigError("controller.method = \"interval\" designs on the ROM loop with "
+        problem = self.problem.load()
+        n_modes = getattr(problem, "n_modes", None)    # None: a plant family, no ROM
+        if self.controller.method == "auto":
+            method = "multispeed" if n_modes is None or self.rom.convective else "paper"
+            object.__setattr__(self, "controller", replace(self.controller, method=method))
+        if (self.controller.method == "multispeed" and "controller" in stages
+                and n_modes is not None and not self.rom.convective):
+            raise ConfigError("controller.method = \"multispeed\" designs on the ROM loop with "
                               "the flap behind the servo at every speed of the interval, which "
                               "the ROM of eq. 8 (Σf frozen at V0) does not stand for: set "
                               "rom.convective = true")
@@ -546,7 +568,8 @@ class RunConfig:
             raise ConfigError("stages: 'suppression' reads acceleration or displacement "
                               "sensors; set sensors.kind accordingly")
         object.__setattr__(self, "stages", tuple(s for s in STAGES if s in stages))
-        n_modes = self.problem.load().n_modes
+        if n_modes is None:
+            return
         if self.sensors.rows:
             check_sensor_rows(self.sensors.rows, n_modes, key="sensors.rows",
                               problem=self.problem.name)

@@ -56,8 +56,14 @@ def _problem(result):
 
 
 def _structure(result):
+    """Σs of the run's ROM or RFA loop (``None`` for a family file)."""
     system = result.system if result.system is not None else getattr(result, "rfa_system", None)
-    return system.structure
+    return None if system is None else system.structure
+
+
+def _time_unit(result) -> str:
+    structure = _structure(result)
+    return structure.time_unit if structure is not None else result.model.family.time_unit
 
 
 def check_output_folder(out_dir, *, overwrite: bool = False) -> Path:
@@ -156,7 +162,7 @@ def _pole_check(result) -> dict | None:
           else (result.data.dt if result.data is not None else None))
     act = cfg.closed_loop.actuator_omega if "closed_loop" in cfg.stages else None
     return controller_pole_check(result.controller, dt=dt, actuator_omega=act,
-                                 time_unit=_structure(result).time_unit)
+                                 time_unit=_time_unit(result))
 
 
 def log_flags(result) -> None:
@@ -176,23 +182,43 @@ def _time_base(sys, time_unit: str) -> dict:
             "frequency_unit": f"rad/{time_unit}"}
 
 
-def _certified(ver, scale, result=None) -> dict:
-    """γ and the certified speed intervals of ``ver``; with a ``result`` whose ROM's time
-    scales with V, the exact interval is the scaled loop's (``RunResult.rom_stable_V``)."""
+def _certified(ver, scale) -> dict:
+    """γ and the speed intervals of the LFT at Vf (eq. 10-16) in ``ver``."""
     def num(x):
         return None if x is None or not math.isfinite(float(x)) else float(x)
-    scaled = result is not None and result.convective_V0 is not None
-    note = ("speed intervals over which the loop is certified stable: small-gain "
-            "(eq. 16, from gamma) and exact (eq. 10-15); each in every unit the problem has")
-    if scaled:
-        note += ("; the ROM's time scales with V, so exact_V is its scaled loop's (flap "
-                 "behind the servo), the small-gain intervals the LFT's frozen at Vf")
     return {"stable": bool(ver.stable), "gamma": num(ver.gamma),
             "gamma_delta": None if ver.hinf_delta is None else num(ver.hinf_delta.gamma),
             "small_gain_V": interval_values(ver.small_gain_V, scale),
             "small_gain_V_delta": interval_values(ver.small_gain_V_delta, scale),
-            "exact_V": interval_values(result.rom_stable_V if scaled else ver.exact_V, scale),
-            "note": note}
+            "exact_V": interval_values(ver.exact_V if ver.stable else None, scale),
+            "note": "speed intervals over which the LFT at Vf (eq. 14, Σf frozen at Vf, flap "
+                    "ideal) is certified stable: small-gain (eq. 16, from gamma) and exact "
+                    "(eq. 10-15); each in every unit the problem has"}
+
+
+def _families_certified(result, scale) -> dict:
+    """The verification layer's certificate on each model (design family, truth)."""
+    out = {}
+    for name, check in result.control.checks.items():
+        iv = check.stable_interval
+        out[name] = {"family": check.family, "speed_unit": check.speed_unit,
+                     "stable_interval": interval_values(iv, scale) if scale is not None
+                     else (None if iv is None else list(iv)),
+                     "absolute_flutter_speed": check.absolute_flutter_speed,
+                     "robust_flutter_speed": check.robust_flutter_speed,
+                     "margins_thresholds": [check.gain_margin_db, check.phase_margin_deg]}
+    return out
+
+
+def _family_signals(result) -> tuple[list, list]:
+    """``inputs`` / ``outputs`` of a controller designed on a family file: its measurements
+    and controls, by name, with their units."""
+    fam = result.control.family
+    sig = fam.signals
+    units_out = dict(zip(sig.outputs, sig.output_units))
+    units_in = dict(zip(sig.inputs, sig.input_units))
+    return ([{"name": n, "unit": units_out[n]} for n in sig.measurements],
+            [{"name": n, "unit": units_in[n]} for n in sig.controls])
 
 
 def controller_document(result) -> dict:
@@ -214,26 +240,46 @@ def controller_document(result) -> dict:
     """
     K, ver, cfg = result.controller, result.verification, result.config
     problem, structure = _problem(result), _structure(result)
+    feedback = result.control.family.feedback
+    doc = {"format": "casflutter-controller/1",
+           "casflutter_version": provenance()["casflutter_version"],
+           **controller_to_json(K), "feedback": feedback}
+    if structure is None:     # a family file: its own signal names, units and speed unit
+        fam = result.control.family
+        inputs, outputs = _family_signals(result)
+        doc.update({"time_base": _time_base(K, fam.time_unit), "inputs": inputs,
+                    "outputs": outputs,
+                    "sign_convention": f"u = {'+' if feedback == 'positive' else '-'}K y: the "
+                                       "controls are K applied to the measurements, with the "
+                                       f"family's {feedback} feedback",
+                    "design": {"problem": cfg.problem.name, "order": int(K.nstates),
+                               "speed_unit": fam.speed_unit, "seed": cfg.seed},
+                    "certified": _families_certified(result, None),
+                    "poles": _pole_check(result)})
+        return doc
     scale = speed_scale(problem)
     names = tuple(structure.sensor_names)
     units = sensor_units(problem, structure, bool(cfg.sensors.rows))
     if len(names) != K.ninputs:   # pragma: no cover - K acts on the structure's sensors
         names = tuple(f"zm[{j}]" for j in range(K.ninputs))
         units = ("",) * K.ninputs
-    doc = {"format": "casflutter-controller/1",
-           "casflutter_version": provenance()["casflutter_version"],
-           **controller_to_json(K),
-           "time_base": _time_base(K, scale.time_unit),
-           "inputs": [{"name": n, "signal": f"zm[{j}]", "unit": u, "kind": structure.sensor}
-                      for j, (n, u) in enumerate(zip(names, units))],
-           "outputs": [{"name": "flap deflection command", "signal": "v", "unit": FLAP_UNIT}],
-           "sign_convention": SIGN_CONVENTION,
-           "design": {"problem": cfg.problem.name, "order": int(K.nstates),
-                      "speed_index_definition": scale.definition,
-                      "Vf": speed_values(ver.Vf if ver is not None else result.Vf, scale),
-                      "seed": cfg.seed},
-           "certified": None if ver is None else _certified(ver, scale, result),
-           "poles": _pole_check(result)}
+    servo = cfg.controller.servo_omega
+    doc.update({
+        "time_base": _time_base(K, scale.time_unit),
+        "inputs": [{"name": n, "signal": f"zm[{j}]", "unit": u, "kind": structure.sensor}
+                   for j, (n, u) in enumerate(zip(names, units))],
+        "outputs": [{"name": "v", "signal": "v", "unit": FLAP_UNIT,
+                     "description": "flap deflection command" + (
+                         f" (to the flap servo, {servo:g} rad/{scale.time_unit})"
+                         if servo > 0 else "")}],
+        "sign_convention": SIGN_CONVENTION,
+        "design": {"problem": cfg.problem.name, "order": int(K.nstates),
+                   "speed_index_definition": scale.definition,
+                   "Vf": speed_values(ver.Vf if ver is not None else result.Vf, scale),
+                   "seed": cfg.seed},
+        "certified": {**({} if ver is None else {"lft": _certified(ver, scale)}),
+                      **_families_certified(result, scale)},
+        "poles": _pole_check(result)})
     return doc
 
 
@@ -317,16 +363,18 @@ def _controller_mat(result, doc: dict) -> dict:
         "input_units": np.array([d["unit"] for d in doc["inputs"]], dtype=object),
         "output_names": np.array([d["name"] for d in doc["outputs"]], dtype=object),
         "output_units": np.array([d["unit"] for d in doc["outputs"]], dtype=object),
-        "sign_convention": SIGN_CONVENTION,
-        "speed_index_definition": doc["design"]["speed_index_definition"],
+        "sign_convention": doc["sign_convention"],
+        "speed_index_definition": doc["design"].get("speed_index_definition",
+                                                    doc["design"].get("speed_unit", "")),
+        "feedback": doc["feedback"],
         "casflutter_version": doc["casflutter_version"]})
-    vf = doc["design"]["Vf"] or {}
+    vf = doc["design"].get("Vf") or {}
     for key, value in vf.items():
         mat[f"Vf_{key}"] = np.nan if value is None else float(value)
+    exact = result.rom_stable_V
+    mat["certified_V"] = _mat_interval(exact)
     if ver is not None:
         mat["small_gain_V"] = _mat_interval(ver.small_gain_V)
-        exact = result.rom_stable_V
-        mat["exact_V"] = _mat_interval(exact)
         scale = speed_scale(_problem(result))
         if scale.has_airspeed:
             for name, pair in (("small_gain", ver.small_gain_V), ("exact", exact)):
@@ -357,9 +405,18 @@ def label_summary(summary: dict, result) -> dict:
     dict
         ``summary``.
     """
+    check = _pole_check(result)
+    if _structure(result) is None:        # a family file: its own units
+        fam = result.model.family
+        summary["units"] = {"speed": fam.speed_unit, "time": fam.time_unit,
+                            "frequency": f"rad/{fam.time_unit}"}
+        if isinstance(summary.get("controller"), dict):
+            summary["controller"]["poles"] = check
+        return _provenance_flags(summary, result, check)
     scale = speed_scale(_problem(result))
     summary["units"] = units_block(scale)
-    for key in ("flutter", "flutter_truth", "flutter_frozen", "flutter_parametric"):
+    for key in ("flutter", "flutter_truth", "flutter_frozen", "flutter_parametric",
+                "flutter_convective"):
         block = summary.get(key)
         if isinstance(block, dict) and block.get("V") is not None:
             sv = speed_values(block["V"], scale)
@@ -368,17 +425,21 @@ def label_summary(summary: dict, result) -> dict:
                     block[k] = sv[k]
     ctl = summary.get("controller")
     ver = result.verification
-    check = _pole_check(result)
-    if isinstance(ctl, dict) and ver is not None:
-        ctl["Vf"] = speed_values(ver.Vf if ver.Vf is not None else result.Vf, scale)
-        ctl["certified"] = {"small_gain_V": interval_values(ver.small_gain_V, scale),
-                            "exact_V": interval_values(result.rom_stable_V, scale)}
+    if isinstance(ctl, dict):
+        if ver is not None:
+            ctl["Vf"] = speed_values(ver.Vf if ver.Vf is not None else result.Vf, scale)
+        ctl["certified"] = _families_certified(result, scale)
         ctl["poles"] = check
     lco = summary.get("lco")
     if isinstance(lco, dict) and result.lco.rom.sensors is not None:
         # the amplitudes are of the sensor readings: say in what
         lco["amplitude_units"] = list(sensor_units(_problem(result), _structure(result),
                                                    bool(result.config.sensors.rows)))
+    return _provenance_flags(summary, result, check)
+
+
+def _provenance_flags(summary: dict, result, check) -> dict:
+    """The version, thread settings and controller-pole flags of a run's summary."""
     info = dict(getattr(result, "provenance", None) or {}) or provenance(seed=result.config.seed)
     summary["casflutter_version"] = info.get("casflutter_version")
     summary["threads"] = info.get("threads")

@@ -11,22 +11,18 @@ import control
 import numpy as np
 
 from .._format import result_repr
-from ..aeroelastic import (AeroelasticLFT, AeroelasticSystem, FlutterResult, LoopSimulation,
-                           ParametricSystem, PKResult, RFASystem)
-from ..data import IOData
-from ..design import IntervalDesign, SynthesisResult
+from ..aeroelastic import FlutterResult, LoopSimulation
 from .._outputs import plain_json
-from ..ident import CommonDenominatorResult, FitReport, IdentificationResult
 from ..lco import LCOBranch
-from ..realize import ParametricROM, RationalApproximation, Realization
 from ..truth import AeroelasticTruth, SuppressionResult, TruthLco, TruthLoopSweep
-from ..verify import SpeedSweep, StabilityInterval, VerificationReport
 from ._config import RunConfig
+from ._control import ControllerStage
 from ._exports import label_summary
+from ._model import FlutterStage, ModelStage, ParametricResult
 from ._units import speed_scale, speed_values
 
 __all__ = ["RunResult", "LcoResult", "ParametricResult", "SimulationCheck",
-           "ClosedLoopChecks"]
+           "ClosedLoopChecks", "ModelStage", "FlutterStage", "ControllerStage"]
 
 
 @dataclass(frozen=True)
@@ -67,27 +63,6 @@ class LcoResult:
     V_hopf_loop: float | None = None
     truth_branch: LCOBranch | None = None
     rom_branch: LCOBranch | None = None
-
-
-@dataclass(frozen=True)
-class ParametricResult:
-    """The parametric-ROM stage.
-
-    Attributes
-    ----------
-    rom : ParametricROM
-        Common-denominator ROMs at several speeds, interpolated in V.
-    system : ParametricSystem
-        Its ΣAE(V).
-    flutter : FlutterResult
-        Its flutter search.
-    """
-
-    __repr__ = result_repr
-
-    rom: ParametricROM
-    system: ParametricSystem
-    flutter: FlutterResult
 
 
 @dataclass(frozen=True)
@@ -190,87 +165,39 @@ def _rel(a, b):
 
 @dataclass(frozen=True)
 class RunResult:
-    """Everything a study run produced, one typed field per stage (``None``: not run).
+    """Everything a study run produced, one typed result per stage (``None``: not run).
 
     Attributes
     ----------
     config : RunConfig
         The configuration.
-    truth : AeroelasticTruth or None
-        The truth simulator (``None`` on a wing file).
-    data : IOData or None
-        The chirp records of the last identification (``None`` on a GAF wing file, which
-        has ``Q(ik)`` instead of records; so are ``identification``, ``fit`` and
-        ``realization``).
-    identification : IdentificationResult or CommonDenominatorResult or None
-        The ROM (``.model``).
-    identification_history : tuple of (float, float)
-        ``(V0, Vf_ROM)`` of every identification (more than one with ``rom.v0_iterations``).
-    fit : FitReport
-        Free-run fit of the ROM on its records (paper Fig. 7).
-    realization : Realization
-        Σf by ERA and Tustin (eq. 5).
-    system : AeroelasticSystem
-        ΣAE(V) (eq. 8-9); on a GAF wing file with Σf of the RFA frozen at the flutter speed
-        (``None`` when the RFA has ``p`` terms: no proper Σf).
-    flutter : FlutterResult
-        Flutter search of the ROM.
-    flutter_truth : FlutterResult or None
-        Of the truth (``None`` on a wing file).
-    flutter_frozen : FlutterResult or None
-        Of the truth with its aerodynamics frozen at ``V0`` (stage ``frozen``).
-    parametric : ParametricResult or None
-        Stage ``parametric``.
+    problem : object
+        What ``[problem]`` loaded: a truth, a wing file, a GAF file or a family file.
+    route : str
+        The problem's route (:data:`casflutter.pipeline.ROUTES`): ``"truth"``, ``"wing"``,
+        ``"gaf"`` or ``"family"``.
+    model : ModelStage
+        The model stages: the ROM (records, identification, Σf) or the RFA, and the loop
+        family the analyses take.
+    flutters : FlutterStage
+        Every flutter search: the model's (the paper's route), the truth's, the frozen and
+        parametric ROMs', the RFA's and p–k.
     lco : LcoResult or None
         Stage ``lco``.
-    lft : AeroelasticLFT or None
-        LFT at the ROM's Vf (eq. 14; stage ``controller``).
-    synthesis : SynthesisResult or None
-        The fixed-order synthesis (``None`` with ``controller.method = "interval"``).
-    interval_design : IntervalDesign or None
-        The design of ``controller.method = "interval"``: the full-order continuation and
-        the order reduction.
-    controller : control.StateSpace or None
-        ``K`` from the sensors to the flap (``v = K zm``).
-    verification : VerificationReport or None
-        γ and the speed intervals (eq. 10-16).
-    rom_sweep : SpeedSweep or None
-        Dense eigenvalue sweep of the ROM loop (``verify.sweep``).
-    rom_interval : StabilityInterval or None
-        For a ROM whose time scales with V (``rom.convective``): the exact stable speed
-        interval of its loop closed by the controller, the flap behind the same servo as the
-        truth's (:meth:`casflutter.aeroelastic.AeroelasticSystem.with_servo`), grown from
-        ``data.V0``.  ``None`` for the paper's frozen ROM, whose exact interval is the
-        verification's (the LFT is exact at every speed), or when the controller does not
-        hold the scaled loop at V0.
-    truth_interval : StabilityInterval or None
-        Exact stable speed interval of the truth's own linearisation closed by the
-        controller, the flap behind a servo of ``controller.flap_rate_bandwidth``
-        (:class:`casflutter.aeroelastic.TruthLoop`), grown from ``data.V0``; ``None``
-        without a truth, or when the controller does not hold the truth at V0.
+    control : ControllerStage or None
+        Stage ``controller``: the design and the verification layer's certificates.
     closed_loop : ClosedLoopChecks or None
         Stage ``closed_loop``.
     suppression : SuppressionResult or None
         Stage ``suppression`` (paper Fig. 11).
+    skipped : mapping
+        Stage (or part of a stage) -> why it did not run.
     timings : mapping
         Seconds per stage and ``"total"``.
     out_dir : Path or None
-        Where the files were written.
+        Where the files were written (``None``: nothing written).
     files : mapping
         Name -> path of every file written.
-    problem : object
-        What ``[problem]`` loaded: the truth, or a :class:`casflutter.truth.WingProblem`.
-    skipped : mapping
-        Stage (or part of a stage) -> why it did not run (the truth-only stages on a wing
-        file).
-    rfa : RationalApproximation or None
-        The RFA of a GAF wing file's ``Q(ik)``.
-    rfa_system : RFASystem or None
-        Its ΣAE(U) in the airspeed [m/s].
-    rfa_flutter : FlutterResult or None
-        The flutter search of ``rfa_system`` (speeds in m/s, frequencies in rad/s).
-    pk : PKResult or None
-        The p–k solution on the same ``Q(ik)`` (the independent check).
     provenance : mapping
         What produced the run (:func:`casflutter._outputs.provenance`: version, seed,
         thread settings, libraries) and its start time (``started``).
@@ -279,38 +206,151 @@ class RunResult:
     __repr__ = result_repr
 
     config: RunConfig
-    truth: AeroelasticTruth | None
-    data: IOData | None
-    identification: IdentificationResult | CommonDenominatorResult | None
-    identification_history: tuple
-    fit: FitReport | None
-    realization: Realization | None
-    system: AeroelasticSystem | None
-    flutter: FlutterResult | None
-    flutter_truth: FlutterResult | None
-    flutter_frozen: FlutterResult | None = None
-    parametric: ParametricResult | None = None
+    problem: Any
+    route: str
+    model: ModelStage
+    flutters: FlutterStage
     lco: LcoResult | None = None
-    lft: AeroelasticLFT | None = None
-    synthesis: SynthesisResult | None = None
-    interval_design: IntervalDesign | None = None
-    controller: control.StateSpace | None = None
-    verification: VerificationReport | None = None
-    rom_sweep: SpeedSweep | None = None
-    rom_interval: StabilityInterval | None = None
-    truth_interval: StabilityInterval | None = None
+    control: ControllerStage | None = None
     closed_loop: ClosedLoopChecks | None = None
     suppression: SuppressionResult | None = None
+    skipped: Mapping[str, str] = field(default_factory=dict)
     timings: Mapping[str, float] = field(default_factory=dict)
     out_dir: Path | None = None
     files: Mapping[str, Path] = field(default_factory=dict)
-    problem: Any = None
-    skipped: Mapping[str, str] = field(default_factory=dict)
-    rfa: RationalApproximation | None = None
-    rfa_system: RFASystem | None = None
-    rfa_flutter: FlutterResult | None = None
-    pk: PKResult | None = None
     provenance: Mapping[str, Any] = field(default_factory=dict)
+
+    # ------------------------------------------------------------------ the stages' parts
+    @property
+    def truth(self) -> AeroelasticTruth | None:
+        """The truth simulator (``None`` without one)."""
+        return self.problem if isinstance(self.problem, AeroelasticTruth) else None
+
+    @property
+    def data(self):
+        """The chirp records of the last identification (``model.data``)."""
+        return self.model.data
+
+    @property
+    def identification(self):
+        """The ROM's identification (``model.identification``)."""
+        return self.model.identification
+
+    @property
+    def identification_history(self) -> tuple:
+        """``(V0, Vf_ROM)`` of every identification."""
+        return self.model.identification_history
+
+    @property
+    def fit(self):
+        """The ROM's free-run fit (paper Fig. 7)."""
+        return self.model.fit
+
+    @property
+    def realization(self):
+        """Σf by ERA and Tustin (eq. 5)."""
+        return self.model.realization
+
+    @property
+    def system(self):
+        """ΣAE(V) of the ROM (eq. 8-9), ``None`` for a family file."""
+        return self.model.system
+
+    @property
+    def rfa(self):
+        """The RFA of a GAF file's ``Q(ik)``."""
+        return self.model.rfa
+
+    @property
+    def rfa_system(self):
+        """ΣAE(U) of the RFA in the airspeed [m/s]."""
+        return self.model.rfa_system
+
+    @property
+    def flutter(self) -> FlutterResult | None:
+        """The flutter search of the model's loop (the paper's route, Table I)."""
+        return self.flutters.rom
+
+    @property
+    def flutter_truth(self) -> FlutterResult | None:
+        """The truth's flutter search."""
+        return self.flutters.truth
+
+    @property
+    def flutter_frozen(self) -> FlutterResult | None:
+        """The truth's with its aerodynamics frozen at V0 (stage ``frozen``)."""
+        return self.flutters.frozen
+
+    @property
+    def parametric(self) -> ParametricResult | None:
+        """Stage ``parametric``."""
+        return self.flutters.parametric
+
+    @property
+    def rfa_flutter(self) -> FlutterResult | None:
+        """The RFA system's flutter search (m/s, rad/s)."""
+        return self.flutters.rfa
+
+    @property
+    def pk(self):
+        """The p–k solution on a GAF file's table."""
+        return self.flutters.pk
+
+    @property
+    def controller(self):
+        """``K`` of the controller stage (``None`` without it)."""
+        return None if self.control is None else self.control.controller
+
+    @property
+    def lft(self):
+        """The LFT at Vf (eq. 14) of a ROM loop's controller stage."""
+        return None if self.control is None else self.control.lft
+
+    @property
+    def synthesis(self):
+        """The paper's synthesis (``controller.method = "paper"``)."""
+        return None if self.control is None else self.control.synthesis
+
+    @property
+    def design(self):
+        """The multi-speed design (``controller.method = "multispeed"``)."""
+        return None if self.control is None else self.control.design
+
+    @property
+    def verification(self):
+        """γ and the intervals of the LFT at Vf (eq. 10-16)."""
+        return None if self.control is None else self.control.verification
+
+    @property
+    def controlled_rom(self):
+        """The loop family the controller was designed on and is certified on first."""
+        if self.control is not None:
+            return self.control.family
+        return self.model.family
+
+    def _check(self, name: str):
+        return None if self.control is None else self.control.checks.get(name)
+
+    @property
+    def rom_sweep(self):
+        """The dense eigenvalue sweep of the LFT's loop over ``verify.sweep`` x Vf
+        (:class:`casflutter.verify.SpeedSweep`), when the configuration asks for it."""
+        return None if self.control is None else self.control.sweep
+
+    @property
+    def rom_stable_V(self) -> tuple | None:
+        """The certified stable interval of the design family closed by the controller
+        (:func:`casflutter.verify.verify_family`; ``None`` when it does not hold the loop at
+        the range's start)."""
+        check = self._check("design")
+        return None if check is None else check.stable_interval
+
+    @property
+    def truth_stable_V(self) -> tuple | None:
+        """The certified stable interval of the truth's own linearisation (flap behind the
+        servo) closed by the controller."""
+        check = self._check("truth")
+        return None if check is None else check.stable_interval
 
     # ------------------------------------------------------------------ flutter speeds
     @property
@@ -407,47 +447,25 @@ class RunResult:
 
     @property
     def required_V(self) -> tuple | None:
-        """``verify.required`` times Vf (``None`` without a target)."""
+        """The speeds the controller must hold: ``verify.required`` times Vf when given, else
+        the multi-speed design's ``controller.interval`` (``None`` without a target)."""
         req = self.config.verify.required
-        if not req or self.Vf is None:
-            return None
-        return (req[0] * self.Vf, req[1] * self.Vf)
-
-    @property
-    def rom_stable_V(self) -> tuple | None:
-        """The exact stable speed interval of the ROM loop closed by the controller: the
-        verification's (on the LFT, eq. 10-15) for the paper's frozen ROM, the scaled loop's
-        (:attr:`rom_interval`) for a ROM whose time scales with V.  ``None`` without a
-        controller or when it does not hold the loop."""
-        if self.verification is None:
-            return None
-        if self.convective_V0 is not None:
-            ri = self.rom_interval
-            return None if ri is None else (float(ri.lower), float(ri.upper))
-        return self.verification.exact_V if self.verification.stable else None
-
-    @property
-    def controlled_rom(self):
-        """The ROM loop family that the controller closes and :attr:`rom_stable_V` judges:
-        ΣAE(V) itself (eq. 8), or for a ROM whose time scales with V, ΣAE(V) with the flap
-        behind the servo of ``controller.flap_rate_bandwidth``
-        (:meth:`~casflutter.aeroelastic.AeroelasticSystem.with_servo`).  ``None`` without a
-        ROM loop."""
-        if self.system is None:
-            return None
-        if self.convective_V0 is not None and self.controller is not None:
-            return self.system.with_servo(self.config.controller.flap_rate_bandwidth)
-        return self.system
+        if req and self.Vf is not None:
+            return (req[0] * self.Vf, req[1] * self.Vf)
+        if self.control is not None and self.control.method == "multispeed":
+            return tuple(self.config.controller.interval)
+        return None
 
     @property
     def interval_ok(self) -> bool | None:
-        """The verified exact stable interval (:attr:`rom_stable_V`) contains
-        :attr:`required_V` (``None`` without a target or a verification)."""
-        if self.required_V is None or self.verification is None:
+        """The certified stable interval of the design family (:attr:`rom_stable_V`)
+        contains :attr:`required_V` (``None`` without a target or a controller).  The
+        truth's certificate is reported beside it (:attr:`truth_stable_V`), not required: a
+        ROM identified at one speed stands for the truth near that speed only."""
+        if self.required_V is None or self.control is None:
             return None
-        ex = self.rom_stable_V
         lo, hi = self.required_V
-        return bool(ex is not None and ex[0] <= lo and ex[1] >= hi)
+        return bool(self.control.checks["design"].covers(lo, hi))
 
     @property
     def success(self) -> bool:
@@ -466,71 +484,47 @@ class RunResult:
         Returns
         -------
         dict
-            ``problem``, ``V0``, ``n_sensors``, ``orders``, ``n_params``,
+            ``problem``, ``route``, ``V0``, ``n_sensors``, ``orders``, ``n_params``,
             ``fit_error_percent``, ``nf``, ``ns``, ``nae``, ``flutter``, ``flutter_truth``,
             ``lco``, ``controller``, ``suppression`` (``None`` when the stage did not run),
             ``timings_s``, ``seed``; ``skipped`` (stage -> reason) when a stage was
-            skipped; and, for the stages that ran, ``v0_history``,
-            ``flutter_frozen``, ``flutter_parametric``, ``verification`` and
-            ``closed_loop``.
+            skipped; and, for the stages that ran, ``v0_history``, ``flutter_frozen``,
+            ``flutter_parametric``, ``verification``, ``rfa``, ``family``,
+            ``closed_loop``, and, on an HWL ROM, ``flutter_convective`` (the ROM that
+            follows the wing over speed; ``flutter`` stays the paper's frozen route of
+            Table I) and ``control_reversal_V`` (the flutter mode's, per loop).
         """
         cfg = self.config
-        model = None if self.identification is None else self.identification.model
-        structure = (self.system.structure if self.system is not None
-                     else self.rfa_system.structure)
-        out = {
-            "problem": cfg.problem.name,
-            "V0": cfg.data.V0 if model is not None else None,
-            "n_sensors": int(structure.n_sensors),
-            "orders": None if model is None else list(model.orders.as_tuple()),
-            "n_params": None if model is None else model.n_params,
-            "fit_error_percent": None if self.fit is None else list(self.fit.error_percent),
-            "nf": None if self.realization is None else self.realization.order,
-            "ns": 2 * structure.n_modes,
-            "nae": (None if self.system is None
-                    else int(self.system.state_matrix(0.0).shape[0])),
-            "flutter": _flutter_summary(self.flutter),
-            "flutter_truth": _flutter_summary(self.flutter_truth),
-            "lco": self._lco_summary(),
-            "controller": self._controller_summary(),
-            "suppression": None if self.suppression is None else {
-                "attenuation_percent": self.suppression.attenuation_percent,
-                "lco_returns": self.suppression.lco_returns, "V": self.suppression.V,
-                "open_loop_amplitude": list(self.suppression.open_loop_amplitude),
-                "closed_loop_amplitude": list(self.suppression.closed_loop_amplitude),
-                "dominant_sensor": self.suppression.dominant_sensor,
-                "started_from_lco": self.suppression.started_from_lco,
-                "flap_limit": cfg.suppression.flap_limit,
-                "flap_rate_limit": cfg.suppression.flap_rate_limit},
-            "timings_s": dict(self.timings),
-            "seed": cfg.seed,
-        }
+        out = {"problem": cfg.problem.name, "route": self.route, **self._model_summary(),
+               "flutter": _flutter_summary(self.flutter),
+               "flutter_truth": _flutter_summary(self.flutter_truth),
+               "lco": self._lco_summary(), "controller": self._controller_summary(),
+               "suppression": self._suppression_summary(),
+               "timings_s": dict(self.timings), "seed": cfg.seed}
         if self.skipped:
             out["skipped"] = dict(self.skipped)
         if self.convective_V0 is not None:
             out["convective_V0"] = float(self.convective_V0)
-        if cfg.rom.v0_iterations > 1:
+        if cfg.rom.v0_iterations > 1 and self.route in ("truth", "wing"):
             out["v0_history"] = [list(map(float, p)) for p in self.identification_history]
+        if self.flutters.convective is not None:
+            out["flutter_convective"] = _flutter_summary(self.flutters.convective)
+            out["control_reversal_V"] = {name: None if r is None else float(r.V)
+                                         for name, r in self.flutters.reversals.items()}
         if self.flutter_frozen is not None:
             out["flutter_frozen"] = _flutter_summary(self.flutter_frozen)
         if self.parametric is not None:
             out["flutter_parametric"] = _flutter_summary(self.parametric.flutter)
-        if self.verification is not None and cfg.verify.required:
-            ver = self.verification
-            out["verification"] = {
-                "gamma_delta": float(ver.hinf_delta.gamma),
-                "small_gain_V_delta": _pair(ver.small_gain_V_delta),
-                "required_V": _pair(self.required_V), "interval_ok": self.interval_ok,
-                "synthesis_gammas": (None if self.synthesis is None
-                                     else [float(g) for g in self.synthesis.gammas]),
-                "synthesis_converged": (None if self.synthesis is None
-                                        else bool(self.synthesis.converged)),
-                "success": self.success}
+        if self.interval_ok is not None:
+            out["verification"] = {"required_V": _pair(self.required_V),
+                                   "interval_ok": self.interval_ok, "success": self.success}
         U_ref = getattr(self.problem, "U_ref", None)
         if U_ref is not None and out["flutter"] is not None and out["flutter"]["V"] is not None:
             out["flutter"]["airspeed_m_s"] = out["flutter"]["V"] * U_ref
         if self.rfa is not None:
             out["rfa"] = self._rfa_summary()
+        if self.route == "family":
+            out["family"] = self._family_summary()
         if self.closed_loop is not None:
             cl = self.closed_loop
             out["closed_loop"] = {
@@ -541,6 +535,51 @@ class RunResult:
                                           "closed_eig_rate": s.closed_eig_rate}
                                 for s in (cl.rom_simulation, cl.truth_simulation)}}
         return _jsonable(label_summary(out, self))
+
+    def _model_summary(self) -> dict:
+        """The ROM's sizes and fit (``None`` entries where the route has none)."""
+        model = None if self.identification is None else self.identification.model
+        structure = (self.system.structure if self.system is not None
+                     else self.rfa_system.structure if self.rfa_system is not None else None)
+        fam = self.model.family
+        return {
+            "V0": self.config.data.V0 if model is not None else None,
+            "n_sensors": (int(structure.n_sensors) if structure is not None
+                          else len(fam.signals.measurements)),
+            "orders": None if model is None else list(model.orders.as_tuple()),
+            "n_params": None if model is None else model.n_params,
+            "fit_error_percent": None if self.fit is None else list(self.fit.error_percent),
+            "nf": None if self.realization is None else self.realization.order,
+            "ns": None if structure is None else 2 * structure.n_modes,
+            "nae": (int(self.system.state_matrix(0.0).shape[0]) if self.system is not None
+                    else int(fam.n_states) if self.route == "family" else None)}
+
+    def _family_summary(self) -> dict:
+        """A family file's size, signals and every open-loop crossing (``flutter`` of
+        ``casflutter flutter FAMILY``)."""
+        fam, fl = self.model.family, self.flutter
+        sig = fam.signals
+        return {"name": fam.name, "n_states": int(fam.n_states), "speed_unit": fam.speed_unit,
+                "time_unit": fam.time_unit, "speed_range": list(fam.speed_range),
+                "feedback": fam.feedback, "controls": list(sig.controls),
+                "measurements": list(sig.measurements),
+                "crossings": [] if fl is None else [
+                    {"speed": c.V, "omega_rad_s": c.omega, "freq_hz": c.frequency_hz,
+                     "branch": int(c.branch), "kind": c.kind, "direction": c.direction}
+                    for c in fl.crossings]}
+
+    def _suppression_summary(self) -> dict | None:
+        cfg, sup = self.config, self.suppression
+        if sup is None:
+            return None
+        return {"attenuation_percent": sup.attenuation_percent,
+                "lco_returns": sup.lco_returns, "V": sup.V,
+                "open_loop_amplitude": list(sup.open_loop_amplitude),
+                "closed_loop_amplitude": list(sup.closed_loop_amplitude),
+                "dominant_sensor": sup.dominant_sensor,
+                "started_from_lco": sup.started_from_lco,
+                "flap_limit": cfg.suppression.flap_limit,
+                "flap_rate_limit": cfg.suppression.flap_rate_limit}
 
     def _rfa_summary(self) -> dict:
         """The RFA, its flutter in m/s and rad/s and the p–k check (GAF wing files)."""
@@ -579,28 +618,39 @@ class RunResult:
                              if br is not None}}
 
     def _controller_summary(self) -> dict | None:
-        if self.verification is None:
+        """The controller stage: order, method, the certified intervals and flutter speeds
+        on the design family and on the truth, the paper's γ, the design time."""
+        c = self.control
+        if c is None:
             return None
-        ver = self.verification
-        ti = self.truth_interval
-        out = {"order": int(self.controller.nstates), "gamma": ver.gamma,
-                "small_gain_V": _pair(ver.small_gain_V), "stable_V": _pair(self.rom_stable_V),
-                "stable": bool(ver.stable),
-                # an upper end without a crossing is written as null
-                "truth_stable_V": None if ti is None else [
-                    float(ti.lower), float(ti.upper) if math.isfinite(ti.upper) else None],
-                "truth_servo_omega": (self.config.controller.flap_rate_bandwidth
-                                      if self.truth is not None else None)}
-        d = self.interval_design
-        if d is not None:
-            red = () if d.reduction is None else d.reduction.steps
-            out["interval_design"] = {
-                "order_requested": d.order, "met": d.met,
-                "full_order": int(d.full_order.controller.nstates),
-                "full_order_reached": list(d.full_order.reached),
-                "orders_held": {str(st.order): st.met for st in red}}
-        if self.convective_V0 is not None:
-            # stable_V is the scaled loop's; the LFT's intervals hold for Σf frozen at Vf
-            out["rom_servo_omega"] = self.config.controller.flap_rate_bandwidth
-            out["stable_V_frozen_at_Vf"] = _pair(ver.exact_V)
+
+        def certified(name: str) -> dict:
+            check = c.checks.get(name)
+            if check is None:
+                return {}
+            iv = check.stable_interval
+            return {"stable_interval": None if iv is None else [
+                        float(iv[0]), float(iv[1]) if math.isfinite(iv[1]) else None],
+                    "absolute_flutter_speed": check.absolute_flutter_speed,
+                    "robust_flutter_speed": check.robust_flutter_speed,
+                    "robust_flutter_reason": check.robust_reason}
+
+        out = {"order": c.order, "method": c.method, **certified("design"),
+               "design_time_s": c.design_time_s,
+               "servo_omega": ((self.config.controller.servo_omega or None)
+                               if self.route != "family" else None)}
+        truth = certified("truth")
+        if truth:
+            out.update({"truth_" + k: v for k, v in truth.items()})
+        if c.design is not None:
+            d = c.design
+            out.update(interval=list(d.interval), held=bool(d.held), reach=d.reached[1],
+                       design_gamma=d.gamma, design_message=d.message)
+        if c.verification is not None:
+            ver = c.verification
+            out.update(gamma=ver.gamma, small_gain_V=_pair(ver.small_gain_V),
+                       lft_stable_V=_pair(ver.exact_V) if ver.stable else None,
+                       stable=bool(ver.stable))
+        if c.synthesis is not None:
+            out["synthesis_gamma"] = float(c.synthesis.gamma)
         return out

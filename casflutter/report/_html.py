@@ -128,7 +128,7 @@ def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflu
     scale = _airspeed_scale(s)
     ours = {
         "nominal speed index V0": _with_airspeed(s.get("V0"), scale),
-        "number of modes N": _fmt(s.get("ns", 0) // 2),
+        "number of modes N": _fmt(s["ns"] // 2 if s.get("ns") else None),
         "(mu, na, nb, r, p, q)": _fmt(tuple(s.get("orders") or [])),
         "order of Σf nf": _fmt(s.get("nf")),
         "order of Σs": _fmt(s.get("ns")),
@@ -138,14 +138,15 @@ def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflu
         "LCO fundamental frequency [Hz]": _fmt(lco.get("freq_hz")),
         "order of controller K(s)": _fmt(ctrl.get("order")),
         "number of sensors": _fmt(s.get("n_sensors")),
-        "stable speed range (controller)": _with_airspeed(ctrl.get("stable_V"), scale),
+        "stable speed range (controller)": _with_airspeed(ctrl.get("stable_interval"), scale),
         "LCO attenuation": (_fmt(None) if sup.get("attenuation_percent") is None
                             else f"{sup['attenuation_percent']:.1f} %"),
     }
     ft = s.get("flutter_truth") or {}
     truth = {   # the truth simulator's own values, where it has one
         "flutter speed index Vf": _with_airspeed(ft.get("V"), scale),
-        "stable speed range (controller)": _with_airspeed(ctrl.get("truth_stable_V"), scale),
+        "stable speed range (controller)": _with_airspeed(ctrl.get("truth_stable_interval"),
+                                                          scale),
         "flutter mode": _fmt(ft.get("mode")),
         "LCO fundamental frequency [Hz]": _fmt(lco.get("truth_freq_hz")
                                                if lco.get("truth_kind") == "lco" else None),
@@ -178,8 +179,21 @@ def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflu
     trows = "\n".join(f"<tr><td>{html.escape(k)}</td><td>{v:.2f}</td></tr>"
                       for k, v in timings.items() if isinstance(v, (int, float)))
     version = s.get("casflutter_version")
-    gamma = (f"verified γ = {_fmt(ctrl.get('gamma'))} (‖T_w̄z‖∞ of the LFT at Vf, eq. 16), "
-             if ctrl else "")
+    gamma = (f"verified γ = {_fmt(ctrl.get('gamma'))} (‖T_w̄z‖∞ of the LFT at Vf, eq. 16, flap "
+             f"ideal), small-gain interval of V {_with_airspeed(ctrl.get('small_gain_V'), scale)}; "
+             if ctrl.get("gamma") is not None else "")
+    design = ""
+    if ctrl.get("method") == "multispeed":
+        design = (f"order-{_fmt(ctrl.get('order'))} multi-speed design over "
+                  f"{_with_airspeed(ctrl.get('interval'), scale)} "
+                  f"({'held' if ctrl.get('held') else 'not held: ' + html.escape(str(ctrl.get('design_message')))}, "
+                  f"{_fmt(ctrl.get('design_time_s'))} s); ")
+    servo = ctrl.get("servo_omega")
+    robust = (f" Absolute / robust flutter speed (the closed loop's loss of stability / of "
+              f"its gain and phase margins): ROM {_fmt(ctrl.get('absolute_flutter_speed'))} / "
+              f"{_fmt(ctrl.get('robust_flutter_speed'))}, truth "
+              f"{_fmt(ctrl.get('truth_absolute_flutter_speed'))} / "
+              f"{_fmt(ctrl.get('truth_robust_flutter_speed'))}." if ctrl else "")
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{html.escape(title)}</title>
 <style>body{{font-family:sans-serif;max-width:960px;margin:2em auto;color:#222}}
@@ -196,11 +210,10 @@ f" Speeds as the speed index V with the airspeed U = {_fmt(scale)} V m/s beside 
 <table><tr><th>quantity</th><th>this run (ROM)</th><th>truth simulator</th><th>paper</th></tr>
 {rows}</table>
 <p>ROM fit error per mode [%]: {fit}. Truth flutter: V = {_with_airspeed(ft.get('V'), scale)},
-{_fmt(ft.get('freq_hz'))} Hz. Controller: {gamma}small-gain interval of V
-{_with_airspeed(ctrl.get('small_gain_V'), scale)}, exact stable interval
-{_with_airspeed(ctrl.get('stable_V'), scale)} on the ROM loop and
-{_with_airspeed(ctrl.get('truth_stable_V'), scale)} on the truth's own linearisation (flap
-behind a servo of {_fmt(ctrl.get('truth_servo_omega'))} rad/s).</p>
+{_fmt(ft.get('freq_hz'))} Hz. Controller: {design}{gamma}certified stable interval
+{_with_airspeed(ctrl.get('stable_interval'), scale)} on the ROM loop and
+{_with_airspeed(ctrl.get('truth_stable_interval'), scale)} on the truth's own linearisation
+(flap behind a servo of {_fmt(servo)} rad/s).{robust}</p>
 {lco_text}
 <h2>Figures</h2>
 {''.join(imgs)}

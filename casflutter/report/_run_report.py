@@ -13,10 +13,12 @@ import numpy as np
 
 from ..aeroelastic import simulate_loop
 from ..lco import speed_convention
+from ._family_plots import plot_family_vg_vf
 from ._flutter_plots import plot_lco, plot_pole_loci, plot_vg_vf, speed_axes
 from ._html import html_report
 from ._labels import frequency_unit, label_unit, sensor_labels
 from ._lco_plots import plot_bifurcation_pair
+from ._margin_plots import plot_family_verification
 from ._pipeline_plots import plot_flap_pulses, plot_gain_ramp, plot_hankel, plot_rom_fit
 
 __all__ = ["write_figures", "write_html", "flap_pulse_comparison", "figure_captions"]
@@ -114,6 +116,8 @@ def write_figures(out: Path, result) -> dict:
     """
     out = Path(out)
     files = {}
+    if result.route == "family":        # a family file: its crossings and certificate
+        return _family_figures(out, result)
     if result.identification is None:   # a GAF wing file: no records, ROM or ERA
         names = result.problem.structure.mode_names
         if result.rfa_flutter is not None:
@@ -171,6 +175,7 @@ def write_figures(out: Path, result) -> dict:
     fig10.axes[0].set_xlim(-0.25 * w_max / 2, 0.1 * w_max / 2)
     fig10.axes[0].set_ylim(0.0, w_max)
     files["fig10_pole_loci"] = _save(fig10, out / "fig10_pole_loci.png")
+    files.update(_margin_figures(out, result))
     if result.suppression is not None:
         sup = result.suppression
         sim = sup.simulation
@@ -186,6 +191,24 @@ def write_figures(out: Path, result) -> dict:
             title=f"Fig. 11: suppression of the truth's LCO at V = {sup.V:.4g}"
                   + (f" ({sup.V * air['speed_scale']:.4g} m/s)" if air["speed_unit"] else "")),
             out / "fig11_gain_ramp.png")
+    return files
+
+
+def _margin_figures(out: Path, result) -> dict:
+    """Margins and closed-loop damping against the speed, one figure per certified model
+    (``margins_design.png``, ``margins_truth.png``)."""
+    if result.control is None:
+        return {}
+    return {f"margins_{name}": _save(plot_family_verification(check),
+                                     out / f"margins_{name}.png")
+            for name, check in result.control.checks.items()}
+
+
+def _family_figures(out: Path, result) -> dict:
+    """A family file's V–g/V–f in its own units, and the controller's margins."""
+    files = {"vg_vf": _save(plot_family_vg_vf(result.flutter, result.model.family),
+                            out / "vg_vf.png")}
+    files.update(_margin_figures(out, result))
     return files
 
 
@@ -209,6 +232,16 @@ def figure_captions(result) -> dict:
         Figure name -> caption.
     """
     cfg = result.config
+    margins = {f"margins_{name}": (
+        f"Loop-at-a-time gain and phase margins at the plant inputs and outputs against the "
+        f"speed, and the closed-loop damping, of the controller on the {name} model "
+        f"({check.family}); the thresholds {check.gain_margin_db:g} dB / "
+        f"{check.phase_margin_deg:g}° are dashed, the absolute and robust flutter speeds marked.")
+        for name, check in (result.control.checks.items() if result.control is not None
+                            else ())}
+    if result.route == "family":
+        return {"vg_vf": ("V–g and V–f of the plant family's open-loop branches, crossings "
+                          "marked."), **margins}
     if result.identification is None:   # a GAF wing file: the RFA's V-g/V-f only
         return {"vg_vf": "V–g and V–f of ΣAE(V) with Σf frozen at the flutter airspeed.",
                 "vg_vf_airspeed": ("V–g and V–f of the RFA's ΣAE(U) against the airspeed: the "
@@ -230,11 +263,12 @@ def figure_captions(result) -> dict:
         "fig10_pole_loci": ("Fig. 10. Poles of ΣAE over the speed range, open loop (x) and "
                             "with the controller (o)."),
     }
-    if result.convective_V0 is not None and result.controller is not None:
+    if result.control is not None and cfg.controller.servo_omega > 0:
         cap["fig10_pole_loci"] = (
-            "Fig. 10. Poles of the scaled ROM loop over the speed range with the flap behind "
-            f"the {cfg.controller.flap_rate_bandwidth:g} rad/s servo, open loop (x) and with "
-            "the controller (o): the loop whose stable interval the run certifies.")
+            "Fig. 10. Poles of the ROM loop the controller was designed on over the speed "
+            f"range, the flap behind the {cfg.controller.servo_omega:g} rad/s servo, open "
+            "loop (x) and with the controller (o): the loop whose stable interval the run "
+            "certifies.")
     if result.lco is not None:
         lco = result.lco
         sens = lco.rom.sensors
@@ -269,6 +303,7 @@ def figure_captions(result) -> dict:
             "gain; dashed: the LCO amplitude before the ramp; dotted: the flap travel). "
             f"Attenuation {att} (RMS of the dominant sensor); the LCO returns on release: "
             f"{'yes' if sup.lco_returns else 'no'}.")
+    cap.update(margins)
     return cap
 
 

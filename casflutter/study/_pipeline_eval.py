@@ -48,17 +48,20 @@ PIPELINE_SETTINGS = {
     "quiet": "no stage progress on stderr (default true)",
 }
 
-#: The columns :func:`pipeline_evaluator` returns (``time_<stage>`` for each of the ten
-#: stages of the default configuration besides ``time_total``).
+#: The columns :func:`pipeline_evaluator` returns (``time_<stage>`` for each of the eight
+#: stages of the default configuration besides ``time_total``; ``stable_V_lo/hi``: the
+#: exact stable interval of the LFT at Vf, eq. 10-15; ``certified_V_lo/hi``: the
+#: controller's certified stable interval on the design family, flap behind the servo).
 PIPELINE_OUTPUTS = (
     "Vf_rom", "freq_hz_rom", "mode_rom", "Vf_truth", "freq_hz_truth", "mode_truth",
     "lco_V", "lco_kind", "lco_freq_hz", "lco_amplitude", "lco_truth_V", "lco_truth_kind",
     "lco_truth_freq_hz", "lco_truth_amplitude", "controller_order", "gamma",
-    "small_gain_V_lo", "small_gain_V_hi", "stable_V_lo", "stable_V_hi", "closed_loop_stable",
+    "small_gain_V_lo", "small_gain_V_hi", "stable_V_lo", "stable_V_hi", "certified_V_lo",
+    "certified_V_hi", "closed_loop_stable",
     "synthesis_success", "synthesis_status", "attenuation_percent", "lco_returns",
     "suppression_V", "fit_error_max", "n_params", "nf", "nae", "time_data", "time_rom",
-    "time_realize", "time_structure", "time_flutter", "time_lco", "time_lft",
-    "time_controller", "time_verify", "time_suppression", "time_total",
+    "time_realize", "time_structure", "time_flutter", "time_lco", "time_controller",
+    "time_suppression", "time_total",
 )
 
 
@@ -170,8 +173,10 @@ def flatten_summary(summary: Mapping[str, Any]) -> dict[str, Any]:
         "controller_order": ctl.get("order"), "gamma": ctl.get("gamma"),
         "small_gain_V_lo": _pair(ctl.get("small_gain_V"), 0),
         "small_gain_V_hi": _pair(ctl.get("small_gain_V"), 1),
-        "stable_V_lo": _pair(ctl.get("stable_V"), 0),
-        "stable_V_hi": _pair(ctl.get("stable_V"), 1),
+        "stable_V_lo": _pair(ctl.get("lft_stable_V"), 0),
+        "stable_V_hi": _pair(ctl.get("lft_stable_V"), 1),
+        "certified_V_lo": _pair(ctl.get("stable_interval"), 0),
+        "certified_V_hi": _pair(ctl.get("stable_interval"), 1),
         "closed_loop_stable": ctl.get("stable"),
         "attenuation_percent": sup.get("attenuation_percent"),
         "lco_returns": sup.get("lco_returns"), "suppression_V": sup.get("V"),

@@ -72,7 +72,7 @@ fig.tight_layout()
 # On the wing the dip lies near V = 1.46, where the mode grows at only 1.3 rad/s; on the
 # frozen ROM loop it lies near V = 1.93, where the mode already grows at 6.6 rad/s, with a
 # grip almost four times weaker than at its flutter speed.  The interval designs
-# (:func:`casflutter.design.stabilize_interval`, ``casflutter bench interval``) meet it:
+# (continuation in speed, :func:`casflutter.design.design_over_speeds`) meet it:
 #
 # * on the frozen ROM loop every route stalls around the dip, whatever the order: continued
 #   up from V = 0.05, the paper's order-3 design reaches 1.88 and the wing's own order-3,

@@ -51,10 +51,14 @@ print(f"truth LCO at V = {s['lco']['truth_V']:.3f}: {s['lco']['truth_kind']}, "
 c = s["controller"]
 print(f"controller order {c['order']}: gamma = {c['gamma']:.4g}, small-gain V interval "
       f"({c['small_gain_V'][0]:.3f}, {c['small_gain_V'][1]:.3f}), exact stable V interval "
-      f"({c['stable_V'][0]:.3f}, {c['stable_V'][1]:.3f}) on the ROM loop")
-if c["truth_stable_V"] is not None:   # the same controller on the wing the ROM stands in for
-    print(f"  on the truth's own linearisation (servo {c['truth_servo_omega']} rad/s): exact "
-          f"stable V interval {c['truth_stable_V']}")
+      f"({c['lft_stable_V'][0]:.3f}, {c['lft_stable_V'][1]:.3f}) of the LFT at Vf")
+print(f"  certified on the ROM loop, flap behind the {c['servo_omega']} rad/s servo: V in "
+      f"({c['stable_interval'][0]:.3f}, {c['stable_interval'][1]:.3f}); robust flutter speed "
+      f"(6 dB / 45 deg) {c['robust_flutter_speed']:.3f}")
+if c.get("truth_stable_interval") is not None:   # the same controller on the wing itself
+    print(f"  certified on the truth's own linearisation, same servo: V in "
+          f"({c['truth_stable_interval'][0]:.3f}, {c['truth_stable_interval'][1]:.3f}); "
+          f"robust flutter speed {c['truth_robust_flutter_speed']:.3f}")
 print(f"suppression of the truth's LCO at V = {s['suppression']['V']:.3f}: "
       f"{s['suppression']['attenuation_percent']:.1f} % attenuation")
 print("timings [s]:", {k: round(v, 2) for k, v in s["timings_s"].items()})

@@ -7,9 +7,9 @@ flap behind the 40 Hz servo) over the paper's V ∈ (0, 2.4): the flap's grip on
 dips near V = 1.93, where the mode already grows at 6.6 rad/s (*Why is one controller over
 (0, 2.4) hard?*).  Two controllers, one for each side of the dip and switched with the speed,
 would do if their intervals overlapped.
-:func:`casflutter.design.search_random_starts` (``casflutter bench interval --servo 251.3
---random-orders 3,4``) answers that order by order: at order 3 the best from either side leave
-a gap around the dip; at order 4 they overlap.
+A search with seeded random starts continued from each end of the interval answered that
+order by order: at order 3 the best from either side leave a gap around the dip; at order 4
+they overlap.
 
 This example loads the kept order-4 pair (``tests/witnesses/rom_order4_*_controller.json``,
 both found by that search and certified in the tests), draws the closed loop's spectral

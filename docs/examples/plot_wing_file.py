@@ -66,8 +66,9 @@ print(f"flutter: V = {fl['V']:.4f} (U = {fl['airspeed_m_s']:.2f} m/s), {fl['freq
       f"mode {fl['mode']}")
 c = s["controller"]
 print(f"controller of order {c['order']}: gamma = {c['gamma']:.3f}, verified stable for V in "
-      f"[{c['stable_V'][0]:.3f}, {c['stable_V'][1]:.3f}] "
-      f"({c['stable_V'][1] / fl['V']:.2f} Vf)")
+      f"[{c['lft_stable_V'][0]:.3f}, {c['lft_stable_V'][1]:.3f}] "
+      f"({c['lft_stable_V'][1] / fl['V']:.2f} Vf) on the LFT at Vf, certified on the ROM loop "
+      f"for V in [{c['stable_interval'][0]:.3f}, {c['stable_interval'][1]:.3f}]")
 print("\n".join(result.skipped_notes()))
 
 # %%

@@ -183,7 +183,7 @@ def test_a_design_on_the_scaled_rom_is_certified_for_the_wing(convective, models
     from dataclasses import replace
 
     from casflutter._settings import settings_as
-    from casflutter.design import SynthesisOptions, design_flutter_controller
+    from casflutter.design import SynthesisOptions, synthesize, with_flap_rate
     from casflutter.pipeline import config_path, load_config
 
     cfg = load_config(config_path("seed_wing", "run"))
@@ -193,9 +193,10 @@ def test_a_design_on_the_scaled_rom_is_certified_for_the_wing(convective, models
     ends = {}
     for name, system in zip(("convective", "frozen"), convective):
         Vf = find_flutter(system, (0.3, 2.5), n_grid=56).Vf
-        K = design_flutter_controller(system, Vf, c.order, starts=c.starts, seed=0,
-                                      options=options, flap_rate_weight=c.flap_rate_weight,
-                                      flap_rate_bandwidth=c.flap_rate_bandwidth).controller
+        lft = build_lft(system, Vf)
+        P = with_flap_rate(lft.P, lft.nmeas, c.flap_rate_weight, c.flap_rate_bandwidth)
+        K = synthesize(P, lft.nmeas, lft.ncon, c.order, starts=c.starts, seed=0,
+                       options=options).controller
         on_rom = speed_family_interval(
             lambda V: system.loop(V).with_servo(SERVO).flap_to_sensors(), K, Vf)
         on_wing = speed_family_interval(lambda V: wing.loop(V).flap_to_sensors(), K, V0)

@@ -10,7 +10,7 @@ from scipy.signal import cont2discrete
 from casflutter.aeroelastic import simulate_loop
 from casflutter.structure import ModalStructure
 from casflutter.data import analyze_response
-from casflutter.errors import DimensionError
+from casflutter.errors import ConfigError, DimensionError
 from casflutter.ident import random_hwl_model
 
 from ._cases import DF2, OMEGA2, ZETA2
@@ -162,3 +162,73 @@ def test_hwl_rom_histories_match_its_own_free_run():
     v_ext = np.concatenate([np.zeros(L), v])
     y_ref = model.simulate(u_ext, v_ext, y0=np.zeros((L, 2)))[L:]
     assert_allclose(sim.y, y_ref, rtol=1e-10, atol=1e-12)
+
+
+@pytest.mark.parametrize("zeta", [0.0, 0.02, 1.0, 1.5])
+@pytest.mark.parametrize("h", [1e-3, 0.05, 0.7])
+def test_structure_step_is_the_matrix_exponential_with_held_and_ramping_force(zeta, h):
+    """[Ad, B0, B1] against Van Loan's exponential of the structure with a held and a
+    ramping input (scipy), under-, critically and over-damped."""
+    from scipy.linalg import expm
+    from casflutter.aeroelastic import structure_step
+    s = ModalStructure([3.0, 40.0], [zeta, 0.01], alpha=1.7)
+    nx, N = s.n_states, s.n_modes
+    M = np.zeros((nx + 2 * N, nx + 2 * N))
+    M[:nx, :nx], M[:nx, nx:nx + N], M[nx:nx + N, nx + N:] = s.As, s.Bs, np.eye(N) / h
+    E = expm(M * h)
+    Ad, B0, B1 = (np.asarray(X) for X in structure_step(s)(h))
+    assert_allclose(Ad, E[:nx, :nx], rtol=0, atol=1e-12)
+    assert_allclose(B0, E[:nx, nx:nx + N], rtol=0, atol=1e-12 * np.abs(B0).max())
+    assert_allclose(B1, E[:nx, nx + N:], rtol=0, atol=1e-9 * np.abs(B1).max())
+
+
+def _loop_growth(s, V, DF, dt, hold):
+    """Growth rate of the sampled-data loop with the static ROM y_k = DF u_k, built here with
+    scipy: zero-order hold, or predictive first-order hold (state [x_s, F_{k-1}])."""
+    from scipy.linalg import expm
+    nx, N = s.n_states, s.n_modes
+    M = np.zeros((nx + 2 * N, nx + 2 * N))
+    M[:nx, :nx], M[:nx, nx:nx + N], M[nx:nx + N, nx + N:] = s.As, s.Bs, np.eye(N) / dt
+    E = expm(M * dt)
+    Ad, B0, B1 = E[:nx, :nx], E[:nx, nx:nx + N], E[:nx, nx + N:]
+    F = V ** 2 * DF @ s.Cs                     # F_k = V^2 DF u_k
+    if hold == "zoh":
+        Phi = Ad + B0 @ F
+    else:
+        Phi = np.block([[Ad + (B0 + B1) @ F, -B1], [F, np.zeros((N, N))]])
+    return np.log(np.max(np.abs(np.linalg.eigvals(Phi)))) / dt
+
+
+@pytest.mark.parametrize("hold", ["zoh", "foh"])
+def test_the_loop_steps_at_the_speeds_own_time_step_with_either_hold(hold):
+    """With convective_V0 the loop is stepped at dt V0 / V: its growth rate is that of the
+    sampled-data loop built with that step (scipy), for either hold.  Against the continuous
+    ΣAE(V) the zero-order hold's half-step lag is an error of first order in the step and
+    the first-order hold's of second order: halving the step halves the one and quarters the
+    other."""
+    from casflutter.aeroelastic import AeroelasticSystem
+    s = ModalStructure(OMEGA2, ZETA2, alpha=1.3)
+    dt, V0, V = 4e-3, 1.5, 2.2
+    rom = LinearARX(0.0, DF2, np.zeros((2, 2)), np.zeros(2), dt)
+    sim = simulate_loop(rom, s, V, 6000, xs0=[0.01, 0.0, 0.0, 0.05], window=0.5, blowup=1e12,
+                        convective_V0=V0, hold=hold)
+    h = dt * V0 / V
+    assert sim.dt == pytest.approx(h) and sim.timepts[1] == pytest.approx(h)
+    assert sim.kind == "divergence"
+    assert sim.modes.growth_rate == pytest.approx(_loop_growth(s, V, DF2, h, hold), rel=5e-3)
+    sigma_c = np.max(np.linalg.eigvals(AeroelasticSystem.from_parts(
+        control.ss([], [], [], DF2), s).state_matrix(V)).real)
+    ratio = (_loop_growth(s, V, DF2, 2e-3, hold) - sigma_c) / (
+        _loop_growth(s, V, DF2, 1e-3, hold) - sigma_c)
+    assert ratio == pytest.approx(2.0 if hold == "zoh" else 4.0, rel=0.1)
+
+
+def test_the_speed_following_loop_and_hold_are_checked():
+    s = ModalStructure(OMEGA2, ZETA2, alpha=1.3)
+    rom = LinearARX(0.0, DF2, np.zeros((2, 2)), np.zeros(2), 1e-3)
+    with pytest.raises(ConfigError, match="convective_V0 = -1"):
+        simulate_loop(rom, s, 1.0, 10, convective_V0=-1.0)
+    with pytest.raises(ConfigError, match="V = 0.0"):
+        simulate_loop(rom, s, 0.0, 10, convective_V0=1.0)
+    with pytest.raises(ConfigError, match="hold = 'linear'"):
+        simulate_loop(rom, s, 1.0, 10, hold="linear")

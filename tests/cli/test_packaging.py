@@ -82,7 +82,7 @@ def test_the_wheel_holds_license_py_typed_and_the_problems(tmp_path):
     assert "casflutter/py.typed" in names
     assert any(n.endswith(".dist-info/licenses/LICENSE") for n in names)
     assert any(n.startswith("casflutter/_problems/typical_section/") for n in names)
-    # the default loop of `casflutter bench interval` ships; measured records that only an
+    # the seed wing's frozen ROM loop (examples and load_rom_loop) ships; measured records that only an
     # example reads, and the tests' witness controllers, do not
     assert "casflutter/_problems/seed_wing_rom/rom_loop_seed0.npz" in names
     assert not any(n.endswith(".mat") and "/f16gvt/" in n for n in names)

@@ -149,3 +149,21 @@ def test_bad_inputs():
         c = m.coefficients()
         c["alpha"][0] = 2.0
         HWLModel.from_coefficients(m.orders, **c)
+
+
+def test_advanced_model_is_the_identified_one_with_its_inputs_one_sample_earlier():
+    """Lowering r by one is the same recursion fed the inputs one sample earlier: the
+    advanced model's one-step predictions on (y, u, v) equal the original's on the inputs
+    shifted forward by a sample (both predict the same y(k))."""
+    from casflutter.ident import random_hwl_model
+    model = random_hwl_model(3, (3, 1, 1, 2, 2, 2), seed=4)
+    rng = np.random.default_rng(1)
+    y, u, v = rng.normal(size=(300, 3)), rng.normal(size=(301, 3)), rng.normal(size=301)
+    adv = model.advanced(1)
+    assert adv.orders.r == 1 and adv.max_lag == model.max_lag - 1
+    p_adv = adv.predict(y, u[:-1], v[:-1])
+    p_ref = model.predict(y, u[1:], v[1:])
+    np.testing.assert_allclose(p_adv[-250:], p_ref[-250:], rtol=1e-12, atol=1e-12)
+    assert model.advanced(0).orders == model.orders
+    with pytest.raises(OrderError, match="r = 2"):
+        model.advanced(3)

@@ -34,6 +34,7 @@ def test_defaults_are_the_paper_choices():
     ("[flutter]\nvrange = [0.5, 1.0]\n", r"flutter.vrange was renamed flutter.V_range"),
     ("stages = ['lco', 'dance']\n", r"stages: unknown stage 'dance'"),
     ("stages = ['suppression']\n", r"'suppression' needs the 'controller' stage"),
+    ("[controller]\nmethod = 'hifoo'\n", r"controller.method = 'hifoo': allowed 'auto'"),
     ("[controller]\nspeeds = [0.5, 1.2]\n", r"controller.speeds .*containing 1.0"),
     ("[controller]\nmax_stab_rounds = 0\n",
      r"\[controller\] invalid SynthesisOptions.*max_stab_rounds"),

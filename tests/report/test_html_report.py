@@ -13,7 +13,7 @@ SUMMARY = {
     "fit_error_percent": [0.5, 2.8, 0.4, 0.2, 0.9], "nf": 15, "ns": 10, "nae": 25,
     "flutter": {"V": 1.19999, "mode": 2}, "flutter_truth": {"V": 1.08499, "mode": 2},
     "lco": {"freq_hz": 9.2855, "truth_freq_hz": 9.3758, "truth_kind": "lco"},
-    "controller": {"order": 3, "stable_V": [0.0, 1.76]},
+    "controller": {"order": 3, "stable_interval": [0.0, 1.76]},
     "suppression": {"attenuation_percent": 99.99},
     "timings_s": {"rom": 0.5, "total": 70.0},
 }

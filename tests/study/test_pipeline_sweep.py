@@ -134,8 +134,10 @@ def test_swept_point_equals_a_direct_run(swept):
         "controller_order": s["controller"]["order"], "gamma": s["controller"]["gamma"],
         "small_gain_V_lo": s["controller"]["small_gain_V"][0],
         "small_gain_V_hi": s["controller"]["small_gain_V"][1],
-        "stable_V_lo": s["controller"]["stable_V"][0],
-        "stable_V_hi": s["controller"]["stable_V"][1],
+        "stable_V_lo": s["controller"]["lft_stable_V"][0],
+        "stable_V_hi": s["controller"]["lft_stable_V"][1],
+        "certified_V_lo": s["controller"]["stable_interval"][0],
+        "certified_V_hi": s["controller"]["stable_interval"][1],
         "attenuation_percent": s["suppression"]["attenuation_percent"],
         "fit_error_max": max(s["fit_error_percent"]), "nf": s["nf"], "nae": s["nae"],
     }

@@ -55,7 +55,8 @@ def test_example_wing_study_runs_every_stage_and_records_the_skipped_ones(tmp_pa
     # the controller's verified exact stable interval holds the configured [0.9, 1.05] Vf
     c = s["controller"]
     Vf = s["flutter"]["V"]
-    assert c["stable"] and c["stable_V"][0] <= 0.9 * Vf and c["stable_V"][1] >= 1.05 * Vf
+    assert c["stable"] and c["lft_stable_V"][0] <= 0.9 * Vf and c["lft_stable_V"][1] >= 1.05 * Vf
+    assert c["stable_interval"][0] <= 0.9 * Vf and c["stable_interval"][1] >= 1.05 * Vf
     assert json.loads((out / "summary.json").read_text())["skipped"] == s["skipped"]
     assert (out / "controller.json").is_file() and not (out / "fig8_flap_pulses.png").exists()
     assert main(["-q", "run", str(EXAMPLE_RUN), "--out", str(out), "--overwrite"]) == 0

@@ -27,29 +27,56 @@ def _speed(block) -> str:
     return text
 
 
-def _controller_lines(c: dict, res) -> list[str]:
-    """The controller's verified numbers, γ said for what it is (eq. 16)."""
+def _controller_lines(c: dict, res, unit: str) -> list[str]:
+    """The controller's design and its certificates, γ said for what it is (eq. 16)."""
+    lines = [f"controller order {c['order']} ({c['method']} design, "
+             f"{sig(c['design_time_s'], 3)} s)"]
+    if c["method"] == "multispeed":
+        lines.append(f"  design over {sig(c['interval'])} {unit}: "
+                     + ("held" if c["held"] else f"not held ({c['design_message']})"))
+    if c.get("gamma") is not None:
+        lines.append(f"  verified γ = {sig(c['gamma'])} (‖T_w̄z‖∞ of the LFT at Vf, eq. 16), "
+                     f"small-gain V {sig(c['small_gain_V'])}, exact V {sig(c['lft_stable_V'])}")
     syn = res.synthesis
-    lines = [f"controller order {c['order']}: verified γ = {sig(c['gamma'])} (‖T_w̄z‖∞ of the "
-             "LFT at Vf, eq. 16)"]
     if syn is not None and res.config.controller.flap_rate_weight > 0:
         lines.append(f"  the synthesis's γ {sig(syn.gamma)} is of its design plants, which add "
                      "the flap-rate output (controller.flap_rate_weight = "
                      f"{sig(res.config.controller.flap_rate_weight)})")
-    lines.append(f"  stable V (speed index): small gain {sig(c['small_gain_V'])}, exact "
-                 f"{sig(c['stable_V'])}")
-    if c.get("rom_servo_omega") is not None:
-        lines.append(f"  the ROM's time scales with V: that interval is its scaled loop's "
-                     f"(servo {sig(c['rom_servo_omega'])} rad/s); the LFT frozen at Vf holds "
-                     f"V in {sig(c['stable_V_frozen_at_Vf'])}")
-    if c.get("truth_servo_omega") is not None:
-        lines.append(f"  on the truth's own linearisation (servo {sig(c['truth_servo_omega'])} "
-                     f"rad/s): exact stable V in {sig(c['truth_stable_V'], none='unbounded')}")
-    air = (c.get("certified") or {}).get("exact_V") or {}
-    if air.get("airspeed_m_s") is not None:
-        lines.append(f"  exact stable airspeed in {sig(air['airspeed_m_s'], 4)} m/s")
+    servo = (f", flap behind a {sig(c['servo_omega'])} rad/s servo"
+             if c.get("servo_omega") else "")
+    for prefix, label in (("", "design model"), ("truth_", "truth's linearisation")):
+        if f"{prefix}stable_interval" not in c:
+            continue
+        lines.append(f"  on the {label}{servo}: certified stable over "
+                     f"{sig(c[prefix + 'stable_interval'], none='no interval')} {unit}; absolute / "
+                     f"robust flutter speed {sig(c[prefix + 'absolute_flutter_speed'], none='none')}"
+                     f" / {sig(c[prefix + 'robust_flutter_speed'], none='none')}")
     for w in (c.get("poles") or {}).get("warnings", ()):
         lines.append(f"  warning: {w}")
+    return lines
+
+
+def _model_lines(s: dict) -> list[str]:
+    """The model stages: the ROM, the RFA of a GAF wing file, or a plant family."""
+    if s.get("family") is not None:
+        f = s["family"]
+        return [f"problem {s['problem']}: plant family of {f['n_states']} states over "
+                f"{sig(f['speed_range'])} {f['speed_unit']}, controls {', '.join(f['controls'])}; "
+                f"measurements {', '.join(f['measurements'])} ({f['feedback']} feedback)"]
+    if s["orders"] is not None:
+        return [
+            f"problem {s['problem']}: orders {tuple(s['orders'])}, {s['n_params']} parameters, "
+            f"nf = {s['nf']}, ns = {s['ns']}, nae = {s['nae']}",
+            "ROM fit error per mode [%]: " + ", ".join(sig(e, 4)
+                                                       for e in s["fit_error_percent"])]
+    r = s["rfa"]                     # a GAF wing file: the RFA of Q(ik) in place of the ROM
+    lines = [f"problem {s['problem']}: {r['method']} RFA, {r['n_lags']} lag roots, fit "
+             f"error {r['fit_error']:.3g}, ns = {s['ns']}, nae = {s['nae']}"]
+    for key, label in (("flutter", "RFA ΣAE(U)"), ("pk", "p-k")):
+        b = r[key]
+        if b is not None:
+            lines.append(f"flutter ({label}): U = {sig(b['airspeed_m_s'])} m/s, "
+                         f"{sig(b['omega_rad_s'])} rad/s, mode {b['mode']}")
     return lines
 
 
@@ -65,34 +92,37 @@ def _main(args) -> int:
     res = run(cfg, out_dir=args.out, seed=args.seed, quiet=log_quiet, overwrite=args.overwrite)
     s = res.summary()
     fl, ft = s["flutter"], s["flutter_truth"]
-    if s["orders"] is not None:
-        lines = [
-            f"problem {s['problem']}: orders {tuple(s['orders'])}, {s['n_params']} parameters, "
-            f"nf = {s['nf']}, ns = {s['ns']}, nae = {s['nae']}",
-            "ROM fit error per mode [%]: " + ", ".join(sig(e, 4)
-                                                       for e in s["fit_error_percent"])]
-    else:                            # a GAF wing file: the RFA of Q(ik) in place of the ROM
-        r = s["rfa"]
-        lines = [f"problem {s['problem']}: {r['method']} RFA, {r['n_lags']} lag roots, fit "
-                 f"error {r['fit_error']:.3g}, ns = {s['ns']}, nae = {s['nae']}"]
-        for key, label in (("flutter", "RFA ΣAE(U)"), ("pk", "p-k")):
-            b = r[key]
-            if b is not None:
-                lines.append(f"flutter ({label}): U = {sig(b['airspeed_m_s'])} m/s, "
-                             f"{sig(b['omega_rad_s'])} rad/s, mode {b['mode']}")
-    lines.append(f"speeds: V is the {s['units']['V']}")
-    hz = s["units"].get("freq_hz") or "Hz"     # cycles per time unit in nondimensional time
-    if fl is not None:
-        what = "ROM" if s["orders"] is not None else "ΣAE(V), Σf frozen at Uf"
-        lines.append(f"flutter ({what}):   {_speed(fl)}, {sig(fl['freq_hz'])} {hz}, "
-                     f"mode {fl['mode']}")
-    if ft is not None:
-        lines.append(f"flutter (truth): {_speed(ft)}, {sig(ft['freq_hz'])} {hz}, "
-                     f"mode {ft['mode']}")
-    if s["lco"] is not None:
-        lines.append(f"LCO: {sig(s['lco']['freq_hz'])} {hz} ({s['lco']['kind']})")
+    lines = _model_lines(s)
+    family = s.get("family")
+    if family is not None:
+        unit = family["speed_unit"]
+        lines.append("flutter: " + ("; ".join(
+            f"{sig(c['speed'])} {unit} at {sig(c['omega_rad_s'])} rad/{family['time_unit']}"
+            for c in family["crossings"] if c["kind"] == "flutter") or "none in the range"))
+    else:
+        unit = "(speed index)"
+        lines.append(f"speeds: V is the {s['units']['V']}")
+        hz = s["units"].get("freq_hz") or "Hz"     # cycles per time unit in nondimensional time
+        if fl is not None:
+            what = "ROM" if s["orders"] is not None else "ΣAE(V), Σf frozen at Uf"
+            lines.append(f"flutter ({what}):   {_speed(fl)}, {sig(fl['freq_hz'])} {hz}, "
+                         f"mode {fl['mode']}")
+        fc = s.get("flutter_convective")
+        if fc is not None:
+            lines.append(f"flutter (ROM following the wing over speed): {_speed(fc)}, "
+                         f"{sig(fc['freq_hz'])} {hz}, mode {fc['mode']}")
+        if ft is not None:
+            lines.append(f"flutter (truth): {_speed(ft)}, {sig(ft['freq_hz'])} {hz}, "
+                         f"mode {ft['mode']}")
+        rev = s.get("control_reversal_V") or {}
+        if any(v is not None for v in rev.values()):
+            lines.append("flutter mode's control reversal (flap behind the servo): " + ", ".join(
+                f"{name.replace('_', '-')} V = {sig(v, 4)}" for name, v in rev.items()
+                if v is not None))
+        if s["lco"] is not None:
+            lines.append(f"LCO: {sig(s['lco']['freq_hz'])} {hz} ({s['lco']['kind']})")
     if s["controller"] is not None:
-        lines += _controller_lines(s["controller"], res)
+        lines += _controller_lines(s["controller"], res, unit)
     if s["suppression"] is not None:
         lines.append(f"suppression: attenuation {sig(s['suppression']['attenuation_percent'], 4)} "
                      f"%, LCO returns on release: {s['suppression']['lco_returns']}")

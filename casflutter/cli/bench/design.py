@@ -1,0 +1,187 @@
+"""``casflutter bench design``: the multi-speed fixed-order design on a plant family.
+
+One JSON record per controller order and seed (:func:`casflutter.design.design_over_speeds`
+over ``--interval``): ``problem``, ``nx``, ``n_inputs``, ``n_outputs``, ``order``, ``seed``,
+``interval``, ``held`` (the design's dense scan finds the decay rate over the whole
+interval), ``reach`` (the top of the interval it holds from ``lo``), ``worst_abscissa``,
+``gamma``, ``wall_time_s`` and ``cpu_time_s``, and the verification layer's certificate of
+the same controller on the family (``certified_interval``: the stable interval containing
+the range's start, :func:`casflutter.verify.verify_family`), and a ``summary`` with the
+medians per order.  The file is rewritten after every record, so a run that is stopped keeps
+what it finished; ``--out`` is checked before any work.
+
+``--problem`` names a plant family (a ``kind = "plant_family"`` file or a folder of
+``problems/`` holding one) or a run configuration (a ``problems/`` name with a ``run.toml``,
+or a ``RUN.toml`` path), whose model stages build the family the run designs on (for the
+seed wing: the ROM loop that follows the wing over speed, flap behind its servo).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import time
+from pathlib import Path
+from typing import Any
+
+from ..._outputs import atomic_file, check_output_path, plain_json, provenance
+from ...errors import ConfigError
+
+__all__ = ["register", "design_records"]
+
+
+def _family(problem: str):
+    """The family ``--problem`` names, and its description."""
+    from ...aeroelastic import load_family
+    from ...pipeline import design_family, load_config
+
+    try:
+        fam = load_family(problem)
+        return fam, f"plant family {problem}"
+    except ConfigError as family_error:
+        try:
+            cfg = load_config(problem)
+        except ConfigError:
+            raise ConfigError(f"--problem {problem!r} is neither a plant family ({family_error}) "
+                              "nor a run configuration (a problems/ name with a run.toml, or "
+                              "a RUN.toml file)") from None
+        return design_family(cfg), f"the design family of the run configuration {problem}"
+
+
+def _ints(text: str, what: str, low: int) -> list[int]:
+    try:
+        values = [int(v) for v in str(text).split(",") if v.strip()]
+    except ValueError:
+        raise ConfigError(f"--{what} = {text!r}: comma-separated integers, e.g. 2,3,4") from None
+    if not values or any(v < low for v in values):
+        raise ConfigError(f"--{what} = {text!r}: comma-separated integers >= {low}")
+    return values
+
+
+def design_records(family, interval, orders, seeds, *, problem: str = "", decay: float = 0.05,
+                   on_record=None) -> list[dict[str, Any]]:
+    """Design at every order and seed and certify each controller on the family.
+
+    Parameters
+    ----------
+    family : PlantFamily
+        The family.
+    interval : (float, float)
+        The speeds to hold.
+    orders, seeds : sequence of int
+        Controller orders and seeds.
+    problem : str
+        The name written in each record.
+    decay : float
+        Decay rate required at every speed [rad per time unit].
+    on_record : callable, optional
+        Called with each record as it is finished.
+
+    Returns
+    -------
+    list of dict
+    """
+    from ...design import MultiSpeedSettings, design_over_speeds
+    from ...errors import SynthesisError
+    from ...verify import verify_family
+
+    sig, nx = family.signals, family.n_states
+    settings = MultiSpeedSettings(decay=decay)
+    records = []
+    for order in orders:
+        for seed in seeds:
+            rec = {"problem": problem, "nx": nx, "n_inputs": len(sig.controls),
+                   "n_outputs": len(sig.measurements), "order": order, "seed": seed,
+                   "interval": list(interval)}
+            t, c = time.perf_counter(), time.process_time()
+            try:
+                d = design_over_speeds(family, interval, order, settings=settings, seed=seed)
+            except SynthesisError as exc:
+                rec.update(held=False, reach=None, worst_abscissa=None, gamma=None,
+                           certified_interval=None, status=f"failed: {exc}",
+                           wall_time_s=time.perf_counter() - t,
+                           cpu_time_s=time.process_time() - c)
+            else:
+                rec.update(held=bool(d.held), reach=d.reached[1],
+                           worst_abscissa=d.worst_abscissa, gamma=d.gamma,
+                           wall_time_s=time.perf_counter() - t,
+                           cpu_time_s=time.process_time() - c, status=d.message)
+                lo, hi = family.speed_range
+                check = verify_family(family, d.controller,
+                                      speed_range=(lo, hi) if hi < float("inf")
+                                      else (lo, interval[1]))
+                rec["certified_interval"] = (None if check.stable_interval is None
+                                             else list(check.stable_interval))
+            records.append(plain_json(rec))
+            if on_record is not None:
+                on_record(records[-1])
+    return records
+
+
+def summarize(records: list[dict[str, Any]]) -> dict[str, Any]:
+    """Per order: how many seeds held, the median reach and the median times.
+
+    Parameters
+    ----------
+    records : list of dict
+        The records of :func:`design_records`.
+
+    Returns
+    -------
+    dict
+    """
+    out = {}
+    for order in sorted({r["order"] for r in records}):
+        rs = [r for r in records if r["order"] == order]
+        reach = [r["reach"] for r in rs if r["reach"] is not None]
+        out[str(order)] = {
+            "held": sum(bool(r["held"]) for r in rs), "of": len(rs),
+            "median_reach": statistics.median(reach) if reach else None,
+            "median_wall_time_s": statistics.median(r["wall_time_s"] for r in rs),
+            "median_cpu_time_s": statistics.median(r["cpu_time_s"] for r in rs)}
+    return out
+
+
+def _write(out: Path, records: list, meta: dict) -> None:
+    with atomic_file(out) as tmp:
+        tmp.write_text(json.dumps({"records": records, "summary": summarize(records),
+                                   **meta}, indent=1))
+
+
+def _handler(args: argparse.Namespace) -> int:
+    orders, seeds = _ints(args.orders, "orders", 0), _ints(args.seeds, "seeds", 0)
+    lo, hi = args.interval
+    if not lo < hi:
+        raise ConfigError(f"--interval {lo} {hi}: need LO < HI")
+    out = check_output_path(args.out, what="--out", suffixes=(".json",))
+    family, about = _family(args.problem)
+    meta = {"problem": args.problem, "family": about, "decay": args.decay,
+            "provenance": provenance()}
+    records: list = []
+
+    def keep(rec):
+        records.append(rec)
+        _write(out, records, meta)
+
+    _write(out, records, meta)
+    design_records(family, (lo, hi), orders, seeds, problem=args.problem, decay=args.decay,
+                   on_record=keep)
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add ``bench design`` to the ``casflutter bench`` sub-commands."""
+    p = subparsers.add_parser("design", help="the multi-speed fixed-order design on a plant "
+                                             "family; writes JSON")
+    p.add_argument("--problem", required=True, metavar="P_OR_FILE",
+                   help="a plant family (file or problems/ name) or a run configuration "
+                        "whose design family is used (e.g. seed_wing)")
+    p.add_argument("--interval", nargs=2, type=float, required=True, metavar=("LO", "HI"),
+                   help="the speeds to hold, in the family's speed unit")
+    p.add_argument("--orders", default="2,3,4", help="comma-separated controller orders")
+    p.add_argument("--seeds", default="0,1,2", help="comma-separated seeds")
+    p.add_argument("--decay", type=float, default=0.05,
+                   help="decay rate required at every speed [rad per time unit]")
+    p.add_argument("--out", required=True, help="output JSON file")
+    p.set_defaults(func=_handler)

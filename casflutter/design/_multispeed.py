@@ -1,0 +1,706 @@
+"""Multi-speed fixed-order synthesis on a plant family (paper §III.C over a speed interval).
+
+The paper designs ``K(s)`` at Vf (eq. 14-16) and reports the speed interval over which the
+loop stays stable.  Here the interval is the requirement, and the design takes any
+:class:`~casflutter.aeroelastic.PlantFamily` (the ROM loop ΣAE(V) of eq. 8-9, a truth's
+linearisation, state-space models on a grid of speeds, several models at once): one
+controller of a given order such that the closed loop decays at the rate ``decay`` at every
+speed of ``[lo, hi]`` for every model, then, among such controllers, the smallest worst H∞
+objective over the speeds the budget allows.  It is a multi-model problem in the manner of
+HIFOO (stabilise first, then minimise the worst H∞ norm over the plants) and of
+hinfstruct/systune (the worst case over a set of models), with the speeds as the models:
+
+1. **Hold the interval.**  The worst closed-loop spectral abscissa over ``n_speeds`` speeds of
+   an interval, smoothed by a log-sum-exp of decreasing temperature, is minimised over the
+   controller's matrices by BFGS with the exact gradient of the rightmost eigenvalues
+   (:class:`._speeds.SpeedLoops`).  An interval counts as held when a dense scan (8x as many
+   speeds) finds the rate ``decay`` everywhere; a peak the scan finds between the objective's
+   speeds joins them and the interval is tried again.  This is continued in speed: starting
+   where a controller already decays, one end is pushed towards the target, the step growing
+   1.5x after a success and halving after a failure.
+2. **Starts.**  From the low end (where the open loop is usually stable) the target order is
+   continued from the zero controller and from seeded random ones.  When none reaches the top,
+   a full-order observer-based (LQG) controller of the plant at the top is continued down to
+   the low end (more states give the continuation room to pass a control reversal, where the
+   phase a controller needs flips), and its order is then lowered to the target one step at a
+   time (balanced truncation, re-held on the fixed interval, a step that misses split in
+   half): continuation in the order.
+3. **H∞ phase.**  From the controller that holds the interval,
+   :func:`casflutter.design.synthesize` minimises the worst H∞ norm of the design plants over
+   ``hinf_speeds`` speeds (the disturbance-to-sensor channels, with the control-rate weight
+   where a servo saturates, or plants the caller gives, e.g. the paper's LFT at Vf) while the
+   loops at the stability speeds keep their decay rate; the dense scan checks the result and
+   the held controller is kept if the H∞ phase lost the interval.
+
+Every budget is counted in iterations and every random choice takes the seed, so the same seed
+gives the same controller.  The interval the design reports is its own dense scan's; the
+certificate is the verification layer's (:func:`casflutter.verify.verify_family`).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, field, replace
+from typing import Any, Mapping, Sequence
+
+import control
+import numpy as np
+from scipy.optimize import minimize
+
+from .._format import result_repr
+from .._settings import finite_numbers
+from .._threads import single_threaded
+from ..errors import ConfigError, DimensionError, SynthesisError
+from ._speeds import DesignChannels, Scaling, SpeedLoops, design_partition
+from ._synthesis import SynthesisOptions, SynthesisResult, synthesize
+
+__all__ = ["MultiSpeedSettings", "MultiSpeedDesign", "HoldRecord", "design_over_speeds"]
+
+log = logging.getLogger("casflutter.design")
+
+#: BFGS temperatures of the smoothed maximum in multiples of the decay rate, last the maximum
+_TAUS = (6.0, 2.0, 0.6, None)
+
+
+@dataclass(frozen=True)
+class MultiSpeedSettings:
+    """Settings of :func:`design_over_speeds` (checked on construction)."""
+
+    __repr__ = result_repr
+
+    decay: float = 0.05
+    """Decay rate [rad per time unit] the closed loop needs at every speed of the interval."""
+    n_speeds: int = 16
+    """Speeds of the stability objective on each interval tried (the dense check uses 8x)."""
+    hinf_speeds: int = 5
+    """Speeds of the H∞ objective spread over the interval (0: no H∞ phase)."""
+    rate_weight: float = 0.0
+    """Weight of the control-rate outputs of the H∞ plants (:class:`._speeds.DesignChannels`;
+    0: none)."""
+    rate_bandwidth: float = 1.0
+    """Bandwidth [rad per time unit] of the control-rate filter (e.g. the servo's)."""
+    strictly_proper: bool | None = None
+    """Keep ``Dk = 0``; ``None``: strictly proper exactly when some model's controls reach its
+    measurements directly (a feed-through would close an algebraic loop that can become
+    singular at some speed)."""
+    random_starts: int = 2
+    """Seeded random starts at the target order from the low end (after the zero start)."""
+    full_order: bool = True
+    """Continue a full-order LQG controller of the top speed down to the low end, and lower
+    its order, when no low-order start reaches the top."""
+    reduction_orders: tuple = (20, 14, 10, 8, 6)
+    """Intermediate orders of the order continuation (those between the target and the full
+    order are used, highest first; a step that misses is split in half)."""
+    max_iter: int = 200
+    """BFGS iterations per temperature of the smoothed maximum."""
+    max_rounds: int = 200
+    """Continuation steps at most, per start."""
+    first_step: float = 0.05
+    """First continuation step, as a fraction of the interval's length."""
+    min_step: float = 0.001
+    """Smallest continuation step, as a fraction of the interval's length."""
+    synthesis: SynthesisOptions = field(default_factory=lambda: SynthesisOptions(
+        max_outer=60, max_stab_rounds=100, full_order_start=False))
+    """Settings of the H∞ phase (:func:`casflutter.design.synthesize`; its ``decay``,
+    ``strictly_proper`` and ``zero_start`` are set by the design)."""
+
+    def __post_init__(self):
+        if isinstance(self.synthesis, Mapping):
+            object.__setattr__(self, "synthesis", SynthesisOptions(**self.synthesis))
+        checks = {"decay": math.isfinite(self.decay) and self.decay >= 0,
+                  "n_speeds": int(self.n_speeds) == self.n_speeds and self.n_speeds >= 2,
+                  "hinf_speeds": int(self.hinf_speeds) == self.hinf_speeds
+                  and self.hinf_speeds >= 0,
+                  "rate_weight": math.isfinite(self.rate_weight) and self.rate_weight >= 0,
+                  "rate_bandwidth": math.isfinite(self.rate_bandwidth)
+                  and self.rate_bandwidth > 0,
+                  "random_starts": int(self.random_starts) == self.random_starts
+                  and self.random_starts >= 0,
+                  "reduction_orders": all(int(o) == o and o >= 1
+                                          for o in self.reduction_orders),
+                  "max_iter": int(self.max_iter) == self.max_iter and self.max_iter >= 1,
+                  "max_rounds": int(self.max_rounds) == self.max_rounds
+                  and self.max_rounds >= 1,
+                  "first_step": 0 < self.first_step <= 1,
+                  "min_step": 0 < self.min_step <= self.first_step}
+        bad = [k for k, ok in checks.items() if not ok]
+        if bad:
+            raise ConfigError(f"invalid MultiSpeedSettings field(s) {bad}: need decay >= 0, "
+                              "n_speeds >= 2, hinf_speeds >= 0, rate_weight >= 0, "
+                              "rate_bandwidth > 0, random_starts >= 0, reduction orders "
+                              ">= 1, max_iter >= 1, max_rounds >= 1, 0 < min_step <= "
+                              "first_step <= 1")
+
+
+@dataclass(frozen=True)
+class HoldRecord:
+    """One start of the design: how far it held the interval.
+
+    Attributes
+    ----------
+    kind : str
+        ``"given"``, ``"zero"``, ``"random"`` or ``"full-order"``.
+    order : int
+        Order of the controller it ended with.
+    reached : tuple of float
+        ``(lo, hi)`` it holds at the rate ``decay`` on the dense scan (``()`` if it held
+        nothing).
+    worst_abscissa : float
+        Largest closed-loop spectral abscissa on the dense scan of ``reached``.
+    steps : int
+        Continuation and order steps taken.
+    wall_time : float
+        Seconds.
+    """
+
+    __repr__ = result_repr
+
+    kind: str
+    order: int
+    reached: tuple
+    worst_abscissa: float
+    steps: int
+    wall_time: float
+
+
+@dataclass(frozen=True)
+class MultiSpeedDesign:
+    """Outcome of :func:`design_over_speeds`.
+
+    Attributes
+    ----------
+    controller : control.StateSpace
+        ``K(s)`` from the measurements to the controls, applied with the family's own
+        ``feedback`` convention.
+    order : int
+        Its order.
+    interval : tuple of float
+        The requested ``(lo, hi)``.
+    reached : tuple of float
+        ``(lo, V)``: the interval from ``lo`` on which the loop decays at the rate ``decay``
+        on the design's dense scan, for every model.
+    held : bool
+        ``reached`` is the requested interval at the requested order.
+    worst_abscissa : float
+        Largest closed-loop spectral abscissa on the dense scan of ``reached``.
+    gamma : float
+        Worst H∞ norm of the design plants at ``hinf_speeds`` (``nan`` without an H∞ phase);
+        with a control-rate weight it includes the weighted rate.
+    hinf_speeds : tuple of float
+        Speeds of the H∞ plants.
+    synthesis : SynthesisResult or None
+        The H∞ phase.
+    starts : tuple of HoldRecord
+        Every start, in the order tried.
+    message : str
+        What was held, in a sentence.
+    wall_time : float
+        Seconds.
+    """
+
+    __repr__ = result_repr
+
+    controller: control.StateSpace
+    order: int
+    interval: tuple
+    reached: tuple
+    held: bool
+    worst_abscissa: float
+    gamma: float
+    hinf_speeds: tuple
+    synthesis: SynthesisResult | None
+    starts: tuple
+    message: str
+    wall_time: float
+
+
+def _peaks(values: np.ndarray, threshold: float, most: int = 8) -> list[int]:
+    """Indices of the ``most`` highest local maxima of a dense scan above ``threshold``."""
+    n = len(values)
+    peaks = [j for j in range(n) if values[j] > threshold and values[j] >= values[max(j - 1, 0)]
+             and values[j] >= values[min(j + 1, n - 1)]]
+    return sorted(peaks, key=lambda j: (-values[j], j))[:most]
+
+
+class _Models:
+    """The families a controller must hold together, their design plants at a speed (cached)
+    and the scaling shared by the whole design."""
+
+    def __init__(self, families: Sequence, lo: float, hi: float):
+        self.families = tuple(families)
+        sizes = {(len(f.signals.controls), len(f.signals.measurements)) for f in self.families}
+        if len(sizes) != 1:
+            raise DimensionError(f"the models have different numbers of controls and "
+                                 f"measurements {sorted(sizes)}; one controller needs the same "
+                                 "controls and measurements on every model")
+        self.nu, self.ny = sizes.pop()
+        self._cache: dict = {}
+        probe = np.linspace(lo, hi, 5)
+        parts = [p for V in probe for p in self.parts(V)]
+        self.scaling = Scaling.of(parts)
+        self.has_d22 = any(np.any(p.D22 != 0) for V in np.linspace(lo, hi, 9)
+                           for p in self.parts(V))
+
+    def parts(self, V: float) -> list:
+        """The unscaled design plants (without rate outputs) of every model at ``V``."""
+        key = float(V)
+        if key not in self._cache:
+            if len(self._cache) > 4096:
+                self._cache.clear()
+            self._cache[key] = [design_partition(f, key) for f in self.families]
+        return self._cache[key]
+
+    def loops(self, speeds, order: int, free: np.ndarray, base: np.ndarray) -> SpeedLoops:
+        """The scaled closed loops of every model at ``speeds``."""
+        sc = self.scaling
+        return SpeedLoops([sc.plant(p, order) for V in speeds for p in self.parts(V)], free, base)
+
+    def dense(self, K: np.ndarray, order: int, lo: float, hi: float, n: int
+              ) -> tuple[np.ndarray, np.ndarray]:
+        """A dense scan of ``[lo, hi]``: the speeds and the worst closed-loop spectral abscissa
+        over the models at each (scaled time; ``inf`` where a loop is ill posed)."""
+        grid = np.linspace(lo, hi, n) if hi > lo else np.array([lo])
+        free = np.zeros(K.shape, bool)
+        values = np.array([float(np.max(self.loops([V], order, free, K).abscissae(
+            np.zeros(0)))) for V in grid])
+        return grid, values
+
+
+@dataclass
+class _Engine:
+    """Holding an interval, continuing it in speed and in the order (module docstring)."""
+
+    models: _Models
+    settings: MultiSpeedSettings
+    strictly_proper: bool
+
+    @property
+    def decay(self) -> float:
+        """The decay rate in the scaled time."""
+        return self.settings.decay / self.models.scaling.w0
+
+    def free(self, order: int) -> np.ndarray:
+        nu, ny = self.models.nu, self.models.ny
+        F = np.ones((nu + order, ny + order), bool)
+        if self.strictly_proper:
+            F[:nu, :ny] = False
+        return F
+
+    def worst(self, K: np.ndarray, lo: float, hi: float) -> tuple[np.ndarray, np.ndarray]:
+        return self.models.dense(K, K.shape[0] - self.models.nu, lo, hi,
+                                 8 * self.settings.n_speeds)
+
+    def _minimise(self, loops: SpeedLoops, q: np.ndarray, good: float
+                  ) -> tuple[np.ndarray, float]:
+        """BFGS on the smoothed worst abscissa at each temperature in turn, keeping a result
+        only when it lowers the worst; stops once the worst is at most ``good``."""
+        best = loops.smoothed(q, None)[0]
+        unit = self.decay if self.decay > 0 else 0.01
+        for tau in _TAUS:
+            if best <= good:
+                break
+            res = minimize(loops.smoothed, q, args=(None if tau is None else tau * unit,),
+                           jac=True, method="BFGS",
+                           options={"maxiter": int(self.settings.max_iter)})
+            if not np.all(np.isfinite(res.x)):
+                continue
+            worst = loops.smoothed(res.x, None)[0]
+            if worst < best:
+                q, best = res.x, worst
+        return q, float(best)
+
+    def hold(self, K: np.ndarray, lo: float, hi: float) -> tuple[np.ndarray, float, bool]:
+        """``K`` re-optimised to decay at the rate ``decay`` on ``[lo, hi]``: ``(K, worst on
+        the dense scan (scaled), held)``; a scan peak joins the objective's speeds, twice at
+        most."""
+        order = K.shape[0] - self.models.nu
+        free = self.free(order)
+        speeds = np.linspace(lo, hi, self.settings.n_speeds)
+        q = K[free]
+        worst = np.inf
+        for _ in range(3):
+            loops = self.models.loops(speeds, order, free, K)
+            q, worst = self._minimise(loops, q, -2.0 * self.decay)
+            if worst > -self.decay:
+                break
+            scan, values = self.worst(loops.gain(q), lo, hi)
+            worst = float(np.max(values))
+            if worst <= -self.decay:
+                return loops.gain(q), worst, True
+            speeds = np.union1d(speeds, scan[_peaks(values, -self.decay)])
+        return loops.gain(q), worst, False
+
+    def edge(self, K: np.ndarray, lo: float, hi: float, anchor: str) -> float | None:
+        """How far from the anchor end ``K`` already decays at the rate ``decay`` (``None``
+        if not even at the anchor)."""
+        scan, values = self.worst(K, lo, hi)
+        ok = values <= -self.decay
+        if anchor == "high":
+            scan, ok = scan[::-1], ok[::-1]
+        if not ok[0]:
+            return None
+        bad = np.flatnonzero(~ok)
+        return float(scan[-1] if bad.size == 0 else scan[bad[0] - 1])
+
+    def continue_interval(self, K: np.ndarray, lo: float, hi: float, anchor: str
+                          ) -> tuple[np.ndarray, tuple, int]:
+        """Continuation in speed from the ``anchor`` end: ``(K, (a, b) held, steps)``;
+        ``()`` when ``K`` does not decay at the anchor."""
+        e = self.edge(K, lo, hi, anchor)
+        if e is None:
+            return K, (), 0
+        cur = (lo, e) if anchor == "low" else (e, hi)
+        s = self.settings
+        step, smallest, rounds = s.first_step * (hi - lo), s.min_step * (hi - lo), 0
+        while cur != (lo, hi) and step >= smallest and rounds < s.max_rounds:
+            rounds += 1
+            trial = ((cur[0], min(hi, cur[1] + step)) if anchor == "low"
+                     else (max(lo, cur[0] - step), cur[1]))
+            Kn, worst, ok = self.hold(K, *trial)
+            log.debug("continuation (%s end): [%.5g, %.5g] worst abscissa %.4g -> %s", anchor,
+                      *trial, worst * self.models.scaling.w0, "kept" if ok else "halved")
+            if ok:
+                # the new controller may hold beyond the trial: start the next step there
+                e = self.edge(Kn, *((trial[0], hi) if anchor == "low" else (lo, trial[1])),
+                              anchor)
+                if e is not None:
+                    trial = (trial[0], max(trial[1], e)) if anchor == "low" else \
+                        (min(trial[0], e), trial[1])
+                K, cur, step = Kn, trial, 1.5 * step
+            else:
+                step *= 0.5
+        return K, cur, rounds
+
+    # ------------------------------------------------------------------ starts
+    def random_start(self, order: int, rng: np.random.Generator, scale: float) -> np.ndarray:
+        """A seeded random controller of ``order`` in the scaled gain: stable ``Ak`` near
+        ``−I`` (the plants' time scale) and couplings of size ``scale``."""
+        nu, ny = self.models.nu, self.models.ny
+        K = np.zeros((nu + order, ny + order))
+        K[nu:, ny:] = -np.eye(order) + 0.3 * rng.standard_normal((order, order))
+        K[:nu, ny:] = scale * rng.standard_normal((nu, order))
+        K[nu:, :ny] = scale * rng.standard_normal((order, ny))
+        if not self.strictly_proper:
+            K[:nu, :ny] = scale * rng.standard_normal((nu, ny))
+        return K
+
+    def lqg_start(self, V: float, state_weight: float = 0.01, noise_ratio: float = 1.0
+                  ) -> np.ndarray | None:
+        """A full-order observer-based (LQG) controller of the first model at ``V`` in the
+        scaled gain (strictly proper), or ``None`` when the Riccati equations have no
+        stabilising solution (an unstable mode the controls cannot reach or the
+        measurements cannot see)."""
+        sc = self.models.scaling
+        P = sc.plant(self.models.parts(V)[0], 0)
+        n, nu, ny = P.A.shape[0], self.models.nu, self.models.ny
+        try:
+            Kx = np.asarray(control.lqr(P.A, P.B2, state_weight * np.eye(n), np.eye(nu))[0])
+            L = np.asarray(control.lqe(P.A, np.eye(n), P.C2, np.eye(n),
+                                       noise_ratio * np.eye(ny))[0])
+        except (ValueError, np.linalg.LinAlgError, control.ControlArgument) as exc:
+            log.debug("full-order start at V = %.5g: no LQG controller (%s)", V, exc)
+            return None
+        if not (np.all(np.isfinite(Kx)) and np.all(np.isfinite(L))):
+            return None
+        K = np.zeros((nu + n, ny + n))
+        K[:nu, ny:] = -Kx
+        K[nu:, :ny] = L
+        K[nu:, ny:] = P.A - P.B2 @ Kx - L @ P.C2 + L @ P.D22 @ Kx
+        return K
+
+    # ------------------------------------------------------------------ order
+    def truncate(self, K: np.ndarray, order: int) -> np.ndarray | None:
+        """The balanced truncation of ``K`` to ``order`` (unstable modes kept), or ``None``
+        when ``K`` has more unstable modes than that."""
+        nu, ny = self.models.nu, self.models.ny
+        Dk, Ck, Bk, Ak = K[:nu, :ny], K[:nu, ny:], K[nu:, :ny], K[nu:, ny:]
+        try:
+            Kr = control.balred(control.ss(Ak, Bk, Ck, Dk), order, method="truncate")
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            log.debug("order %d: no truncation (%s)", order, exc)
+            return None
+        Ar, Br, Cr = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (Kr.A, Kr.B, Kr.C))
+        if Ar.shape[0] != order:
+            return None
+        out = np.zeros((nu + order, ny + order))
+        out[:nu, :ny] = Dk
+        out[:nu, ny:] = Cr.reshape(nu, order)
+        out[nu:, :ny] = Br.reshape(order, ny)
+        out[nu:, ny:] = Ar
+        return out
+
+    def reduce(self, K: np.ndarray, lo: float, hi: float, order: int
+               ) -> tuple[np.ndarray, int]:
+        """Continuation in the order: ``K`` (which holds ``[lo, hi]``) truncated through the
+        settings' intermediate orders to ``order``, each step re-held on the interval, a step
+        of more than one order that misses split in half.  Returns the lowest-order
+        controller that holds the interval and the steps taken."""
+        nu = self.models.nu
+        n = K.shape[0] - nu
+        queue = [o for o in sorted(set(self.settings.reduction_orders), reverse=True)
+                 if order < o < n] + [order]
+        steps = 0
+        while queue and K.shape[0] - nu > order:
+            target, cur = queue[0], K.shape[0] - nu
+            steps += 1
+            Kr = self.truncate(K, target)
+            held = False
+            if Kr is not None:
+                Kr, worst, held = self.hold(Kr, lo, hi)
+                log.debug("order continuation: %d -> %d: worst abscissa %.4g -> %s", cur,
+                          target, worst * self.models.scaling.w0, "held" if held else "missed")
+            if held:
+                K = Kr
+                queue.pop(0)
+            elif cur - target > 1:
+                queue.insert(0, (cur + target) // 2)
+            else:
+                break
+        return K, steps
+
+
+def _families(family) -> tuple:
+    fams = tuple(family) if isinstance(family, (list, tuple)) else (family,)
+    if not fams or not all(callable(getattr(f, "plant", None)) and hasattr(f, "signals")
+                           for f in fams):
+        raise ConfigError("family must be a casflutter.aeroelastic.PlantFamily (plant(V), "
+                          "signals) or a non-empty sequence of them")
+    return fams
+
+
+def _interval(interval, fams) -> tuple[float, float]:
+    lo, hi = finite_numbers("interval", interval, 2, what="two numbers (lo, hi)")
+    if not lo < hi:
+        raise ConfigError(f"interval = {[lo, hi]!r}: need lo < hi")
+    for f in fams:
+        a, b = f.speed_range
+        if lo < a or hi > b:
+            raise ConfigError(f"interval = {[lo, hi]!r} leaves the speed range [{a:g}, {b:g}] "
+                              f"{f.speed_unit} of {f.name}; design inside it")
+    return lo, hi
+
+
+def _padded(P, dims: tuple) -> control.StateSpace:
+    """A stability plant with zero ``w`` and ``z`` channels of the H∞ plants' sizes."""
+    nw, nz = dims
+    nx, nu, ny = P.A.shape[0], P.B2.shape[1], P.C2.shape[0]
+    B = np.hstack([np.zeros((nx, nw)), P.B2])
+    C = np.vstack([np.zeros((nz, nx)), P.C2])
+    D = np.block([[np.zeros((nz, nw)), np.zeros((nz, nu))], [np.zeros((ny, nw)), P.D22]])
+    return control.ss(P.A, B, C, D)
+
+
+def _as_ss(P) -> control.StateSpace:
+    return control.ss(P.A, np.hstack([P.B1, P.B2]), np.vstack([P.C1, P.C2]),
+                      np.block([[P.D11, P.D12], [P.D21, P.D22]]))
+
+
+def design_over_speeds(family, interval, order: int = 3, *,
+                       settings: MultiSpeedSettings | Mapping[str, Any] | None = None,
+                       seed: int = 0, initial: Sequence = (),
+                       hinf_plants: Sequence[control.StateSpace] | None = None
+                       ) -> MultiSpeedDesign:
+    """One fixed-order controller that keeps a plant family decaying over a speed interval,
+    with the smallest worst H∞ objective over the speeds the budget finds (module docstring).
+
+    Parameters
+    ----------
+    family : PlantFamily or sequence of PlantFamily
+        The family (or several, with the same numbers of controls and measurements, that
+        one controller must hold together: the worst of them at every speed).
+    interval : (lo, hi)
+        Speeds, inside every family's range.
+    order : int
+        Controller order (>= 1 when strictly proper, else >= 0).
+    settings : MultiSpeedSettings or dict, optional
+        Algorithm settings.
+    seed : int
+        Seed of the random starts (the same seed gives the same controller).
+    initial : sequence of control.StateSpace
+        Controllers to start from, first (in the family's convention, e.g. a design at one
+        speed); of the target order or lower (padded with decoupled stable states).
+    hinf_plants : sequence of control.StateSpace, optional
+        H∞ plants in the partitioned form of :func:`synthesize` (inputs ``[w, u]``, outputs
+        ``[z, y]``, ``u = +K y``), e.g. the paper's LFT at Vf (eq. 14); default the
+        disturbance-to-sensor channels of every model at ``hinf_speeds`` speeds.
+
+    Returns
+    -------
+    MultiSpeedDesign
+        The requested order; when no controller of it held the interval, the one with the
+        farthest reach from ``lo``, and ``held`` false (the message says so).
+
+    Raises
+    ------
+    ConfigError
+        A bad interval (outside a family's range), order or setting.
+    DimensionError
+        Families with different numbers of controls and measurements, or H∞ plants that do
+        not fit them.
+    SynthesisError
+        When no start holds even the low end of the interval.
+
+    See Also
+    --------
+    casflutter.verify.verify_family : the independent certificate of the interval.
+    """
+    t0 = time.perf_counter()
+    fams = _families(family)
+    lo, hi = _interval(interval, fams)
+    if isinstance(settings, Mapping):
+        settings = MultiSpeedSettings(**settings)
+    s = settings or MultiSpeedSettings()
+    if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order < 0:
+        raise ConfigError(f"order = {order!r}: an integer >= 0")
+    order = int(order)
+    with single_threaded():
+        models = _Models(fams, lo, hi)
+        sp = models.has_d22 if s.strictly_proper is None else bool(s.strictly_proper)
+        if sp and order == 0:
+            raise ConfigError("order = 0 with a strictly proper controller leaves nothing to "
+                              "design; ask for order >= 1 (or strictly_proper = False)")
+        eng = _Engine(models, s, sp)
+        records, held, best = [], None, None
+        rng = np.random.default_rng(seed)
+        plan = [("given", _given(models.scaling, K, order, models.nu, models.ny))
+                for K in initial]
+        plan += [("random", eng.random_start(order, rng, 0.05 if i == 0 else 0.5))
+                 for i in range(1 + s.random_starts)]
+        for kind, K0 in plan:
+            t = time.perf_counter()
+            K, reached, steps = eng.continue_interval(K0, lo, hi, "low")
+            rec = _record(eng, kind, K, reached, steps, t)
+            records.append(rec)
+            log.info("start %d (%s): holds %s", len(records), kind, _fmt(reached))
+            if reached and (best is None or reached[1] > best[1][1] * (1 + 1e-9)):
+                best = (K, reached)
+            if reached == (lo, hi):
+                held = K
+                break
+        if held is None and s.full_order:
+            t = time.perf_counter()
+            K0 = eng.lqg_start(hi)
+            if K0 is not None:
+                Kf, reached, steps = eng.continue_interval(K0, lo, hi, "high")
+                log.info("start %d (full order %d from the top): holds %s", len(records) + 1,
+                         K0.shape[0] - models.nu, _fmt(reached))
+                if reached == (lo, hi):
+                    Kr, more = eng.reduce(Kf, lo, hi, order)
+                    steps += more
+                    if Kr.shape[0] - models.nu == order:
+                        held = Kr
+                    else:
+                        Kf = Kr
+                records.append(_record(eng, "full-order", held if held is not None else Kf,
+                                       reached if held is not None or reached != (lo, hi)
+                                       else (lo, hi), steps, t))
+                if held is not None:
+                    best = (held, (lo, hi))
+        if best is None:
+            raise SynthesisError(
+                f"no start of order {order} decays at the rate {s.decay:g} even at the low end "
+                f"V = {lo:g} of the interval; check that the plant is stabilisable there, or "
+                "lower the decay rate", best_spectral_abscissa=float("nan"))
+        K, reached = (held, (lo, hi)) if held is not None else best
+        return _finish(eng, fams, K, order, (lo, hi), reached, held is not None, records,
+                       hinf_plants, t0)
+
+
+def _fmt(reached: tuple) -> str:
+    return "nothing" if not reached else f"[{reached[0]:.5g}, {reached[1]:.5g}]"
+
+
+def _given(sc: Scaling, K, order: int, nu: int, ny: int) -> np.ndarray:
+    """The scaled gain of a given controller, padded to ``order`` with decoupled states at
+    the plants' time scale."""
+    K = control.ss(K)
+    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (K.A, K.B, K.C, K.D))
+    k = K.nstates
+    if Dk.shape != (nu, ny):
+        raise DimensionError(f"an initial controller maps {Dk.shape[1]} inputs to "
+                             f"{Dk.shape[0]} outputs; the family needs {ny} measurements to "
+                             f"{nu} controls")
+    if k > order:
+        raise DimensionError(f"an initial controller has order {k} > the requested {order}")
+    A = -sc.w0 * np.eye(order)
+    B, C = np.zeros((order, ny)), np.zeros((nu, order))
+    if k:
+        A[:k, :k], B[:k], C[:, :k] = Ak, Bk.reshape(k, ny), Ck.reshape(nu, k)
+    return sc.gain(A, B, C, Dk)
+
+
+def _record(eng: _Engine, kind: str, K: np.ndarray, reached: tuple, steps: int, t: float
+            ) -> HoldRecord:
+    worst = (float(np.max(eng.worst(K, *reached)[1])) * eng.models.scaling.w0 if reached
+             else float("nan"))
+    return HoldRecord(kind, K.shape[0] - eng.models.nu, tuple(float(v) for v in reached),
+                      worst, int(steps), time.perf_counter() - t)
+
+
+def _controller(eng: _Engine, K: np.ndarray) -> control.StateSpace:
+    Ak, Bk, Ck, Dk = eng.models.scaling.controller(K)
+    return control.ss(Ak, Bk, Ck, Dk)
+
+
+def _finish(eng: _Engine, fams, K: np.ndarray, order: int, interval: tuple, reached: tuple,
+            held: bool, records: list, hinf_plants, t0: float) -> MultiSpeedDesign:
+    """The H∞ phase on the interval held (module docstring) and the result."""
+    s, models = eng.settings, eng.models
+    lo, e = reached
+    Kss = _controller(eng, K)
+    channels = DesignChannels(s.rate_weight, s.rate_bandwidth)
+    hv = tuple(float(v) for v in np.linspace(lo, e, s.hinf_speeds)) if s.hinf_speeds else ()
+    if hinf_plants is None:
+        hinf = [_as_ss(design_partition(f, V, channels)) for V in hv for f in fams]
+    else:
+        hinf = [control.ss(P) for P in hinf_plants]
+        hv = ()
+    syn, gamma = None, float("nan")
+    if hinf:
+        nw = hinf[0].ninputs - models.nu
+        nz = hinf[0].noutputs - models.ny
+        if nw < 1 or nz < 1:
+            raise DimensionError(f"the H∞ plants have {hinf[0].ninputs} inputs and "
+                                 f"{hinf[0].noutputs} outputs: they need [w, u] with "
+                                 f"{models.nu} controls and [z, y] with {models.ny} "
+                                 "measurements, and at least one w and one z")
+        speeds = np.linspace(lo, e, s.n_speeds)
+        stab = [_padded(P, (nw, nz)) for V in speeds for P in models.parts(V)]
+        opts = replace(s.synthesis, decay=float(s.decay), strictly_proper=eng.strictly_proper,
+                       zero_start=False, full_order_start=False)
+        try:
+            syn = synthesize(hinf, models.ny, models.nu, order, starts=0, initial=Kss,
+                             stability_plants=stab, options=opts)
+        except SynthesisError as exc:
+            log.info("H-infinity phase: %s; the held controller is kept", exc)
+        if syn is not None:
+            Kh = models.scaling.gain(*(np.atleast_2d(np.asarray(M, dtype=float)).reshape(r, c)
+                                       for M, (r, c) in zip(
+                (syn.controller.A, syn.controller.B, syn.controller.C, syn.controller.D),
+                ((order, order), (order, models.ny), (models.nu, order),
+                 (models.nu, models.ny)))))
+            worst = float(np.max(eng.worst(Kh, lo, e)[1]))
+            if worst <= -eng.decay:
+                K, Kss, gamma = Kh, syn.controller, float(syn.gamma)
+            else:
+                log.info("H-infinity phase: the dense scan finds abscissa %.4g > %.4g; the "
+                         "held controller is kept", worst * models.scaling.w0, -s.decay)
+                syn = None
+        if syn is None:
+            from ._problem import verify_closed_loop
+            gamma = max(verify_closed_loop(P, Kss, models.ny, models.nu)[0] for P in hinf)
+    worst = float(np.max(eng.worst(K, lo, e)[1])) * models.scaling.w0
+    what = f"order {order} holds [{lo:.5g}, {e:.5g}]"
+    if held:
+        message = f"{what}, the whole interval, at the decay rate {s.decay:g}"
+    else:
+        message = (f"{what} at the decay rate {s.decay:g}, not the requested "
+                   f"[{interval[0]:.5g}, {interval[1]:.5g}]: the farthest any start reached")
+    log.info("multi-speed design: %s; worst H-infinity objective %.5g", message, gamma)
+    return MultiSpeedDesign(controller=Kss, order=order, interval=interval,
+                            reached=(float(lo), float(e)), held=bool(held),
+                            worst_abscissa=worst, gamma=gamma, hinf_speeds=hv, synthesis=syn,
+                            starts=tuple(records), message=message,
+                            wall_time=time.perf_counter() - t0)

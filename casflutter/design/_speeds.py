@@ -1,0 +1,244 @@
+"""Design plants of a plant family, and the closed loops' decay over a set of speeds.
+
+Helpers of :mod:`._multispeed` (the multi-speed fixed-order synthesis).  A
+:class:`~casflutter.aeroelastic.PlantFamily` gives the plant at a speed with named inputs and
+outputs; the design needs it in the partitioned form of :mod:`._plant` (inputs ``[w, u]``,
+outputs ``[z, y]``) with the controller closed as ``u = +K y``:
+
+* ``u`` the family's controls, ``y`` its measurements, the sign of ``u`` flipped for a family
+  whose controllers act as ``u = −K y`` (so the controller designed here is the family's own);
+* ``w`` the family's disturbance inputs, or, when it has none, disturbances added to the
+  controls at the plant's input;
+* ``z`` the measurements (the disturbance-to-sensor channels), and optionally the weighted
+  rate of every control through a first-order filter (``z_r = w a (u − x_r)``,
+  ``ẋ_r = a (u − x_r)``): the flap rate a servo can give is limited.
+
+:class:`SpeedLoops` holds a set of such plants, scaled once for the whole design (balanced
+states, inputs and outputs of order one, time scaled by the plants' geometric-mean pole
+modulus, as :class:`._problem.Problem` does), and evaluates the closed loops of a controller
+written as a static gain on the augmented plant, ``Kbar = [[Dk, Ck], [Bk, Ak]]``: the
+spectral abscissa of every loop and the exact gradient of the rightmost eigenvalue,
+``∂ Re λ / ∂ Kbar = Re(Lᵀ (B2ᵀ ȳ)(C2 x)ᵀ Rᵀ) / (yᴴ x)`` with the left and right eigenvectors
+``y``, ``x`` and the well-posedness factors ``L``, ``R`` of a loop with feed-through.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+import scipy.linalg as sla
+
+from .._format import result_repr
+from ..errors import ConfigError, DimensionError
+from ._plant import Partition
+from ._problem import _balance, _io_scales, _time_scale
+
+__all__ = ["DesignChannels", "design_partition", "SpeedLoops", "Scaling"]
+
+
+@dataclass(frozen=True)
+class DesignChannels:
+    """What the design reads from a family's plant.
+
+    Attributes
+    ----------
+    rate_weight : float
+        ``w`` of the control-rate outputs (0: none).
+    rate_bandwidth : float
+        ``a`` [rad per time unit] of their filter (> 0).
+    """
+
+    __repr__ = result_repr
+
+    rate_weight: float = 0.0
+    rate_bandwidth: float = 1.0
+
+    def __post_init__(self):
+        if not (math.isfinite(self.rate_weight) and self.rate_weight >= 0
+                and math.isfinite(self.rate_bandwidth) and self.rate_bandwidth > 0):
+            raise ConfigError(f"rate weight {self.rate_weight!r} (>= 0) and bandwidth "
+                              f"{self.rate_bandwidth!r} (> 0, rad per time unit)")
+
+
+def design_partition(family, V: float, channels: DesignChannels = DesignChannels()
+                     ) -> Partition:
+    """The plant of ``family`` at ``V`` in the design's partitioned form (module docstring).
+
+    Parameters
+    ----------
+    family : casflutter.aeroelastic.PlantFamily
+        The family.
+    V : float
+        Speed.
+    channels : DesignChannels
+        The control-rate outputs.
+
+    Returns
+    -------
+    Partition
+        ``u = +K y`` closes it (the family's sign convention folded into ``B2``, ``D12``,
+        ``D22``).
+    """
+    P, sig = family.plant(V), family.signals
+    A, B, C, D = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (P.A, P.B, P.C, P.D))
+    iu, iy = sig.input_index(), sig.output_index()
+    iw = sig.input_index(sig.disturbances) if sig.disturbances else iu
+    s = family.feedback_sign
+    nx, nu = A.shape[0], len(iu)
+    B2, C2, D22 = s * B[:, iu], C[iy], s * D[np.ix_(iy, iu)]
+    B1, D21 = B[:, iw], D[np.ix_(iy, iw)]
+    C1, D11, D12 = C2, D21, D22
+    if channels.rate_weight > 0:
+        a, w = channels.rate_bandwidth, channels.rate_weight
+        nw = B1.shape[1]
+        A = np.block([[A, np.zeros((nx, nu))], [np.zeros((nu, nx)), -a * np.eye(nu)]])
+        B1 = np.vstack([B1, np.zeros((nu, nw))])
+        B2 = np.vstack([B2, a * np.eye(nu)])
+        C2 = np.hstack([C2, np.zeros((C2.shape[0], nu))])
+        C1 = np.block([[C1, np.zeros((C1.shape[0], nu))],
+                       [np.zeros((nu, nx)), -w * a * np.eye(nu)]])
+        D11 = np.vstack([D11, np.zeros((nu, nw))])
+        D12 = np.vstack([D12, w * a * np.eye(nu)])
+    return Partition(A=A, B1=B1, B2=B2, C1=C1, C2=C2, D11=D11, D12=D12, D21=D21, D22=D22)
+
+
+@dataclass(frozen=True)
+class Scaling:
+    """Input, output and time scales of a design (:mod:`._problem`'s): ``u = su u~``,
+    ``y~ = y / sy``, ``t~ = w0 t``."""
+
+    __repr__ = result_repr
+
+    su: np.ndarray
+    sy: np.ndarray
+    w0: float
+
+    @classmethod
+    def of(cls, parts: Sequence[Partition]) -> "Scaling":
+        """The scales of a set of plants.
+
+        Parameters
+        ----------
+        parts : sequence of Partition
+            Plants with the same ``u`` and ``y``.
+
+        Returns
+        -------
+        Scaling
+        """
+        su, sy = _io_scales(parts)
+        return cls(su, sy, _time_scale(parts))
+
+    def plant(self, P: Partition, order: int) -> Partition:
+        """``P`` balanced, scaled and augmented with ``order`` controller states."""
+        return P.transformed(_balance(P), self.su, self.sy, self.w0).augmented(order)
+
+    def gain(self, Ak, Bk, Ck, Dk) -> np.ndarray:
+        """The scaled static gain ``Kbar`` of an unscaled controller."""
+        nu, ny, k = len(self.su), len(self.sy), np.shape(Ak)[0]
+        K = np.zeros((nu + k, ny + k))
+        K[:nu, :ny] = np.asarray(Dk) * self.sy[None, :] / self.su[:, None]
+        K[:nu, ny:] = np.asarray(Ck) / self.su[:, None]
+        K[nu:, :ny] = np.asarray(Bk) * self.sy[None, :] / self.w0
+        K[nu:, ny:] = np.asarray(Ak) / self.w0
+        return K
+
+    def controller(self, K: np.ndarray) -> tuple[np.ndarray, ...]:
+        """``(Ak, Bk, Ck, Dk)``, unscaled, of the scaled static gain ``K``."""
+        nu, ny = len(self.su), len(self.sy)
+        Dk = self.su[:, None] * K[:nu, :ny] / self.sy[None, :]
+        Ck = self.su[:, None] * K[:nu, ny:]
+        Bk = self.w0 * K[nu:, :ny] / self.sy[None, :]
+        return self.w0 * K[nu:, ny:], Bk, Ck, Dk
+
+
+class SpeedLoops:
+    """Closed loops of a controller of one order on a set of scaled, augmented plants.
+
+    Parameters
+    ----------
+    parts : sequence of Partition
+        Scaled plants augmented with the controller's states (:meth:`Scaling.plant`).
+    free : ndarray of bool
+        Which entries of ``Kbar`` are parameters (the others stay at ``base``).
+    base : ndarray
+        ``Kbar`` of the fixed entries.
+    """
+
+    def __init__(self, parts: Sequence[Partition], free: np.ndarray, base: np.ndarray):
+        if not parts:
+            raise DimensionError("the closed loops need at least one plant")
+        self.parts, self.free, self.base = list(parts), free, base
+
+    def gain(self, q: np.ndarray) -> np.ndarray:
+        """``Kbar`` of the parameters ``q``."""
+        K = self.base.copy()
+        K[self.free] = q
+        return K
+
+    def params(self, K: np.ndarray) -> np.ndarray:
+        """The parameters of ``Kbar``."""
+        return K[self.free].copy()
+
+    @staticmethod
+    def _matrix(P: Partition, K: np.ndarray) -> np.ndarray:
+        Kt = P.loop_gain(K)[0]
+        return P.A + P.B2 @ Kt @ P.C2
+
+    def abscissae(self, q: np.ndarray) -> np.ndarray:
+        """The spectral abscissa of every loop (``inf`` where a loop is ill posed or its
+        eigenvalues cannot be computed)."""
+        K = self.gain(q)
+        out = np.empty(len(self.parts))
+        for j, P in enumerate(self.parts):
+            try:
+                M = self._matrix(P, K)
+                out[j] = float(np.max(np.linalg.eigvals(M).real)) if np.all(np.isfinite(M)) \
+                    else np.inf
+            except (np.linalg.LinAlgError, ValueError):
+                out[j] = np.inf
+        return out
+
+    def rightmost(self, q: np.ndarray, j: int) -> tuple[float, np.ndarray]:
+        """Real part of loop ``j``'s rightmost eigenvalue and its gradient in ``q``."""
+        K, P = self.gain(q), self.parts[j]
+        zero = np.zeros(int(self.free.sum()))
+        try:
+            Kt, L, R = P.loop_gain(K)
+            M = P.A + P.B2 @ Kt @ P.C2
+            if not np.all(np.isfinite(M)):
+                return np.inf, zero
+            lam, VL, VR = sla.eig(M, left=True, right=True)
+        except (np.linalg.LinAlgError, ValueError):
+            return np.inf, zero
+        i = int(np.argmax(lam.real))
+        y, x = VL[:, i], VR[:, i]
+        yx = y.conj() @ x
+        if not np.isfinite(lam[i].real) or abs(yx) < 1e-300:
+            return float(lam[i].real), zero
+        a = (y.conj() @ P.B2) / yx
+        b = P.C2 @ x
+        G = L.T @ np.real(np.outer(a, b)) @ R.T
+        return float(lam[i].real), G[self.free]
+
+    def smoothed(self, q: np.ndarray, tau: float | None) -> tuple[float, np.ndarray]:
+        """The worst abscissa over the loops, or its log-sum-exp of temperature ``tau``
+        (``tau → 0`` is the maximum), and its gradient in ``q``."""
+        if tau is None:
+            a = self.abscissae(q)
+            k = int(np.argmax(a))
+            if not np.isfinite(a[k]):
+                return np.inf, np.zeros(q.size)
+            return float(a[k]), self.rightmost(q, k)[1]
+        pairs = [self.rightmost(q, j) for j in range(len(self.parts))]
+        a = np.array([v for v, _ in pairs])
+        k = int(np.argmax(a))
+        if not np.isfinite(a[k]):
+            return np.inf, np.zeros(q.size)
+        w = np.exp((a - a[k]) / tau)
+        total = float(np.sum(w))
+        grad = sum((wj / total) * g for wj, (_, g) in zip(w, pairs))
+        return float(a[k] + tau * math.log(total)), grad

@@ -1,0 +1,211 @@
+"""The controller stage of a run: design, then certify, on plant families (paper §III.C-IV).
+
+The design takes the run's loop family, the one the model stages built (the ROM loop ΣAE(V)
+of eq. 8-9 with its aerodynamic time following the speed and the flap behind its servo, or
+a gridded family read from a file), and one of two methods:
+
+* ``"multispeed"`` — one fixed-order controller that keeps the family decaying over
+  ``controller.interval`` and, among such controllers, the smallest worst H∞ objective over
+  the speeds (:func:`casflutter.design.design_over_speeds`);
+* ``"paper"`` — the paper's design: γ of the LFT at Vf (eq. 14-16) with the flap-rate weight
+  (:func:`casflutter.design.synthesize`), the interval only measured afterwards.
+
+Then the verification layer, which shares no code with the design, certifies the controller
+on the design family and on every reference model the problem has (the truth's own
+linearisation with the flap behind the same servo): the stable speed interval, the absolute
+and robust flutter speeds and the margins (:func:`casflutter.verify.verify_family`), and, on
+a ROM loop, the paper's γ and small-gain interval of the LFT at Vf
+(:func:`casflutter.verify.verify_controller`).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, field, replace
+from typing import Mapping
+
+import control
+import numpy as np
+
+from .._format import result_repr
+from .._settings import settings_as
+from ..aeroelastic import AeroelasticLFT, build_lft
+from ..design import (MultiSpeedDesign, MultiSpeedSettings, SynthesisOptions,
+                      SynthesisResult, design_over_speeds, synthesize, with_flap_rate)
+from ..errors import CasflutterError
+from ..verify import (FamilyVerification, SpeedSweep, VerificationReport, speed_sweep,
+                      verify_controller, verify_family)
+from ._config import RunConfig
+
+__all__ = ["ControllerStage", "controller_stage"]
+
+log = logging.getLogger("casflutter.pipeline")
+
+
+@dataclass(frozen=True)
+class ControllerStage:
+    """What the controller stage produced.
+
+    Attributes
+    ----------
+    controller : control.StateSpace
+        ``K`` from the family's measurements to its controls, applied with the family's
+        ``feedback`` convention (``v = +K zm`` on a ROM loop, paper Fig. 3).
+    method : str
+        ``"multispeed"`` or ``"paper"``.
+    family : PlantFamily
+        The design family.
+    design : MultiSpeedDesign or None
+        The multi-speed design (``method = "multispeed"``).
+    synthesis : SynthesisResult or None
+        The paper's synthesis on the LFT at Vf (``method = "paper"``).
+    lft : AeroelasticLFT or None
+        The LFT at Vf (eq. 14) of a ROM loop, on which the paper's γ is verified.
+    verification : VerificationReport or None
+        γ, the small-gain and the exact intervals of the LFT at Vf (eq. 10-16).
+    checks : mapping of str to FamilyVerification
+        The verification layer's certificate on each model: ``"design"`` (the design family)
+        and, with a truth, ``"truth"`` (its own linearisation, flap behind the servo).
+    design_time_s : float
+        Seconds spent designing (the verification not included).
+    sweep : SpeedSweep or None
+        The dense eigenvalue sweep of the LFT's loop over ``verify.sweep`` x Vf
+        (:func:`casflutter.verify.speed_sweep`), when asked.
+    """
+
+    __repr__ = result_repr
+
+    controller: control.StateSpace
+    method: str
+    family: object
+    design: MultiSpeedDesign | None = None
+    synthesis: SynthesisResult | None = None
+    lft: AeroelasticLFT | None = None
+    verification: VerificationReport | None = None
+    checks: Mapping[str, FamilyVerification] = field(default_factory=dict)
+    design_time_s: float = float("nan")
+    sweep: SpeedSweep | None = None
+
+    @property
+    def order(self) -> int:
+        """The controller's order."""
+        return int(self.controller.nstates)
+
+
+def _paper_plant(system, Vf: float, cfg: RunConfig):
+    """The LFT at Vf (eq. 14) and the H∞ plants of the paper's design, the LFTs at
+    ``controller.speeds`` x Vf (with the flap-rate output when ``controller.flap_rate_weight
+    > 0``)."""
+    c = cfg.controller
+    lft = build_lft(system, Vf)
+
+    def plant(factor: float):
+        P = lft.P if factor == 1.0 else build_lft(system, factor * Vf).P
+        if c.flap_rate_weight > 0:
+            P = with_flap_rate(P, lft.nmeas, c.flap_rate_weight, c.flap_rate_bandwidth)
+        return P
+
+    return lft, [plant(float(f)) for f in c.speeds]
+
+
+def _multispeed(cfg: RunConfig, family) -> MultiSpeedDesign:
+    c = cfg.controller
+    settings = MultiSpeedSettings(
+        decay=c.interval_decay, n_speeds=c.n_speeds, hinf_speeds=c.hinf_speeds,
+        rate_weight=c.flap_rate_weight, rate_bandwidth=c.flap_rate_bandwidth,
+        strictly_proper=c.strictly_proper, random_starts=c.random_starts,
+        full_order=c.full_order, reduction_orders=c.reduction_orders,
+        synthesis=replace(settings_as(c, SynthesisOptions), ipopt={**cfg.solver.ipopt,
+                                                                   **c.ipopt}))
+    return design_over_speeds(family, tuple(c.interval), c.order, settings=settings,
+                              seed=cfg.seed)
+
+
+def _paper(cfg: RunConfig, P, lft) -> SynthesisResult:
+    c = cfg.controller
+    options = replace(settings_as(c, SynthesisOptions), ipopt={**cfg.solver.ipopt, **c.ipopt})
+    return synthesize(P, lft.nmeas, lft.ncon, c.order, starts=c.starts, seed=cfg.seed,
+                      options=options)
+
+
+def verification_range(family, cfg: RunConfig) -> tuple[float, float]:
+    """The speeds a controller is certified over: the family's own range where it is
+    finite, else from 0 to the larger of the flutter search's top and the design interval's
+    top."""
+    lo, hi = family.speed_range
+    if math.isfinite(hi):
+        return float(lo), float(hi)
+    tops = [cfg.flutter.V_range[1]] + ([cfg.controller.interval[1]]
+                                       if cfg.controller.interval else [])
+    return float(lo), float(max(tops))
+
+
+def controller_stage(cfg: RunConfig, family, *, system=None, Vf: float | None = None,
+                     references: Mapping[str, object] = ()) -> ControllerStage:
+    """Design a controller on ``family`` and certify it (module docstring).
+
+    Parameters
+    ----------
+    cfg : RunConfig
+        The run's configuration (``[controller]``, ``[verify]``).
+    family : PlantFamily
+        The design family.
+    system : AeroelasticSystem, optional
+        The ROM loop without the servo, when there is one: its LFT at ``Vf`` is the paper's
+        design plant and carries the paper's γ.
+    Vf : float, optional
+        The ROM loop's flutter speed (with ``system``).
+    references : mapping of str to PlantFamily
+        Further models to certify the controller on (e.g. ``{"truth": TruthLoop(...)}``).
+
+    Returns
+    -------
+    ControllerStage
+
+    Raises
+    ------
+    CasflutterError
+        ``method = "paper"`` without a ROM loop and its flutter speed.
+    casflutter.errors.SynthesisError
+        No start held even the interval's low end, or the paper's synthesis stabilised
+        nothing.
+    """
+    c = cfg.controller
+    t0 = time.perf_counter()
+    lft = P = None
+    if system is not None and Vf is not None:
+        lft, P = _paper_plant(system, Vf, cfg)
+    design = syn = None
+    if c.method == "paper":
+        if lft is None:
+            raise CasflutterError("controller.method = \"paper\" designs on the LFT at the ROM "
+                                  "loop's flutter speed (eq. 14); this problem has no ROM loop "
+                                  "with a flutter speed: use method = \"multispeed\"")
+        syn = _paper(cfg, P, lft)
+        K = syn.controller
+    else:
+        design = _multispeed(cfg, family)
+        K = design.controller
+        if not design.held:
+            log.warning("controller: %s", design.message)
+    t_design = time.perf_counter() - t0
+    sig = family.signals                 # K reads the measurements and drives the controls
+    K = control.ss(K.A, K.B, K.C, K.D, inputs=list(sig.measurements),
+                   outputs=list(sig.controls), name="K")
+    rng = verification_range(family, cfg)
+    checks = {"design": verify_family(family, K, speed_range=rng, margins=c.margins)}
+    for name, ref in dict(references).items():
+        checks[name] = verify_family(ref, K, speed_range=verification_range(ref, cfg),
+                                     margins=c.margins)
+    ver = sweep = None
+    if lft is not None:
+        ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
+        if cfg.verify.sweep:
+            lo, hi = cfg.verify.sweep
+            sweep = speed_sweep(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta,
+                                V=np.linspace(lo * Vf, hi * Vf, cfg.verify.n_sweep))
+    return ControllerStage(controller=K, method=c.method, family=family, design=design,
+                           synthesis=syn, lft=lft, verification=ver, checks=checks,
+                           design_time_s=t_design, sweep=sweep)
