@@ -97,9 +97,11 @@ class ModelStage:
     V0 : float or None
         The identification speed (the records' speed).
     speed_following : SpeedFollowingROM or None
-        The HWL ROM made to follow the wing over speed (records' coupling delay removed, Σf's
-        time scaled by V / V0, :func:`casflutter.aeroelastic.speed_following_rom`), beside
-        the paper's frozen loop of eq. 8; ``None`` for other ROMs and routes.
+        The paper's HWL ROM (``rom.method = "hwl"``) made to follow the wing over speed
+        (records' coupling delay removed, Σf's time scaled by V / V0,
+        :func:`casflutter.aeroelastic.speed_following_rom`), beside the paper's frozen loop
+        of eq. 8; ``None`` for other ROMs (``rom.convective`` scales a common-denominator
+        ROM's time itself) and routes.
     """
 
     __repr__ = result_repr
@@ -306,7 +308,7 @@ def rom_model(cfg: RunConfig, problem, structure, progress, *, needs_vf: bool
                  else "; truth: no flutter in flutter.V_range")
     log.info(note)
     sf, reversals = None, {}
-    if isinstance(model, HWLModel) and not cfg.rom.convective:
+    if cfg.rom.method == "hwl" and isinstance(model, HWLModel) and not cfg.rom.convective:
         with progress.stage("flutter"):
             sf, reversals = _speed_following(cfg, model, structure, V0, system, truth)
     stage = ModelStage(family=system, system=system, data=data, identification=ident,

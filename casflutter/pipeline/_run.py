@@ -41,17 +41,15 @@ from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 
-import casadi as ca
 import control
 import numpy as np
-from scipy.optimize import brentq
 
 from .._linalg import spectral_abscissa
 from .._outputs import provenance, utc_now
 from ..aeroelastic import AeroelasticSystem, FlutterResult, find_flutter, simulate_loop
 from ..data import envelope_growth_rate
 from ..errors import CasflutterError, ConfigError, ConvergenceError
-from ..lco import LCOSettings, lco_branch, rom_lco_branch, rom_loop_map, speed_convention
+from ..lco import LCOSettings, lco_branch, rom_lco_branch, rom_loop_flutter, speed_convention
 from ..realize import realize
 from ..truth import (closed_loop_truth, suppression_run, truth_lco, truth_loop_matrix,
                      truth_loop_sweep)
@@ -392,7 +390,7 @@ def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth) -> Lco
     fl_exact = find_flutter(sys_exact, vr, n_grid=cfg.flutter.n_grid,
                             max_refine=cfg.flutter.max_refine)
     V_hopf = float(fl_exact.Vf) if fl_exact.flutter is not None else float(flutter.Vf)
-    V_loop = _loop_hopf(model, structure, vr, cfg.flutter.n_grid)
+    V_loop = rom_loop_flutter(model, structure, vr, n_grid=cfg.flutter.n_grid)
     V_lco = (V_loop if V_loop is not None else V_hopf) * lc.speed_factor
     crit = _mode(flutter)
     n = int(round(lc.duration / model.dt))
@@ -450,30 +448,6 @@ def _branches(cfg: RunConfig, truth, model, structure) -> dict:
 
 #: most continuations of an LCO simulation that still grows
 _MAX_EXTENSIONS = 5
-
-
-def _loop_hopf(model, structure, vrange, n_grid: int) -> float | None:
-    """Speed of the first Neimark--Sacker point of the sampled-data ROM loop in ``vrange``
-    (the spectral radius of its linearisation at rest crossing one), or None."""
-    F = rom_loop_map(model, structure)
-    s, V = ca.SX.sym("s", int(F.size1_in(0))), ca.SX.sym("V")
-    jac = ca.Function("loop_jacobian", [s, V], [ca.jacobian(F(s, V), s)])
-    zero = np.zeros(int(F.size1_in(0)))
-
-    def radius(v: float) -> float:
-        lam = np.linalg.eigvals(np.asarray(jac(zero, v), float))
-        osc = lam[np.abs(lam.imag) > 1e-9]
-        return float(np.max(np.abs(osc))) - 1.0 if osc.size else -1.0
-
-    grid = np.linspace(max(vrange[0], 1e-3), vrange[1], n_grid)
-    r = np.array([radius(v) for v in grid])
-    if r[0] >= 0:
-        return None
-    up = np.flatnonzero((r[:-1] < 0) & (r[1:] >= 0))
-    if up.size == 0:
-        return None
-    k = int(up[0])
-    return float(brentq(radius, grid[k], grid[k + 1], xtol=1e-10))
 
 
 def _rate(timepts, X) -> float:
