@@ -53,6 +53,7 @@ from .._format import result_repr
 from .._settings import finite_numbers
 from .._threads import single_threaded
 from ..errors import ConfigError, DimensionError, SynthesisError
+from ._problem import verify_closed_loop
 from ._speeds import DesignChannels, Scaling, SpeedLoops, design_partition
 from ._synthesis import SynthesisOptions, SynthesisResult, synthesize
 
@@ -172,8 +173,8 @@ class MultiSpeedDesign:
     Attributes
     ----------
     controller : control.StateSpace
-        ``K(s)`` from the measurements to the controls, applied with the family's own
-        ``feedback`` convention.
+        ``K(s)`` from the measurements to the controls (named as the first family names
+        them), applied with the family's own ``feedback`` convention.
     order : int
         Its order.
     interval : tuple of float
@@ -689,7 +690,6 @@ def _finish(eng: _Engine, fams, K: np.ndarray, order: int, interval: tuple, reac
                          "held controller is kept", worst * models.scaling.w0, -s.decay)
                 syn = None
         if syn is None:
-            from ._problem import verify_closed_loop
             gamma = max(verify_closed_loop(P, Kss, models.ny, models.nu)[0] for P in hinf)
     worst = float(np.max(eng.worst(K, lo, e)[1])) * models.scaling.w0
     what = f"order {order} holds [{lo:.5g}, {e:.5g}]"
@@ -699,6 +699,9 @@ def _finish(eng: _Engine, fams, K: np.ndarray, order: int, interval: tuple, reac
         message = (f"{what} at the decay rate {s.decay:g}, not the requested "
                    f"[{interval[0]:.5g}, {interval[1]:.5g}]: the farthest any start reached")
     log.info("multi-speed design: %s; worst H-infinity objective %.5g", message, gamma)
+    sig = fams[0].signals          # K reads the measurements and drives the controls
+    Kss = control.ss(Kss.A, Kss.B, Kss.C, Kss.D, inputs=list(sig.measurements),
+                     outputs=list(sig.controls), name="K")
     return MultiSpeedDesign(controller=Kss, order=order, interval=interval,
                             reached=(float(lo), float(e)), held=bool(held),
                             worst_abscissa=worst, gamma=gamma, hinf_speeds=hv, synthesis=syn,

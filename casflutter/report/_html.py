@@ -102,30 +102,11 @@ def flutter_speed_flags(summary: dict, threshold: float = VF_FLAG_FRACTION) -> l
     return out
 
 
-def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflutter run",
-                captions: dict[str, str] | None = None) -> str:
-    """HTML text of the report (figures read from PNG files and embedded as base64).
-
-    Parameters
-    ----------
-    summary : dict
-        The run's summary (``summary.json``).
-    figures : dict
-        Figure name -> PNG path.
-    title : str
-        Page title.
-    captions : dict, optional
-        Figure name -> caption; a figure without one is captioned by its file name.
-
-    Returns
-    -------
-    str
-    """
-    captions = captions or {}
-    s = summary
+def _table_i_columns(s: dict, scale) -> tuple[dict, dict]:
+    """Table I's run column and truth column (the truth simulator's own values, where it has
+    one), each row name -> HTML text."""
     fl, ctrl = s.get("flutter") or {}, s.get("controller") or {}
     lco, sup = s.get("lco") or {}, s.get("suppression") or {}
-    scale = _airspeed_scale(s)
     ours = {
         "nominal speed index V0": _with_airspeed(s.get("V0"), scale),
         "number of modes N": _fmt(s["ns"] // 2 if s.get("ns") else None),
@@ -151,6 +132,34 @@ def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflu
         "LCO fundamental frequency [Hz]": _fmt(lco.get("truth_freq_hz")
                                                if lco.get("truth_kind") == "lco" else None),
     }
+    return ours, truth
+
+
+def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflutter run",
+                captions: dict[str, str] | None = None) -> str:
+    """HTML text of the report (figures read from PNG files and embedded as base64).
+
+    Parameters
+    ----------
+    summary : dict
+        The run's summary (``summary.json``).
+    figures : dict
+        Figure name -> PNG path.
+    title : str
+        Page title.
+    captions : dict, optional
+        Figure name -> caption; a figure without one is captioned by its file name.
+
+    Returns
+    -------
+    str
+    """
+    captions = captions or {}
+    s = summary
+    lco, sup, ctrl = s.get("lco") or {}, s.get("suppression") or {}, s.get("controller") or {}
+    scale = _airspeed_scale(s)
+    ours, truth = _table_i_columns(s, scale)
+    ft = s.get("flutter_truth") or {}
     rows = "\n".join(f"<tr><td>{html.escape(k)}</td><td>{ours[k]}</td>"
                      f"<td>{truth.get(k, _fmt(None))}</td>"
                      f"<td>{html.escape(v)}</td></tr>" for k, v in PAPER_TABLE_I.items())

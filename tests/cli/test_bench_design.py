@@ -1,0 +1,53 @@
+"""``casflutter bench design``: one JSON record per order and seed, certified by the
+verification layer, and a summary per order.
+
+Truth used: :func:`casflutter.verify.verify_family` run here on the controller rebuilt from
+the design with the same seed (the record's certified interval must be that one), on the
+shipped ``goland_4flaps`` family.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from casflutter.aeroelastic import load_family
+from casflutter.cli import main
+from casflutter.design import MultiSpeedSettings, design_over_speeds
+from casflutter.verify import verify_family
+
+KEYS = {"problem", "nx", "n_inputs", "n_outputs", "order", "seed", "interval", "held", "reach",
+        "worst_abscissa", "gamma", "wall_time_s", "cpu_time_s", "certified_interval", "status"}
+
+
+def test_records_per_order_and_seed_with_the_certificate(tmp_path):
+    out = tmp_path / "bench.json"
+    assert main(["-q", "bench", "design", "--problem", "goland_4flaps", "--interval", "60",
+                 "150", "--orders", "2", "--seeds", "0", "--out", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    (rec,) = doc["records"]
+    assert set(rec) >= KEYS
+    assert (rec["nx"], rec["n_inputs"], rec["n_outputs"]) == (50, 4, 8)
+    assert rec["order"] == 2 and rec["seed"] == 0 and rec["held"] is True
+    assert rec["reach"] == 150.0
+    assert doc["summary"]["2"]["held"] == 1 and doc["summary"]["2"]["of"] == 1
+    family = load_family("goland_4flaps")
+    K = design_over_speeds(family, (60.0, 150.0), 2, seed=0,
+                           settings=MultiSpeedSettings(decay=0.05)).controller
+    check = verify_family(family, K, speed_range=family.speed_range)
+    assert rec["certified_interval"] == pytest.approx(list(check.stable_interval), rel=1e-9)
+    assert rec["certified_interval"][0] <= 60.0 and rec["certified_interval"][1] >= 150.0
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--interval", "150", "60"], "LO < HI"),
+    (["--interval", "60", "150", "--orders", "two"], "--orders"),
+    (["--interval", "60", "150", "--problem", "no_such_problem"], "neither a plant family"),
+])
+def test_bad_arguments_are_refused_before_any_work(tmp_path, capsys, args, words):
+    out = tmp_path / "b.json"
+    base = ["bench", "design", "--problem", "goland_4flaps", "--out", str(out)]
+    assert main(base + args) == 1
+    assert words in capsys.readouterr().err
+    assert not out.exists()
