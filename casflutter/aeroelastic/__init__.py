@@ -8,6 +8,7 @@
   :class:`LoopFamily` — the interface they share (a loop with one flap at every speed index);
   :class:`PlantFamily` — any linear plant over a speed range (named inputs and outputs,
   controls and measurements, units, feedback convention), of which every loop family is one;
+  :class:`MatrixFamily` — a family that computes ``(A, B, C, D)`` at each speed;
   :class:`GriddedFamily` — state-space models at a grid of speeds, interpolated;
   :func:`load_family` / :func:`write_family` — a gridded family from / to a family file
   (``kind = "plant_family"``: a TOML file and an ``.npz`` or MATLAB ``.mat`` data file);
@@ -32,7 +33,7 @@
   Q(ik), and :func:`pk_flutter`, the p-k flutter solution on a Q(ik) table.
 """
 
-from ._family import FEEDBACK_SIGNS, FamilySignals, GriddedFamily, PlantFamily
+from ._family import FEEDBACK_SIGNS, FamilySignals, GriddedFamily, MatrixFamily, PlantFamily
 from ._family_flutter import family_flutter
 from ._family_io import family_record, load_family, write_family
 from ._flap_wing import FlapWingFamily
@@ -51,7 +52,7 @@ from ._tracking import EigenTracking, eig_sorted_by_reference, track_eigenvalues
 from ._truth_loop import TruthLoop
 
 __all__ = [
-    "PlantFamily", "FamilySignals", "GriddedFamily", "FEEDBACK_SIGNS",
+    "PlantFamily", "MatrixFamily", "FamilySignals", "GriddedFamily", "FEEDBACK_SIGNS",
     "load_family", "write_family", "family_record", "FlapWingFamily", "family_flutter",
     "AeroelasticSystem", "AeroelasticLoop", "LoopFamily", "ParametricSystem", "ServoSystem",
     "aeroelastic_loop",

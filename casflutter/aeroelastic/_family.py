@@ -34,7 +34,7 @@ import numpy as np
 from ..data import check_grid_speeds, check_stack
 from ..errors import ConfigError, DimensionError
 
-__all__ = ["FEEDBACK_SIGNS", "FamilySignals", "PlantFamily", "GriddedFamily"]
+__all__ = ["FEEDBACK_SIGNS", "FamilySignals", "PlantFamily", "MatrixFamily", "GriddedFamily"]
 
 #: The sign ``s`` of ``u = s K y`` for each feedback convention.
 FEEDBACK_SIGNS = {"positive": 1.0, "negative": -1.0}
@@ -341,7 +341,55 @@ class PlantFamily(abc.ABC):
                 + (f", disturbances {list(s.disturbances)}" if s.disturbances else ""))
 
 
-class GriddedFamily(PlantFamily):
+class MatrixFamily(PlantFamily):
+    """A family that computes its plant's matrices at each speed (:meth:`matrices`): the
+    named plant and the state matrix follow from them."""
+
+    @abc.abstractmethod
+    def matrices(self, V: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(A, B, C, D)`` at speed V.
+
+        Parameters
+        ----------
+        V : float
+            Speed inside :attr:`speed_range`.
+
+        Returns
+        -------
+        tuple of ndarray
+        """
+
+    def plant(self, V: float) -> control.StateSpace:
+        """The plant at speed V, inputs and outputs named by :attr:`signals`.
+
+        Parameters
+        ----------
+        V : float
+            Speed inside :attr:`speed_range`.
+
+        Returns
+        -------
+        control.StateSpace
+        """
+        s = self.signals
+        return control.ss(*self.matrices(V), inputs=list(s.inputs), outputs=list(s.outputs))
+
+    def state_matrix(self, V: float) -> np.ndarray:
+        """``A`` at speed V.
+
+        Parameters
+        ----------
+        V : float
+            Speed inside :attr:`speed_range`.
+
+        Returns
+        -------
+        ndarray
+        """
+        return self.matrices(V)[0]
+
+
+class GriddedFamily(MatrixFamily):
     """A plant family given at a grid of speeds, linearly interpolated between them.
 
     The state-space matrices are interpolated elementwise between neighbouring grid speeds,
@@ -433,35 +481,6 @@ class GriddedFamily(PlantFamily):
         """
         j, t = self._weights(V)
         return tuple((1.0 - t) * M[j] + t * M[j + 1] for M in self._mats)
-
-    def plant(self, V: float) -> control.StateSpace:
-        """The plant at V (interpolated; see the class docstring).
-
-        Parameters
-        ----------
-        V : float
-            Speed inside the grid's range.
-
-        Returns
-        -------
-        control.StateSpace
-        """
-        s = self.signals
-        return control.ss(*self.matrices(V), inputs=list(s.inputs), outputs=list(s.outputs))
-
-    def state_matrix(self, V: float) -> np.ndarray:
-        """A at V (interpolated).
-
-        Parameters
-        ----------
-        V : float
-            Speed inside the grid's range.
-
-        Returns
-        -------
-        ndarray
-        """
-        return self.matrices(V)[0]
 
     @property
     def n_states(self) -> int:

@@ -35,14 +35,13 @@ import math
 from dataclasses import dataclass, field
 from functools import cached_property
 
-import control
 import numpy as np
 
 from .._format import result_repr
 from ..errors import ConfigError
 from ..truth import JONES_A, GolandParams, GolandWing
 from ..truth._goland import _bending_shapes
-from ._family import FamilySignals, PlantFamily
+from ._family import FamilySignals, MatrixFamily
 from ._loop import check_servo
 
 __all__ = ["FlapWingFamily"]
@@ -57,7 +56,7 @@ def _station(y: float) -> str:
 
 
 @dataclass(frozen=True)
-class FlapWingFamily(PlantFamily):
+class FlapWingFamily(MatrixFamily):
     """The Goland wing with flap segments, actuators, rate gyros and accelerometers.
 
     See the module docstring for the model.  The default instance is the 50-state,
@@ -276,36 +275,6 @@ class FlapWingFamily(PlantFamily):
         C = np.vstack([np.hstack([np.zeros((ngy, ig.start)), np.eye(ngy)]), acc @ A[iud]])
         D = np.vstack([np.zeros((ngy, nf)), acc @ B[iud]])
         return A, B, C, D
-
-    def plant(self, V: float) -> control.StateSpace:
-        """The plant at airspeed V [m/s].
-
-        Parameters
-        ----------
-        V : float
-            Airspeed inside :attr:`speed_range`.
-
-        Returns
-        -------
-        control.StateSpace
-            Named inputs and outputs (:attr:`signals`).
-        """
-        s = self.signals
-        return control.ss(*self.matrices(V), inputs=list(s.inputs), outputs=list(s.outputs))
-
-    def state_matrix(self, V: float) -> np.ndarray:
-        """The open-loop state matrix at airspeed V.
-
-        Parameters
-        ----------
-        V : float
-            Airspeed [m/s].
-
-        Returns
-        -------
-        ndarray
-        """
-        return self.matrices(V)[0]
 
     @property
     def n_states(self) -> int:
