@@ -184,16 +184,16 @@ def controller_stage(cfg: RunConfig, family, *, system=None, Vf: float | None = 
                                   "loop's flutter speed (eq. 14); this problem has no ROM loop "
                                   "with a flutter speed: use method = \"multispeed\"")
         syn = _paper(cfg, P, lft)
-        K = syn.controller
-    else:
+        sig = family.signals    # the LFT's K reads the measurements and drives the flap
+        K = control.ss(syn.controller.A, syn.controller.B, syn.controller.C,
+                       syn.controller.D, inputs=list(sig.measurements),
+                       outputs=list(sig.controls), name="K")
+    else:                       # design_over_speeds names K after the family
         design = _multispeed(cfg, family)
         K = design.controller
         if not design.held:
             log.warning("controller: %s", design.message)
     t_design = time.perf_counter() - t0
-    sig = family.signals                 # K reads the measurements and drives the controls
-    K = control.ss(K.A, K.B, K.C, K.D, inputs=list(sig.measurements),
-                   outputs=list(sig.controls), name="K")
     rng = verification_range(family, cfg)
     checks = {"design": verify_family(family, K, speed_range=rng, margins=c.margins)}
     for name, ref in dict(references).items():
