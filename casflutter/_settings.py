@@ -31,7 +31,8 @@ from typing import Any, Mapping
 
 from .errors import ConfigError
 
-__all__ = ["build_settings", "set_dotted", "settings_as", "field_names", "finite_numbers"]
+__all__ = ["build_settings", "set_dotted", "settings_as", "field_names", "finite_numbers",
+           "reject_unknown"]
 
 
 def field_names(cls) -> list[str]:
@@ -150,6 +151,38 @@ def build_settings(cls, table: Mapping[str, Any], path: str = ""):
         raise _located(exc, path, allowed) from None
     except (TypeError, ValueError) as exc:  # a stage's own check that is not a ConfigError
         raise _located(ConfigError(str(exc)), path, allowed) from None
+
+
+def reject_unknown(table: Mapping[str, Any], allowed, what: str = "unknown key(s)", *,
+                   where: str = "", allowed_text: str | None = None) -> None:
+    """Raise :class:`~casflutter.errors.ConfigError` when a table read by hand (not by
+    :func:`build_settings`) has keys outside ``allowed``.
+
+    The message reads ``"{what} {unknown keys, sorted}{where}; allowed: {allowed_text}"``,
+    e.g. ``"unknown key(s) ['smaples'] in [study]; allowed: ['name', 'samples', ...]"``.
+
+    Parameters
+    ----------
+    table : mapping
+        The table (its keys are checked).
+    allowed : set of str
+        The keys it may have.
+    what : str
+        The message's start.
+    where : str
+        Where the table is, after the unknown keys (``" in [study]"``).
+    allowed_text : str, optional
+        The allowed keys as the message lists them (default ``sorted(allowed)``).
+
+    Raises
+    ------
+    ConfigError
+        A key outside ``allowed``.
+    """
+    bad = set(table) - set(allowed)
+    if bad:
+        listed = sorted(allowed) if allowed_text is None else allowed_text
+        raise ConfigError(f"{what} {sorted(bad)}{where}; allowed: {listed}")
 
 
 def _located(exc: ConfigError, path: str, names) -> ConfigError:

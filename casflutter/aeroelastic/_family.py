@@ -60,6 +60,13 @@ def _subset(what: str, names: tuple, pool: tuple, pool_what: str) -> None:
                           + (f" ({hint})" if hint else ""))
 
 
+def _positions(names, default: tuple, pool: tuple, pool_what: str) -> list[int]:
+    """Positions in ``pool`` of ``names`` (``None``: ``default``), checked by :func:`_subset`."""
+    names = default if names is None else tuple(names)
+    _subset(f"{pool_what} asked for", names, pool, pool_what)
+    return [pool.index(n) for n in names]
+
+
 @dataclass(frozen=True)
 class FamilySignals:
     """Names, roles and units of a family's inputs and outputs.
@@ -130,20 +137,19 @@ class FamilySignals:
         Parameters
         ----------
         names : sequence of str, optional
-            Input names.
+            Input names, in the order wanted.
 
         Returns
         -------
         list of int
+            Column indices into the plant's ``B`` and ``D``.
 
         Raises
         ------
         ConfigError
             A name the plant does not have (with the closest one).
         """
-        names = self.controls if names is None else tuple(names)
-        _subset("inputs asked for", names, self.inputs, "inputs")
-        return [self.inputs.index(n) for n in names]
+        return _positions(names, self.controls, self.inputs, "inputs")
 
     def output_index(self, names=None) -> list[int]:
         """Positions of outputs in the plant (default: the measurements).
@@ -151,20 +157,19 @@ class FamilySignals:
         Parameters
         ----------
         names : sequence of str, optional
-            Output names.
+            Output names, in the order wanted.
 
         Returns
         -------
         list of int
+            Row indices into the plant's ``C`` and ``D``.
 
         Raises
         ------
         ConfigError
-            A name the plant does not have (with the closest one).
+            As :meth:`input_index`, for an output name.
         """
-        names = self.measurements if names is None else tuple(names)
-        _subset("outputs asked for", names, self.outputs, "outputs")
-        return [self.outputs.index(n) for n in names]
+        return _positions(names, self.measurements, self.outputs, "outputs")
 
 
 class PlantFamily(abc.ABC):
@@ -360,32 +365,13 @@ class MatrixFamily(PlantFamily):
         """
 
     def plant(self, V: float) -> control.StateSpace:
-        """The plant at speed V, inputs and outputs named by :attr:`signals`.
-
-        Parameters
-        ----------
-        V : float
-            Speed inside :attr:`speed_range`.
-
-        Returns
-        -------
-        control.StateSpace
-        """
+        """The plant of :meth:`matrices` at speed V, inputs and outputs named by
+        :attr:`signals`; see :meth:`PlantFamily.plant`."""
         s = self.signals
         return control.ss(*self.matrices(V), inputs=list(s.inputs), outputs=list(s.outputs))
 
     def state_matrix(self, V: float) -> np.ndarray:
-        """``A`` at speed V.
-
-        Parameters
-        ----------
-        V : float
-            Speed inside :attr:`speed_range`.
-
-        Returns
-        -------
-        ndarray
-        """
+        """``A`` of :meth:`matrices` at speed V; see :meth:`PlantFamily.state_matrix`."""
         return self.matrices(V)[0]
 
 

@@ -146,19 +146,16 @@ def write_family(family: PlantFamily, path, speeds, format: str = "npz", *,
         The problem file (``.toml``).
     speeds : array_like
         Grid speeds inside the family's range.
-    format : {"npz", "mat"}
-        The data file's format (``.mat``: MATLAB v5, matrices as pages ``n x n x k``).
-    data_file : str, optional
-        The data file's name (default the problem file's stem with the format's suffix).
+    format, data_file, overwrite :
+        The data file's format and name, and whether existing files are replaced: see
+        :meth:`casflutter.data.FamilyFile.write`.
     name, description, source, reference :
         See :func:`family_record`.
-    overwrite : bool
-        Replace existing files.
 
     Returns
     -------
     pathlib.Path
-        The problem file.
+        The problem file written (its data file beside it).
 
     Raises
     ------

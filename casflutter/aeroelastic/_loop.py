@@ -306,17 +306,8 @@ class LoopFamily(PlantFamily):
                              input_units=("",) * s.n_modes + ("rad",))
 
     def plant(self, V: float) -> control.StateSpace:
-        """The loop at V as a named plant (:meth:`AeroelasticLoop.statespace`).
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        control.StateSpace
-        """
+        """The loop at speed index V as a named plant (:meth:`AeroelasticLoop.statespace`);
+        see :meth:`PlantFamily.plant`."""
         P, sig = self.loop(float(V)).statespace(), self.signals
         return control.ss(P.A, P.B, P.C, P.D, inputs=list(sig.inputs),
                           outputs=list(sig.outputs))
@@ -327,7 +318,7 @@ class LoopFamily(PlantFamily):
         Parameters
         ----------
         V : float
-            Speed index.
+            Speed index, inside :attr:`speed_range`.
 
         Returns
         -------
@@ -336,17 +327,8 @@ class LoopFamily(PlantFamily):
         raise NotImplementedError
 
     def state_matrix(self, V: float) -> np.ndarray:
-        """The open-loop state matrix at speed index V.
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        ndarray
-        """
+        """The open-loop state matrix of :meth:`loop` at speed index V; see
+        :meth:`PlantFamily.state_matrix`."""
         return self.loop(V).A
 
     def closed_loop_state_matrix(self, V: float, controller) -> np.ndarray:
@@ -423,7 +405,7 @@ class AeroelasticSystem(LoopFamily):
         Parameters
         ----------
         V : float
-            Speed index.
+            Speed index at which the loop is closed.
 
         Returns
         -------
@@ -439,7 +421,7 @@ class AeroelasticSystem(LoopFamily):
         Parameters
         ----------
         V : float
-            Speed index (> 0).
+            The speed index (> 0) whose time scale Σf keeps.
 
         Returns
         -------
@@ -530,17 +512,7 @@ class AeroelasticSystem(LoopFamily):
         return self.structure.mode_states
 
     def state_matrix(self, V: float) -> np.ndarray:
-        """Â(V) of eq. 8a.
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        ndarray, shape (2N + nf, 2N + nf)
-        """
+        """Â(V) of eq. 8a, shape ``(2N + nf, 2N + nf)``; see :meth:`PlantFamily.state_matrix`."""
         s = self.structure
         V2, r = float(V) ** 2, self.lag_scale(V)
         As, Bs, Cs = s.As, s.Bs, s.Cs
@@ -549,12 +521,7 @@ class AeroelasticSystem(LoopFamily):
         return np.vstack([top, bot])
 
     def modal_structure(self) -> ModalStructure:
-        """Σs (the attribute ``structure``).
-
-        Returns
-        -------
-        ModalStructure
-        """
+        """Σs (the attribute ``structure``); see :meth:`LoopFamily.modal_structure`."""
         return self.structure
 
     def with_servo(self, omega: float, zeta: float = 0.7) -> "ServoSystem":
@@ -563,10 +530,9 @@ class AeroelasticSystem(LoopFamily):
 
         Parameters
         ----------
-        omega : float
-            Servo natural frequency [rad per time unit] (> 0).
-        zeta : float
-            Servo damping ratio (>= 0).
+        omega, zeta : float
+            The servo's natural frequency and damping ratio, as in
+            :meth:`AeroelasticLoop.with_servo`.
 
         Returns
         -------
@@ -581,17 +547,8 @@ class AeroelasticSystem(LoopFamily):
         return ServoSystem(self, omega, zeta)
 
     def loop(self, V: float) -> AeroelasticLoop:
-        """ΣAE at speed index V (eq. 8-9), with flap input v and disturbance w.
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        AeroelasticLoop
-        """
+        """ΣAE at speed index V (eq. 8-9), with flap input v and disturbance w; see
+        :meth:`LoopFamily.loop`."""
         s = self.structure
         V2 = float(V) ** 2
         nf = self.n_f
@@ -656,12 +613,7 @@ class ParametricSystem(LoopFamily):
                                  f"{self.structure.n_modes} modes; they must be equal")
 
     def modal_structure(self) -> ModalStructure:
-        """Σs (the attribute ``structure``).
-
-        Returns
-        -------
-        ModalStructure
-        """
+        """Σs (the attribute ``structure``); see :meth:`LoopFamily.modal_structure`."""
         return self.structure
 
     def system_at(self, V: float) -> AeroelasticSystem:
@@ -670,7 +622,7 @@ class ParametricSystem(LoopFamily):
         Parameters
         ----------
         V : float
-            Speed index.
+            Speed index at which the ROMs are interpolated.
 
         Returns
         -------
@@ -680,35 +632,18 @@ class ParametricSystem(LoopFamily):
                                             warn_unstable=False)
 
     def loop(self, V: float) -> AeroelasticLoop:
-        """ΣAE at speed index V (eq. 8-9) with Σf interpolated at the same V.
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        AeroelasticLoop
-        """
+        """ΣAE at speed index V (eq. 8-9) with Σf interpolated at the same V; see
+        :meth:`LoopFamily.loop`."""
         return AeroelasticSystem(self.structure, *self.rom.sigma_f_matrices(V)).loop(V)
 
     def state_matrix(self, V: float) -> np.ndarray:
-        """Â(V) of eq. 8a with Σf interpolated at the same V.
+        """Â(V) of eq. 8a with Σf interpolated at the same V; see
+        :meth:`PlantFamily.state_matrix`.
 
         The origin mode of a branch is judged by the nearest natural frequency
         (``structure.omega``; the class has no ``mode_states``): the canonical realisation's
         states are not balanced, so eigenvector energy fractions would be dominated by the
         aerodynamic states.
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        ndarray
         """
         return AeroelasticSystem(self.structure, *self.rom.sigma_f_matrices(V)).state_matrix(V)
 
@@ -747,12 +682,7 @@ class ServoSystem(LoopFamily):
         check_servo(self.servo_omega, self.servo_zeta, ("servo_omega", "servo_zeta"))
 
     def modal_structure(self) -> ModalStructure:
-        """Σs of the family behind the servo.
-
-        Returns
-        -------
-        ModalStructure
-        """
+        """Σs of the family behind the servo; see :meth:`LoopFamily.modal_structure`."""
         return self.system.modal_structure()
 
     @property
@@ -761,16 +691,6 @@ class ServoSystem(LoopFamily):
         return self.system.speed_degree
 
     def loop(self, V: float) -> AeroelasticLoop:
-        """The family's loop at speed index V, flap behind the servo.
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        AeroelasticLoop
-            States ``(x, v, v̇)``.
-        """
+        """The family's loop at speed index V, flap behind the servo (states ``(x, v, v̇)``);
+        see :meth:`LoopFamily.loop`."""
         return self.system.loop(V).with_servo(self.servo_omega, self.servo_zeta)

@@ -170,7 +170,8 @@ def mode_residues(family, speeds, *, mode: complex | None = None, min_score: flo
     >>> import numpy as np
     >>> from casflutter.aeroelastic import TruthLoop, mode_residues
     >>> from casflutter.truth import SeedWing
-    >>> res = mode_residues(TruthLoop(SeedWing(), 251.3), np.linspace(1.1, 2.4, 27))
+    >>> res = mode_residues(TruthLoop(SeedWing(), servo_omega=251.3),
+    ...                     np.linspace(1.1, 2.4, 27))
     >>> bool(res.phase_swing_deg.min() > 150)        # the flap's grip turns round
     True
     """
@@ -291,7 +292,8 @@ def control_reversal(family, speeds, *, mode: complex | None = None,
     >>> import numpy as np
     >>> from casflutter.aeroelastic import TruthLoop, control_reversal
     >>> from casflutter.truth import SeedWing
-    >>> rev = control_reversal(TruthLoop(SeedWing(), 251.3), np.linspace(0.05, 2.4, 48))
+    >>> wing = TruthLoop(SeedWing(), servo_omega=251.3)      # the flap behind a 40 Hz servo
+    >>> rev = control_reversal(wing, np.linspace(0.05, 2.4, 48))
     >>> 1.4 < rev.V < 1.5                      # the wing's flutter mode reverses near 1.46
     True
     """

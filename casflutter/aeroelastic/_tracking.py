@@ -163,6 +163,7 @@ def track_eigenvalues(matrix_fn, V_grid, *, min_score: float = 0.9, max_refine: 
     Returns
     -------
     EigenTracking
+        The branches at the speeds of ``V_grid`` and at those the bisection added.
 
     See Also
     --------

@@ -79,27 +79,14 @@ class TruthLoop(LoopFamily):
         return self.truth.n_modes
 
     def modal_structure(self) -> ModalStructure:
-        """The sensors' structure (``sensors``, or the truth's own).
-
-        Returns
-        -------
-        ModalStructure
-        """
+        """The sensors' structure (``sensors``, or the truth's own); see
+        :meth:`LoopFamily.modal_structure`."""
         return self.sensors if self.sensors is not None else self.truth.modal_structure()
 
     def loop(self, V: float) -> AeroelasticLoop:
-        """The linear loop at speed index V.
-
-        Parameters
-        ----------
-        V : float
-            Speed index.
-
-        Returns
-        -------
-        AeroelasticLoop
-            ``n_f`` counts every state beyond the structure's ``2N`` (lags and servo).
-        """
+        """The truth's linear loop at speed index V, flap behind the servo; see
+        :meth:`LoopFamily.loop`.  Its ``n_f`` counts every state beyond the structure's ``2N``
+        (lags and servo)."""
         P = self.truth.statespace(float(V), actuator_omega=self.servo_omega,
                                   actuator_zeta=self.servo_zeta)
         A, B = np.asarray(P.A, float), np.asarray(P.B, float)

@@ -99,6 +99,7 @@ def chirp_excitation(n_samples: int, dt: float, n_channels: int = 1, *,
     See Also
     --------
     chirp_motion : one chirp with its exact derivatives.
+    stepped_chirp_motion : chirps at several amplitude levels, one after the other.
     truth_records : chirp records of a truth simulator.
 
     Examples

@@ -669,6 +669,7 @@ def flutter_config(problem: str, *, updates=None) -> RunConfig:
     Returns
     -------
     RunConfig
+        Validated; its run gives the command's flutter speeds.
 
     Raises
     ------

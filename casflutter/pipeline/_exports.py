@@ -79,6 +79,7 @@ def check_output_folder(out_dir, *, overwrite: bool = False) -> Path:
     Returns
     -------
     pathlib.Path
+        The folder to write (``out_dir`` or :data:`DEFAULT_OUT`).
 
     Raises
     ------

@@ -260,6 +260,8 @@ def rom_model(cfg: RunConfig, problem, structure, progress, *, needs_vf: bool
     Returns
     -------
     (ModelStage, FlutterStage)
+        The records, the ROM, its fit, Σf and ΣAE(V); the flutter of the ROM loop, of the
+        truth and (``rom.method = "hwl"``) of the speed-following ROM.
 
     Raises
     ------
@@ -411,6 +413,7 @@ def gaf_model(cfg: RunConfig, gaf: GAFProblem, structure, progress
     Returns
     -------
     (ModelStage, FlutterStage)
+        The RFA and its ΣAE(U); its flutter in m/s and the p–k solution.
 
     Raises
     ------
@@ -470,6 +473,7 @@ def family_model(cfg: RunConfig, record, progress) -> tuple[ModelStage, FlutterS
     Returns
     -------
     (ModelStage, FlutterStage)
+        The family; its crossings.
     """
     with progress.stage("family"):
         family = load_family(record)

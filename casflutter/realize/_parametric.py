@@ -138,7 +138,7 @@ class ParametricROM:
         Parameters
         ----------
         V : float
-            Speed index.
+            Speed index at which the ROMs' coefficients are interpolated.
 
         Returns
         -------
@@ -160,7 +160,7 @@ class ParametricROM:
         Parameters
         ----------
         V : float
-            Speed index.
+            Speed index, as in :meth:`model_at`.
 
         Returns
         -------
@@ -178,7 +178,7 @@ class ParametricROM:
         Parameters
         ----------
         V : float
-            Speed index.
+            Speed index, as in :meth:`sigma_f`.
 
         Returns
         -------

@@ -99,6 +99,8 @@ def pipeline_config(params: Mapping[str, Any], settings: Mapping[str, Any] | Non
     Returns
     -------
     RunConfig
+        The base file (``config``, default the seed wing's) with the point's values and the
+        fixed changes applied.
 
     Raises
     ------

@@ -37,6 +37,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from .._resources import read_toml
+from .._settings import reject_unknown
 from ..errors import ConfigError
 
 __all__ = ["Parameter", "Study", "load_study", "point_key", "check_setting"]
@@ -219,10 +220,7 @@ class Parameter:
             return cls(name, values=(spec,))
         if isinstance(spec, Mapping):
             allowed = {"low", "high", "num", "scale", "integer", "values"}
-            bad = set(spec) - allowed
-            if bad:
-                raise ConfigError(f"parameter {name!r}: unknown key(s) {sorted(bad)}; allowed: "
-                                  f"{sorted(allowed)}")
+            reject_unknown(spec, allowed, f"parameter {name!r}: unknown key(s)")
             vals = spec.get("values")
             if vals is not None and not isinstance(vals, list):
                 raise ConfigError(f"parameter {name!r}: values = {vals!r} must be a list")
@@ -380,16 +378,11 @@ class Study:
                   base_dir: str | Path = ".") -> "Study":
         """From the parsed TOML tables ``study``, ``settings``, ``parameters``."""
         allowed_top = {"study", "settings", "parameters"}
-        bad = set(data) - allowed_top
-        if bad:
-            raise ConfigError(f"unknown table(s) {sorted(bad)} in the study file; allowed: "
-                              f"{sorted(allowed_top)}")
+        reject_unknown(data, allowed_top, "unknown table(s)", where=" in the study file")
         st = dict(data.get("study", {}))
         allowed = {"name", "evaluator", "design", "samples", "seed", "outputs", "workers",
                    "scheduler"}
-        bad = set(st) - allowed
-        if bad:
-            raise ConfigError(f"unknown key(s) {sorted(bad)} in [study]; allowed: {sorted(allowed)}")
+        reject_unknown(st, allowed, where=" in [study]")
         if "evaluator" not in st:
             raise ConfigError("[study] needs evaluator = \"NAME\" (e.g. \"truth_flutter\")")
         for table in ("study", "settings", "parameters"):

@@ -153,7 +153,7 @@ class FamilyVerification:
         Parameters
         ----------
         lo, hi : float
-            Speeds.
+            The ends of the speed range asked about, in :attr:`speed_unit`.
 
         Returns
         -------
@@ -168,7 +168,7 @@ class FamilyVerification:
         Parameters
         ----------
         lo, hi : float
-            Speeds.
+            As :meth:`covers`.
 
         Returns
         -------

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from ..._outputs import print_json
 
-__all__ = ["run_family", "summarize_family"]
+__all__ = ["print_notes", "run_family", "summarize_family"]
 
 
 def summarize_family(family, result, problem: str, *, seconds: float | None = None) -> dict:
@@ -115,7 +115,7 @@ def run_family(args, record, label: str, fig_path) -> int:
     t0 = time.perf_counter()
     result = family_flutter(family, speeds=speeds)
     doc = summarize_family(family, result, label, seconds=time.perf_counter() - t0)
-    doc["figure"] = None
+    doc["figure"] = fig_path
     if fig_path is not None:
         import matplotlib.pyplot as plt
 
@@ -125,7 +125,6 @@ def run_family(args, record, label: str, fig_path) -> int:
         fig = plot_family_vg_vf(result, family)
         fig.savefig(fig_path, dpi=110)
         plt.close(fig)
-        doc["figure"] = fig_path
     if args.json:
         print_json(doc)
         return 0
@@ -143,6 +142,12 @@ def run_family(args, record, label: str, fig_path) -> int:
                   f"{c['branch']:7d}  {c['kind']}, {c['direction']}")
     print(f"  flutter speed: {_fmt(doc['flutter_speed'], '.6g')} {u['speed']}, "
           f"{_fmt(doc['flutter_freq_hz'], '.4g')} {u['freq_hz']}")
+    return print_notes(doc)
+
+
+def print_notes(doc: dict) -> int:
+    """Print the warnings of a ``casflutter flutter`` document and its figure's path (the
+    lines under every route's table); return the handler's exit code, 0."""
     for w in doc["warnings"]:
         print(f"  warning: {w}")
     if doc["figure"]:

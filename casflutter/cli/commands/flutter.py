@@ -23,6 +23,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..._outputs import check_figure_path, print_json
+from ._flutter_family import print_notes
 
 __all__ = ["register", "run", "summarize"]
 
@@ -240,6 +241,7 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
     cfg = replace(cfg, problem=replace(cfg.problem, name=str(problem.path)))
     result = run_config(cfg, quiet=True, write=False)
     doc = summarize_gaf(result, label)
+    doc["figure"] = fig_path
     if fig_path is not None:
         import numpy as np
 
@@ -263,9 +265,6 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
                   borderaxespad=0.0)
         fig.tight_layout()
         fig.savefig(fig_path, dpi=110)
-        doc["figure"] = fig_path
-    else:
-        doc["figure"] = None
     if args.json:
         print_json(doc)
         return 0
@@ -287,11 +286,7 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
         err = (f"{100 * e['airspeed']:+8.2f}% {100 * e['omega']:+11.2f}%" if e else "")
         k = "" if b["k"] is None else f"{b['k']:.4f}"
         print(f"  {name:22} {b['airspeed_m_s']:10.2f} {b['omega_rad_s']:14.2f} {k:>8} {err}")
-    for w in doc["warnings"]:
-        print(f"  warning: {w}")
-    if doc["figure"]:
-        print(f"  V-g/V-f figure: {doc['figure']}")
-    return 0
+    return print_notes(doc)
 
 
 def run(args) -> int:
@@ -333,12 +328,10 @@ def run(args) -> int:
         cfg = replace(cfg, stages=tuple(s for s in cfg.stages if s != "parametric"))
     result = run_config(cfg, quiet=True, write=False)
     doc = summarize(result, label)
+    doc["figure"] = fig_path
     if fig_path is not None:
         Path(fig_path).parent.mkdir(parents=True, exist_ok=True)
         _figure(result, fig_path, float(truth.modal_structure().omega.max()))
-        doc["figure"] = fig_path
-    else:
-        doc["figure"] = None
     if args.json:
         print_json(doc)
         return 0
@@ -359,8 +352,4 @@ def run(args) -> int:
         print(f"  {label:{w}} {_fmt(b['V_flutter']):>18} {_fmt(b['omega_flutter']):>14} "
               f"{str(b['mode']):>12} {_fmt(b['V_divergence']):>20}")
     print(f"  {doc['explanation']}")
-    for w in doc["warnings"]:
-        print(f"  warning: {w}")
-    if doc["figure"]:
-        print(f"  V-g/V-f figure: {doc['figure']}")
-    return 0
+    return print_notes(doc)

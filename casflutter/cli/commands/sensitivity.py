@@ -108,21 +108,18 @@ def _check_sensitivity(sec: dict, params: dict) -> None:
 
 def _config(args) -> tuple[dict, dict]:
     from ..._resources import read_toml
+    from ..._settings import reject_unknown
     from ...errors import ConfigError
 
     cfg: dict = {}
     if args.config:
         cfg = read_toml(args.config, "config file")
-        bad = set(cfg) - {"sensitivity", "params", "gamma"}
-        if bad:
-            raise ConfigError(f"unknown table(s) {sorted(bad)}; allowed: [sensitivity] or "
-                              "[gamma], and [params]")
+        reject_unknown(cfg, {"sensitivity", "params", "gamma"}, "unknown table(s)",
+                       allowed_text="[sensitivity] or [gamma], and [params]")
     sec = dict(cfg.get("sensitivity", {}))
     allowed = {"problem", "parameters", "V_min", "V_max", "n_grid", "rel_step", "check",
                "method"}
-    bad = set(sec) - allowed
-    if bad:
-        raise ConfigError(f"unknown key(s) {sorted(bad)} in [sensitivity]; allowed: {sorted(allowed)}")
+    reject_unknown(sec, allowed, where=" in [sensitivity]")
     params = dict(cfg.get("params", {}))
     for item in args.sets:
         name, sep, value = item.partition("=")
