@@ -106,7 +106,9 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     A real flap servo saturates: with ``flap_limit`` the command is clipped to
     ``±flap_limit`` and the actuator stops at that angle; with ``flap_rate_limit`` the
     actuator's rate stops growing at ``±flap_rate_limit`` (its acceleration is cut while the
-    rate is at the limit and pushing outwards, and the rate is clipped after every step).
+    rate is at the limit and pushing outwards, the flap moves at the clipped rate within a
+    Runge--Kutta step, whose stages a sharp command would otherwise carry past the limit,
+    and the rate is clipped after every step).
 
     Parameters
     ----------
@@ -254,12 +256,15 @@ class _FlapServo:
 
     def integrate(self, f, s, xa, vc: float, h: float, steps: int):
         """``steps`` Runge--Kutta steps of length ``h`` of the truth ``f`` (its
-        :meth:`flap_dynamics`) and the servo under the held command ``vc``."""
+        :meth:`flap_dynamics`) and the servo under the held command ``vc``.  Within a step
+        the flap moves at most at the rate limit: a sharp command would otherwise carry the
+        stages past it."""
 
         def deriv(s_, xa_):
             vdd = self.acceleration(xa_, vc)
-            ds, _ = f(s_, xa_[0], xa_[1], vdd)
-            return ds, np.array([xa_[1], vdd])
+            rate = min(max(xa_[1], -self.rate_max), self.rate_max)
+            ds, _ = f(s_, xa_[0], rate, vdd)
+            return ds, np.array([rate, vdd])
 
         for _ in range(steps):
             k1s, k1a = deriv(s, xa)
