@@ -23,7 +23,7 @@ from scipy.optimize import brentq
 
 from .._format import result_repr
 from .._linalg import spectral_abscissa
-from ..errors import CasflutterError, ConfigError
+from ..errors import CasflutterError, ConfigError, DimensionError
 
 __all__ = ["TruthLoopSimulation", "closed_loop_truth", "gain_schedule", "SuppressionSettings",
            "SuppressionResult", "suppression_run", "truth_loop_matrix", "TruthLoopSweep",
@@ -49,6 +49,8 @@ class TruthLoopSimulation:
         Flap angle (actuator output).
     gain : ndarray, shape (K,)
         Gain schedule ``g(t_k)``.
+    v_rate : ndarray, shape (K,)
+        Flap rate (actuator output rate).
     """
 
     __repr__ = result_repr
@@ -57,6 +59,18 @@ class TruthLoopSimulation:
     zm: np.ndarray
     v: np.ndarray
     gain: np.ndarray
+    v_rate: np.ndarray | None = None
+
+
+def _record(values, shape: tuple, name: str) -> np.ndarray | None:
+    """A per-sample input record of ``shape`` as floats (``None`` stays ``None``)."""
+    if values is None:
+        return None
+    out = np.asarray(values, dtype=float)
+    if out.shape != shape:
+        raise DimensionError(f"{name} must have shape {shape} (samples, channels), got "
+                             f"{out.shape}")
+    return out
 
 
 def gain_schedule(settle: float, ramp: float, hold: float) -> Callable[[float], float]:
@@ -89,7 +103,8 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
                       substeps: int = 4, sensor: str = "acceleration",
                       kick: tuple[float, int, float] | None = None,
                       sensor_rows=None, flap_limit: float | None = None,
-                      flap_rate_limit: float | None = None) -> TruthLoopSimulation:
+                      flap_rate_limit: float | None = None, disturbance=None,
+                      sensor_noise=None) -> TruthLoopSimulation:
     """Sampled-data closed loop of the nonlinear truth with the controller ``K``.
 
     At every sample ``t_k`` the sensors are read, the controller (ZOH discretisation at the
@@ -109,6 +124,12 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     rate is at the limit and pushing outwards, the flap moves at the clipped rate within a
     Runge--Kutta step, whose stages a sharp command would otherwise carry past the limit,
     and the rate is clipped after every step).
+
+    A tunnel's turbulence enters as eq. 7's modal disturbance ``w`` (``disturbance``, held over
+    each sample interval, through the truth's own disturbance input of
+    :meth:`~casflutter.truth.AeroelasticTruth.statespace`), and its sensors' noise is added to
+    the readings the controller sees and the record keeps (``sensor_noise``);
+    :func:`~casflutter.truth.tunnel_disturbances` draws both.
 
     Parameters
     ----------
@@ -142,6 +163,10 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
         omitted.
     flap_rate_limit : float, optional
         Largest flap rate [flap unit per time unit]; no limit when omitted.
+    disturbance : array_like, shape (K, N), optional
+        Eq. 7's modal disturbance ``w`` at the samples (zero when omitted).
+    sensor_noise : array_like, shape (K, n_sensors), optional
+        Added to the sensor readings (zero when omitted).
 
     Returns
     -------
@@ -152,6 +177,8 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     ------
     ConfigError
         An unknown ``sensor`` or a non-positive limit.
+    DimensionError
+        A disturbance or noise record of the wrong shape.
 
     See Also
     --------
@@ -175,14 +202,21 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     servo = _FlapServo.of(actuator_omega, actuator_zeta, flap_limit, flap_rate_limit)
     t = np.asarray(timepts, dtype=float)
     dt = float(t[1] - t[0])
-    s = truth.layout.initial(x0, truth.state_matrix(V).shape[0])  # the flow at rest
+    nx = truth.state_matrix(V).shape[0]
+    s = truth.layout.initial(x0, nx)  # the flow at rest
     Hs = _sensor_rows(truth, sensor_rows)
+    W = _record(disturbance, (t.size, truth.n_modes), "disturbance")
+    noise = _record(sensor_noise, (t.size, Hs.shape[0]), "sensor_noise")
+    # the disturbance's rate of the truth state, per sample (eq. 7's input of statespace)
+    forcing = None if W is None else W @ np.asarray(truth.statespace(V).B)[:nx, 1:].T
     ZM = np.full((t.size, Hs.shape[0]), np.nan)
     Vf = np.zeros(t.size)
+    Vr = np.zeros(t.size)
     G = np.zeros(t.size)
     _run_closed_loop(truth, truth.flap_dynamics(V), s, _sampled(K, dt), servo, Hs,
-                     sensor == "acceleration", t, gain, kick, substeps, (ZM, Vf, G))
-    return TruthLoopSimulation(t, ZM, Vf, G)
+                     sensor == "acceleration", t, gain, kick, substeps, (ZM, Vf, Vr, G),
+                     forcing=forcing, noise=noise)
+    return TruthLoopSimulation(t, ZM, Vf, G, Vr)
 
 
 def _sampled(K: control.StateSpace, dt: float):
@@ -194,34 +228,43 @@ def _sampled(K: control.StateSpace, dt: float):
 
 
 def _run_closed_loop(truth, f, s, controller, servo, Hs, acceleration: bool, t, gain, kick,
-                     substeps: int, records) -> None:
+                     substeps: int, records, *, forcing=None, noise=None) -> None:
     """The sample loop of :func:`closed_loop_truth` from the truth state ``s``: read the
     sensors, update the controller (state ``(A, B, C, D, n)`` discretised), hold the command
-    and integrate over the sample; fills ``records = (zm, v, g)`` up to a blow-up."""
+    and integrate over the sample; fills ``records = (zm, v, v', g)`` up to a blow-up.
+    ``forcing`` (samples, states): the disturbance's rate of the state, held over each
+    sample; ``noise`` (samples, sensors): added to the readings."""
     Ak, Bk, Ck, Dk, nk = controller
-    ZM, Vf, G = records
+    ZM, Vf, Vr, G = records
     N, n = truth.n_modes, t.size
     h = float(t[1] - t[0]) / substeps
     xa = np.zeros(2)  # actuator: v, v'
     xk = np.zeros(nk)
+    fw = None  # the disturbance's rate of the state over the current sample interval
     vc = 0.0  # command held over the current sample interval
     kicked = kick is None
     for k in range(n):
         if not kicked and t[k] >= kick[0]:
             s[:2 * N] += truth.layout.vector(truth.displaced_state(kick[1], kick[2]))
             kicked = True
+        if forcing is not None:
+            fw = forcing[k]
         _, acc = f(s, xa[0], xa[1], servo.acceleration(xa, vc))
+        if fw is not None:
+            acc = acc + fw[N:2 * N]
         zm = Hs @ (acc if acceleration else s[:Hs.shape[1]])
+        if noise is not None:
+            zm = zm + noise[k]
         if not np.all(np.isfinite(zm)) or np.abs(s).max() > 1e6:
             break
-        ZM[k], Vf[k], G[k] = zm, xa[0], gain(t[k])
+        ZM[k], Vf[k], Vr[k], G[k] = zm, xa[0], xa[1], gain(t[k])
         vc = G[k] * float((Ck @ xk + Dk @ zm)[0]) if nk else G[k] * float((Dk @ zm)[0])
         vc = float(np.clip(vc, -servo.pos_max, servo.pos_max))
         if nk and G[k] > 0:  # the controller runs from its engagement (state zero before)
             xk = Ak @ xk + Bk @ zm
         if k == n - 1:
             break
-        s, xa = servo.integrate(f, s, xa, vc, h, substeps)
+        s, xa = servo.integrate(f, s, xa, vc, h, substeps, fw)
 
 
 @dataclass(frozen=True)
@@ -254,17 +297,17 @@ class _FlapServo:
             vdd = 0.0  # on the end stop
         return vdd
 
-    def integrate(self, f, s, xa, vc: float, h: float, steps: int):
+    def integrate(self, f, s, xa, vc: float, h: float, steps: int, forcing=None):
         """``steps`` Runge--Kutta steps of length ``h`` of the truth ``f`` (its
-        :meth:`flap_dynamics`) and the servo under the held command ``vc``.  Within a step
-        the flap moves at most at the rate limit: a sharp command would otherwise carry the
-        stages past it."""
+        :meth:`flap_dynamics`) and the servo under the held command ``vc`` (and the held
+        rate ``forcing`` of the state by a disturbance).  Within a step the flap moves at
+        most at the rate limit: a sharp command would otherwise carry the stages past it."""
 
         def deriv(s_, xa_):
             vdd = self.acceleration(xa_, vc)
             rate = min(max(xa_[1], -self.rate_max), self.rate_max)
             ds, _ = f(s_, xa_[0], rate, vdd)
-            return ds, np.array([rate, vdd])
+            return (ds if forcing is None else ds + forcing), np.array([rate, vdd])
 
         for _ in range(steps):
             k1s, k1a = deriv(s, xa)

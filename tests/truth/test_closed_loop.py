@@ -69,6 +69,17 @@ def test_flap_position_and_rate_limits_hold(wing):
     assert np.abs(np.diff(lim_v)).max() / dt <= rate * (1 + 1e-9)
 
 
+def test_the_rate_limit_holds_against_a_noisy_command(wing):
+    """Sensor noise makes the command jump at every sample, so the servo's acceleration is
+    large inside each Runge--Kutta step: the flap still moves no faster than the limit
+    between samples, and its recorded rate stays within it."""
+    rate = 2.0
+    noise = 50.0 * np.random.default_rng(2).standard_normal((300, 2))
+    dt, lim = _aggressive_loop(wing, flap_limit=0.2, flap_rate_limit=rate, sensor_noise=noise)
+    assert np.abs(np.diff(lim.v)).max() / dt == pytest.approx(rate, rel=1e-9)
+    assert np.abs(lim.v_rate).max() <= rate * (1 + 1e-12)
+
+
 def test_limits_far_away_change_nothing(wing):
     """Limits the loop never reaches leave the simulation bit-identical."""
     _, free = _aggressive_loop(wing)
