@@ -19,11 +19,12 @@ the noise it collects over a sample, by Van Loan's matrix exponential), started 
 stationary distribution and scaled so that the stationary rms is exactly ``σ_w``.
 
 Modal forces.  The gust changes each strip's angle of attack by ``w_g / U``; quasi-steady
-strip theory turns it into the lift ``ρ U² b c_lα w_g / U`` per unit span at the elastic axis
-(the quarter chord of a wing whose axis is there), so that the generalised-force coefficient
-of eq. 6 is ``y_g,i = −c_lα (w_g / U) h̄_i`` with ``h̄_i`` the mean over the (equal) strips
-of mode ``i``'s plunge (positive down).  It enters the structure as eq. 7's disturbance,
-``w = V² y_g`` (:func:`gust_modal_forces`).  Linear, without the Küssner lag and without
+strip theory turns it into the lift ``ρ U² b c_lα w_g / U`` per unit span (and its moment
+about the elastic axis, none for the seed wing's quarter-chord axis), so that the
+generalised-force coefficient of eq. 6 is ``y_g,i = −c_lα (w_g / U) h̄_i`` with ``h̄_i`` the
+mean over the (equal) strips of mode ``i``'s plunge (positive down).  It enters the structure
+as eq. 7's disturbance, ``w = V² y_g`` (:func:`gust_modal_forces`, through the truth's own
+strip operator).  Linear, without the Küssner lag and without
 spanwise correlation: a disturbance of the right size and spectrum, not a gust-load model.
 
 Sensor noise.  Independent white Gaussian noise of rms ``noise`` on each sensor reading, in
@@ -44,7 +45,13 @@ __all__ = ["dryden_gust", "gust_modal_forces", "tunnel_disturbances"]
 
 def dryden_gust(n: int, dt: float, sigma: float, tau: float,
                 rng: np.random.Generator) -> np.ndarray:
-    """Samples of the Dryden vertical gust (module docstring) every ``dt``.
+    """Samples of the Dryden vertical gust every ``dt``.
+
+    A stationary Gaussian process with the Dryden spectrum (MIL-F-8785C)
+    ``Φ(ω) = σ² (τ/π) (1 + 3 (τω)²) / (1 + (τω)²)²``: its shaping filter
+    ``(1 + √3 τ s) / (1 + τ s)²`` driven by white noise, discretised exactly (the transition
+    and the noise collected over a sample by Van Loan's matrix exponential), started from its
+    stationary distribution and scaled so that the stationary rms is exactly ``σ``.
 
     Parameters
     ----------
@@ -87,39 +94,53 @@ def dryden_gust(n: int, dt: float, sigma: float, tau: float,
 def gust_modal_forces(truth, V: float) -> np.ndarray:
     """Eq. 7's disturbance per unit vertical gust velocity: ``w = V² y_g / w_g``.
 
+    The gust changes each strip's angle of attack by ``w_g / U``, i.e. its downwash by
+    ``w_g``; quasi-steady, it acts through the truth's own steady circulatory strip lift and
+    moment (the ``W`` of :meth:`~casflutter.truth.AeroelasticTruth.aero_matrices`, one column
+    per strip, per unit modal mass), ``w = W 1 w_g / α`` (``u'' += α w``, eq. 6-7).  With the
+    elastic axis at the quarter chord (the seed wing) that is
+    ``y_g,i = −c_lα (w_g / U) h̄_i``, ``h̄_i`` the mean over the equal strips of mode ``i``'s
+    plunge (positive down).  A uniform gust without the Küssner lag or spanwise correlation:
+    a disturbance of the right size and spectrum rather than a gust-load model.
+
     Parameters
     ----------
     truth : AeroelasticTruth
-        A strip-theory truth with ``strip_shapes()``, ``airspeed(V)`` and ``params.lift_slope``
-        (the seed wing).
+        A strip-theory truth: ``strip_shapes()``, ``airspeed(V)`` and an aerodynamic operator
+        with one downwash per strip (the seed wing).
     V : float
         Speed index.
 
     Returns
     -------
     ndarray, shape (N,)
-        Per m/s of gust (module docstring).
+        Per m/s of gust.
 
     Raises
     ------
     ConfigError
-        A truth without strip shapes or airspeed.
+        A truth without strips or airspeed.
     """
-    needed = ("strip_shapes", "airspeed")
-    if not all(callable(getattr(truth, name, None)) for name in needed) or not hasattr(
-            getattr(truth, "params", None), "lift_slope"):
+    strips = getattr(truth, "strip_shapes", None)
+    W = None
+    if callable(strips) and getattr(getattr(truth, "speed", None), "has_airspeed", False):
+        W = np.asarray(truth.aero_matrices(V).W, dtype=float)
+        if W.shape[1] != np.size(strips()["y"]):
+            W = None
+    if W is None:
         raise ConfigError(f"the gust acts through strip theory, and the truth "
-                          f"{type(truth).__name__} has no strip shapes, airspeed and lift "
-                          "slope; set gust_intensity = 0 for it")
-    h = np.asarray(truth.strip_shapes()["h"], dtype=float)       # (N, strips), positive down
-    U = float(truth.airspeed(V))
-    return -float(V) ** 2 * float(truth.params.lift_slope) * h.mean(axis=1) / U
+                          f"{type(truth).__name__} has no aerodynamic strips with an airspeed; "
+                          "set gust_intensity = 0 for it")
+    return W.sum(axis=1) / float(truth.alpha)
 
 
 def tunnel_disturbances(truth, V: float, n: int, dt: float, *, gust_intensity: float,
                         gust_scale: float, noise: float, n_sensors: int,
                         seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The turbulence and the sensor noise of one run (module docstring).
+    """The turbulence and the sensor noise of one run: a Dryden gust of rms
+    ``gust_intensity U`` and time constant ``gust_scale / U`` (:func:`dryden_gust`) through
+    :func:`gust_modal_forces`, and independent white noise of rms ``noise`` on each sensor,
+    all drawn from ``numpy.random.default_rng(seed)`` (one seed, one record).
 
     Parameters
     ----------
