@@ -4,7 +4,8 @@
   ``K`` (ZOH at the sample time) and a second-order flap actuator, with a gain schedule
   ``g(t)`` on the controller output (paper Fig. 11 ramps it 0 -> 1);
 - :func:`suppression_run` — paper Fig. 11: the LCO develops, the gain ramps, holds and is
-  released; the attenuation of the dominant sensor;
+  released, in the tunnel's turbulence with noisy sensors; the attenuation of the dominant
+  sensor; :func:`suppression_runs` — one such run per speed, each from the established LCO;
 - :func:`truth_loop_matrix` / :func:`truth_loop_sweep` — the truth's *linear* loop with the
   controller and the actuator, and its spectral abscissa over a range of speeds with the
   closed-loop stable interval around the flutter speed.
@@ -23,11 +24,14 @@ from scipy.optimize import brentq
 
 from .._format import result_repr
 from .._linalg import spectral_abscissa
+from .._settings import finite_numbers
 from ..errors import CasflutterError, ConfigError, DimensionError
+from ._lco import truth_lco
+from ._turbulence import tunnel_disturbances
 
 __all__ = ["TruthLoopSimulation", "closed_loop_truth", "gain_schedule", "SuppressionSettings",
-           "SuppressionResult", "suppression_run", "truth_loop_matrix", "TruthLoopSweep",
-           "truth_loop_sweep"]
+           "SuppressionResult", "suppression_run", "suppression_runs", "truth_loop_matrix",
+           "TruthLoopSweep", "truth_loop_sweep"]
 
 
 def _sensor_rows(truth, rows) -> np.ndarray:
@@ -322,13 +326,23 @@ class _FlapServo:
         return s, xa
 
 
+def _nonnegative(name: str, value, *, positive: bool = False) -> None:
+    """Refuse a setting that is not a finite number ``>= 0`` (``> 0`` when ``positive``)."""
+    ok = (not isinstance(value, bool) and isinstance(value, (int, float))
+          and np.isfinite(value) and (value > 0 if positive else value >= 0))
+    if not ok:
+        raise ConfigError(f"{name} = {value!r}: must be a finite number "
+                          f"{'> 0' if positive else '>= 0'}")
+
+
 @dataclass(frozen=True)
 class SuppressionSettings:
-    """The gain-ramp run of paper Fig. 11 (times in the problem's time unit)."""
+    """The gain-ramp runs of paper Fig. 11 in a tunnel (times in the problem's time unit):
+    one run per speed factor, in turbulence with noisy sensors when asked."""
 
-    speed_factor: float = 1.05
-    """Run at ``speed_factor`` times the truth's own flutter speed (where the wing itself has
-    an LCO)."""
+    speed_factors: tuple = (1.05,)
+    """Run at each of these multiples of the truth's own flutter speed (where the wing
+    itself has an LCO)."""
     settle: float = 10.0
     """Open loop: the LCO develops."""
     ramp: float = 5.0
@@ -341,12 +355,33 @@ class SuppressionSettings:
     """Largest flap angle of the servo (the truth's flap unit; ``None``: no limit)."""
     flap_rate_limit: float | None = None
     """Largest flap rate of the servo (flap unit per time unit; ``None``: no limit)."""
+    gust_intensity: float = 0.0
+    """Turbulence intensity ``σ_w / U``: the rms of the vertical gust over the airspeed
+    (Dryden spectrum, :mod:`casflutter.truth._turbulence`); 0 for none.  Needs a strip-theory
+    truth (the seed wing)."""
+    gust_scale: float = 0.3
+    """Integral scale ``L_w`` of the turbulence [m]: the Dryden filter's time constant is
+    ``L_w / U``."""
+    noise: float = 0.0
+    """Rms of each sensor's white noise, in the sensors' unit (m/s² for accelerometers); 0 for
+    none."""
 
     def __post_init__(self):
-        for name in ("speed_factor", "settle", "ramp", "hold", "release"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
-                raise ConfigError(f"{name} = {value!r}: must be > 0")
+        factors = self.speed_factors
+        if isinstance(factors, np.ndarray):
+            factors = factors.tolist()
+        if not isinstance(factors, (list, tuple)) or not factors:
+            raise ConfigError(f"speed_factors = {factors!r}: give a list of multiples of the "
+                              "flutter speed, e.g. [1.05, 1.2]")
+        factors = finite_numbers("speed_factors", list(factors), len(factors),
+                                 what="multiples of the flutter speed")
+        if not all(f > 0 for f in factors):
+            raise ConfigError(f"speed_factors = {list(factors)!r}: every factor must be > 0")
+        object.__setattr__(self, "speed_factors", tuple(factors))
+        for name in ("settle", "ramp", "hold", "release", "gust_scale"):
+            _nonnegative(name, getattr(self, name), positive=True)
+        for name in ("gust_intensity", "noise"):
+            _nonnegative(name, getattr(self, name))
         for name in ("flap_limit", "flap_rate_limit"):
             value = getattr(self, name)
             if value is not None and (isinstance(value, bool)
@@ -384,6 +419,12 @@ class SuppressionResult:
         deflected mode.
     dominant_sensor : int
         The sensor with the largest open-loop RMS.
+    speed_factor : float or None
+        ``V`` over the truth's flutter speed.
+    flap_peak, flap_rate_peak : float or None
+        Largest ``|v|`` and ``|v'|`` while the controller is engaged (ramp and hold).
+    gust_rms : float
+        Rms of the gust velocity of the run [m/s] (0 without turbulence).
     """
 
     __repr__ = result_repr
@@ -399,18 +440,43 @@ class SuppressionResult:
     open_loop_amplitude: tuple = ()
     closed_loop_amplitude: tuple = ()
     started_from_lco: bool = False
+    speed_factor: float | None = None
+    flap_peak: float | None = None
+    flap_rate_peak: float | None = None
+    gust_rms: float = 0.0
+
+    def record(self) -> dict:
+        """The run as plain numbers (``summary.json`` → ``suppression.runs``).
+
+        Returns
+        -------
+        dict
+            ``speed_factor``, ``V``, ``attenuation_percent``, ``open_loop_rms``,
+            ``closed_loop_rms`` (per sensor), ``dominant_sensor``, ``flap_peak``,
+            ``flap_rate_peak``, ``lco_returns``, ``started_from_lco``, ``gust_rms``.
+        """
+        return {"speed_factor": self.speed_factor, "V": self.V,
+                "attenuation_percent": self.attenuation_percent,
+                "open_loop_rms": list(self.open_loop_rms),
+                "closed_loop_rms": list(self.closed_loop_rms),
+                "dominant_sensor": self.dominant_sensor, "flap_peak": self.flap_peak,
+                "flap_rate_peak": self.flap_rate_peak, "lco_returns": self.lco_returns,
+                "started_from_lco": self.started_from_lco, "gust_rms": self.gust_rms}
 
 
 def suppression_run(truth, K: control.StateSpace, V_flutter: float,
                     settings: SuppressionSettings | None = None, *, dt: float, mode: int,
-                    deflection: float, sensor_rows=None,
-                    sensor: str = "acceleration", x0=None) -> SuppressionResult:
+                    deflection: float, sensor_rows=None, sensor: str = "acceleration",
+                    x0=None, speed_factor: float | None = None,
+                    seed=0) -> SuppressionResult:
     """Paper Fig. 11 on the truth: the LCO develops, the gain ramps 0 -> 1, holds, is released.
 
     Started from ``x0``, the end state of a simulation in which the truth's LCO has
     converged (:attr:`TruthLco.final_state`), the controller is switched on against the
     established LCO, as in the wind tunnel; without it the run starts from a deflected mode
-    and the LCO must develop during ``settle``.
+    and the LCO must develop during ``settle``.  The tunnel's turbulence and the sensors'
+    noise of ``settings`` act throughout (:func:`~casflutter.truth.tunnel_disturbances`,
+    drawn from ``seed``), and the flap goes through the servo with its limits.
 
     The attenuation compares the RMS of the dominant sensor over the last third of the
     hold with its RMS over the last third of the settling phase (open-loop LCO);
@@ -422,11 +488,11 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
     truth : AeroelasticTruth
         The nonlinear simulator (:func:`closed_loop_truth` runs it with the flap servo).
     K : control.StateSpace
-        Controller from the accelerometers to the flap command.
+        Controller from the sensors to the flap command (``v_c = +K zm``).
     V_flutter : float
-        The truth's flutter speed index; the run is at ``settings.speed_factor`` times it.
+        The truth's flutter speed index; the run is at ``speed_factor`` times it.
     settings : SuppressionSettings, optional
-        Durations and speed factor.
+        Durations, servo limits, turbulence and noise.
     dt : float
         Sample time of the loop.
     mode : int
@@ -439,6 +505,10 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
         What the sensors read (:func:`closed_loop_truth`).
     x0 : array_like, optional
         Full truth state to start from (an established LCO at this speed).
+    speed_factor : float, optional
+        Default: the first of ``settings.speed_factors``.
+    seed : int or sequence of int
+        Seed of the turbulence and the noise (``numpy.random.default_rng``).
 
     Returns
     -------
@@ -451,6 +521,7 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
 
     See Also
     --------
+    suppression_runs : one run per speed factor, each from the truth's established LCO.
     closed_loop_truth : the closed-loop simulation it runs.
     truth_lco : the established LCO it starts from.
 
@@ -462,46 +533,59 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
 
     >>> lco = cf.truth_lco(truth, 1.05 * Vf, 20.0, mode=1, deflection=0.01, dt=0.002)  # doctest: +SKIP
     >>> sup = cf.suppression_run(truth, K, Vf, dt=0.002, mode=1, deflection=0.01,
-    ...                          x0=lco.final_state)                        # doctest: +SKIP
+    ...                          x0=lco.final_state, speed_factor=1.05)      # doctest: +SKIP
     >>> sup.attenuation_percent, sup.lco_returns                           # doctest: +SKIP
     """
     sp = settings or SuppressionSettings()
-    V = V_flutter * sp.speed_factor
+    factor = float(sp.speed_factors[0] if speed_factor is None else speed_factor)
+    V = V_flutter * factor
     T = sp.settle + sp.ramp + sp.hold + sp.release
     t = np.arange(0.0, T, dt)
     g = gain_schedule(sp.settle, sp.ramp, sp.hold)
     t_release = sp.settle + sp.ramp + sp.hold
+    n_sensors = _sensor_rows(truth, sensor_rows).shape[0]
+    w, noise, gust = tunnel_disturbances(truth, V, t.size, dt, gust_intensity=sp.gust_intensity,
+                                         gust_scale=sp.gust_scale, noise=sp.noise,
+                                         n_sensors=n_sensors, seed=seed)
     start = truth.displaced_state(mode, deflection) if x0 is None else x0
     sim = closed_loop_truth(truth, K, V, t, start, g,
                             kick=(t_release, mode, deflection), sensor_rows=sensor_rows,
                             sensor=sensor, flap_limit=sp.flap_limit,
-                            flap_rate_limit=sp.flap_rate_limit)
+                            flap_rate_limit=sp.flap_rate_limit,
+                            disturbance=w if sp.gust_intensity > 0 else None,
+                            sensor_noise=noise if sp.noise > 0 else None)
     if not np.all(np.isfinite(sim.zm)):
         raise CasflutterError(f"the closed-loop truth simulation at V = {V:.4f} blew up")
-    return _suppression_result(float(V), sim, t, sp, started_from_lco=x0 is not None)
+    return _suppression_result(float(V), sim, t, sp, started_from_lco=x0 is not None,
+                               speed_factor=factor, gust_rms=float(np.sqrt(np.mean(gust ** 2))))
 
 
 def _suppression_result(V: float, sim: TruthLoopSimulation, t, sp: SuppressionSettings,
-                        started_from_lco: bool) -> SuppressionResult:
-    """The RMS and peaks of each phase of a suppression run and the attenuation of the
-    dominant sensor (see :func:`suppression_run`)."""
+                        started_from_lco: bool, speed_factor: float | None = None,
+                        gust_rms: float = 0.0) -> SuppressionResult:
+    """The RMS and peaks of each phase of a suppression run, the flap's peaks while the
+    controller is engaged, and the attenuation of the dominant sensor (see
+    :func:`suppression_run`)."""
     zm = sim.zm
     T = sp.settle + sp.ramp + sp.hold + sp.release
+    t_full = sp.settle + sp.ramp
+    t_release = t_full + sp.hold
+
+    def window(a, b):
+        return (t >= a) & (t < b)
 
     def rms(a, b):
-        sel = (t >= a) & (t < b)
-        return np.sqrt(np.mean(zm[sel] ** 2, axis=0))
+        return np.sqrt(np.mean(zm[window(a, b)] ** 2, axis=0))
 
     def peak(a, b):
-        sel = (t >= a) & (t < b)
-        return np.max(np.abs(zm[sel]), axis=0)
+        return np.max(np.abs(zm[window(a, b)]), axis=0)
 
     open_rms = rms(sp.settle * 2 / 3, sp.settle)
     dom = int(np.argmax(open_rms))
-    t_full = sp.settle + sp.ramp
-    closed_rms = rms(t_full + sp.hold * 2 / 3, t_full + sp.hold)
+    closed_rms = rms(t_full + sp.hold * 2 / 3, t_release)
     after = rms(T - sp.release / 3, T)
     att = 100.0 * (1.0 - closed_rms[dom] / open_rms[dom]) if open_rms[dom] > 0 else None
+    engaged = window(sp.settle, t_release)
     return SuppressionResult(V=V, simulation=sim,
                              attenuation_percent=None if att is None else float(att),
                              open_loop_rms=tuple(map(float, open_rms)),
@@ -512,8 +596,58 @@ def _suppression_result(V: float, sim: TruthLoopSimulation, t, sp: SuppressionSe
                              open_loop_amplitude=tuple(map(float, peak(sp.settle * 2 / 3,
                                                                        sp.settle))),
                              closed_loop_amplitude=tuple(map(float, peak(
-                                 t_full + sp.hold * 2 / 3, t_full + sp.hold))),
-                             started_from_lco=started_from_lco)
+                                 t_full + sp.hold * 2 / 3, t_release))),
+                             started_from_lco=started_from_lco, speed_factor=speed_factor,
+                             flap_peak=float(np.max(np.abs(sim.v[engaged]))),
+                             flap_rate_peak=float(np.max(np.abs(sim.v_rate[engaged]))),
+                             gust_rms=gust_rms)
+
+
+def suppression_runs(truth, K: control.StateSpace, V_flutter: float,
+                     settings: SuppressionSettings | None = None, *, dt: float, mode: int,
+                     deflection: float, lco_duration: float, sensor_rows=None,
+                     sensor: str = "acceleration", seed: int = 0,
+                     lcos=None) -> tuple[SuppressionResult, ...]:
+    """One :func:`suppression_run` per speed factor of ``settings``, each from the truth's
+    established LCO at that speed.
+
+    The LCO is established by :func:`~casflutter.truth.truth_lco` (the truth released from
+    a deflected mode and continued while it still grows) unless ``lcos`` holds that run;
+    where the truth has no LCO the run starts from the deflected mode
+    (``started_from_lco`` False).  Run ``k`` draws its turbulence and noise from the seed
+    ``(seed, k)``: one seed gives the same runs.
+
+    Parameters
+    ----------
+    truth, K, V_flutter, settings, dt, mode, deflection, sensor_rows, sensor :
+        As :func:`suppression_run`.
+    lco_duration : float
+        Length of each simulation that establishes the LCO.
+    seed : int
+        The runs' seed.
+    lcos : mapping of float to TruthLco, optional
+        The truth's runs of :func:`~casflutter.truth.truth_lco` by speed factor, where
+        already computed (e.g. by an LCO study at the same speeds).
+
+    Returns
+    -------
+    tuple of SuppressionResult
+        In the order of ``settings.speed_factors``.
+    """
+    sp = settings or SuppressionSettings()
+    known = {round(float(f), 9): lco for f, lco in (lcos or {}).items()}
+    out = []
+    for k, factor in enumerate(sp.speed_factors):
+        lco = known.get(round(factor, 9))
+        if lco is None:
+            lco = truth_lco(truth, V_flutter * factor, lco_duration, mode, deflection, dt=dt,
+                            sensor_rows=sensor_rows, sensor=sensor)
+        x0 = lco.final_state if lco.kind == "lco" else None
+        out.append(suppression_run(truth, K, V_flutter, sp, dt=dt, mode=mode,
+                                   deflection=deflection, sensor_rows=sensor_rows,
+                                   sensor=sensor, x0=x0, speed_factor=factor,
+                                   seed=(int(seed), k)))
+    return tuple(out)
 
 
 def truth_loop_matrix(truth, K: control.StateSpace, V: float, *, actuator_omega: float,

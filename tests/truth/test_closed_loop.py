@@ -107,7 +107,7 @@ def test_suppression_starts_from_the_established_lco(wing):
     from casflutter.aeroelastic import find_flutter
     from casflutter.truth import SuppressionSettings, suppression_run, truth_lco
     Vf = find_flutter(wing.state_matrix, (0.3, 2.0), omega=wing.modal_structure().omega).Vf
-    sp = SuppressionSettings(speed_factor=1.05, settle=1.5, ramp=0.5, hold=1.5, release=0.5,
+    sp = SuppressionSettings(speed_factors=[1.05], settle=1.5, ramp=0.5, hold=1.5, release=0.5,
                              flap_limit=0.2618, flap_rate_limit=5.236)
     lco = truth_lco(wing, 1.05 * Vf, 10.0, 1, 0.01, dt=0.002)  # the run's [lco] settings
     assert lco.kind == "lco" and lco.final_state is not None

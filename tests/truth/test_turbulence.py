@@ -10,8 +10,9 @@ import pytest
 from scipy.signal import cont2discrete, welch
 
 from casflutter.errors import ConfigError, DimensionError
-from casflutter.truth import (closed_loop_truth, dryden_gust, gust_modal_forces,
-                              load_problem, tunnel_disturbances)
+from casflutter.truth import (SuppressionSettings, closed_loop_truth, dryden_gust,
+                              gust_modal_forces, load_problem, suppression_run,
+                              tunnel_disturbances)
 
 
 @pytest.fixture(scope="module")
@@ -94,3 +95,33 @@ def test_the_disturbance_enters_as_the_truths_own_disturbance_input(wing):
     assert np.abs(sim.zm - ref).max() <= 2e-5 * np.abs(ref).max()
     with pytest.raises(DimensionError, match="disturbance"):
         closed_loop_truth(wing, K, V, t, np.zeros(10), lambda tt: 0.0, disturbance=w[:, :2])
+
+
+def test_a_suppression_run_in_turbulence_is_reproducible_and_recorded(wing):
+    """A short gain ramp in turbulence with noisy sensors: the same seed gives the same
+    record, another seed another; the record keeps the speed factor, the flap's peaks within
+    the servo's limits and the gust's rms (sigma = intensity x airspeed, to sampling)."""
+    sp = SuppressionSettings(speed_factors=(1.05,), settle=0.6, ramp=0.2, hold=0.6,
+                             release=0.2, flap_limit=0.2618, flap_rate_limit=5.236,
+                             gust_intensity=0.005, gust_scale=0.1, noise=0.1)
+    K = control.ss([[-50.0]], [[0.0, 1.0]], [[-0.01]], [[0.0, 0.0]])
+    kw = dict(dt=0.002, mode=1, deflection=0.01)
+    a = suppression_run(wing, K, 1.085, sp, seed=(0, 0), **kw)
+    b = suppression_run(wing, K, 1.085, sp, seed=(0, 0), **kw)
+    c = suppression_run(wing, K, 1.085, sp, seed=(0, 1), **kw)
+    np.testing.assert_array_equal(a.simulation.zm, b.simulation.zm)
+    assert not np.allclose(a.simulation.zm, c.simulation.zm)
+    rec = a.record()
+    assert rec["speed_factor"] == 1.05 and rec["V"] == pytest.approx(1.05 * 1.085)
+    assert 0 < rec["flap_peak"] <= 0.2618 * (1 + 1e-9)
+    assert 0 < rec["flap_rate_peak"] <= 5.236 * (1 + 1e-9)
+    assert rec["gust_rms"] == pytest.approx(0.005 * wing.airspeed(a.V), rel=0.5)
+
+
+@pytest.mark.parametrize("changes, words", [
+    ({"speed_factors": []}, "speed_factors"), ({"speed_factors": [1.1, -1.0]}, "> 0"),
+    ({"gust_intensity": -0.1}, "gust_intensity"), ({"gust_scale": 0.0}, "gust_scale"),
+    ({"noise": float("nan")}, "noise")])
+def test_bad_suppression_settings_are_refused(changes, words):
+    with pytest.raises(ConfigError, match=words):
+        SuppressionSettings(**changes)
