@@ -475,8 +475,9 @@ class SuppressionSection(SuppressionSettings):
     hold: float = 6.0
     """Closed-loop time at full gain."""
     release: float = 25.0
-    """Open-loop time after the release: long enough for the LCO to grow back from the tap
-    to half its amplitude (its growth rate at 1.05 Vf is slow)."""
+    """Longest open-loop time after the release: long enough for the LCO to grow back from
+    the tap to half its RMS at 1.05 Vf, where it grows slowly (a run ends as soon as it is
+    back)."""
     flap_limit: float | None = 0.2618
     """Flap position limit [rad] (15 deg); from Python ``None`` for no limit."""
     flap_rate_limit: float | None = 5.236

@@ -108,7 +108,9 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
                       kick: tuple[float, int, float] | None = None,
                       sensor_rows=None, flap_limit: float | None = None,
                       flap_rate_limit: float | None = None, disturbance=None,
-                      sensor_noise=None) -> TruthLoopSimulation:
+                      sensor_noise=None,
+                      stop: Callable[[int, np.ndarray], bool] | None = None
+                      ) -> TruthLoopSimulation:
     """Sampled-data closed loop of the nonlinear truth with the controller ``K``.
 
     At every sample ``t_k`` the sensors are read, the controller (ZOH discretisation at the
@@ -171,11 +173,16 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
         Eq. 7's modal disturbance ``w`` at the samples (zero when omitted).
     sensor_noise : array_like, shape (K, n_sensors), optional
         Added to the sensor readings (zero when omitted).
+    stop : callable, optional
+        ``stop(k, zm) -> bool``, called once sample ``k`` is recorded, with the readings so
+        far (``zm[:k + 1]`` are set): ``True`` ends the simulation there, and the record
+        ends with sample ``k``.
 
     Returns
     -------
     TruthLoopSimulation
-        Stopped (NaN from there on) when the state blows up.
+        Stopped (NaN from there on) when the state blows up; cut after the sample at which
+        ``stop`` said so.
 
     Raises
     ------
@@ -217,10 +224,10 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     Vf = np.zeros(t.size)
     Vr = np.zeros(t.size)
     G = np.zeros(t.size)
-    _run_closed_loop(truth, truth.flap_dynamics(V), s, _sampled(K, dt), servo, Hs,
-                     sensor == "acceleration", t, gain, kick, substeps, (ZM, Vf, Vr, G),
-                     forcing=forcing, noise=noise)
-    return TruthLoopSimulation(t, ZM, Vf, G, Vr)
+    n = _run_closed_loop(truth, truth.flap_dynamics(V), s, _sampled(K, dt), servo, Hs,
+                         sensor == "acceleration", t, gain, kick, substeps, (ZM, Vf, Vr, G),
+                         forcing=forcing, noise=noise, stop=stop)
+    return TruthLoopSimulation(t[:n], ZM[:n], Vf[:n], G[:n], Vr[:n])
 
 
 def _sampled(K: control.StateSpace, dt: float):
@@ -232,12 +239,13 @@ def _sampled(K: control.StateSpace, dt: float):
 
 
 def _run_closed_loop(truth, f, s, controller, servo, Hs, acceleration: bool, t, gain, kick,
-                     substeps: int, records, *, forcing=None, noise=None) -> None:
+                     substeps: int, records, *, forcing=None, noise=None, stop=None) -> int:
     """The sample loop of :func:`closed_loop_truth` from the truth state ``s``: read the
     sensors, update the controller (state ``(A, B, C, D, n)`` discretised), hold the command
     and integrate over the sample; fills ``records = (zm, v, v', g)`` up to a blow-up.
     ``forcing`` (samples, states): the disturbance's rate of the state, held over each
-    sample; ``noise`` (samples, sensors): added to the readings."""
+    sample; ``noise`` (samples, sensors): added to the readings; ``stop(k, zm)``: end after
+    sample ``k``.  Returns the number of samples the record keeps."""
     Ak, Bk, Ck, Dk, nk = controller
     ZM, Vf, Vr, G = records
     N, n = truth.n_modes, t.size
@@ -262,6 +270,8 @@ def _run_closed_loop(truth, f, s, controller, servo, Hs, acceleration: bool, t, 
         if not np.all(np.isfinite(zm)) or np.abs(s).max() > 1e6:
             break
         ZM[k], Vf[k], Vr[k], G[k] = zm, xa[0], xa[1], gain(t[k])
+        if stop is not None and stop(k, ZM):
+            return k + 1
         vc = G[k] * float((Ck @ xk + Dk @ zm)[0]) if nk else G[k] * float((Dk @ zm)[0])
         vc = float(np.clip(vc, -servo.pos_max, servo.pos_max))
         if nk and G[k] > 0:  # the controller runs from its engagement (state zero before)
@@ -269,6 +279,7 @@ def _run_closed_loop(truth, f, s, controller, servo, Hs, acceleration: bool, t, 
         if k == n - 1:
             break
         s, xa = servo.integrate(f, s, xa, vc, h, substeps, fw)
+    return n
 
 
 @dataclass(frozen=True)
@@ -350,7 +361,9 @@ class SuppressionSettings:
     hold: float = 10.0
     """Full gain."""
     release: float = 10.0
-    """Open loop again, after a tap on the wing: the LCO returns."""
+    """Open loop again, after a tap on the wing, until the LCO has returned (the RMS of the
+    dominant sensor over the last ``settle / 3``, the open-loop window, above half the open
+    loop's) and at most this long."""
     flap_limit: float | None = None
     """Largest flap angle of the servo (the truth's flap unit; ``None``: no limit)."""
     flap_rate_limit: float | None = None
@@ -405,10 +418,11 @@ class SuppressionResult:
         ``100 (1 - rms_closed / rms_open)`` of the dominant sensor (``None`` when the open
         loop is at rest).
     open_loop_rms, closed_loop_rms, released_rms : tuple of float
-        RMS per sensor over the last third of the settling phase, of the hold and of the
-        release.
+        RMS per sensor over the last third of the settling phase, over the last third of the
+        hold, and over the last ``settle / 3`` of the release (the record's end).
     lco_returns : bool
-        After the release the dominant sensor climbs back above half its open-loop RMS.
+        After the release the dominant sensor climbs back above half its open-loop RMS (over
+        a window as long as the open loop's); the run ends there.
     open_loop_amplitude : tuple of float
         Peak ``|zm|`` per sensor over the last third of the settling phase, just before the
         ramp: the amplitude of the LCO the controller is switched on against.
@@ -481,7 +495,9 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
     The attenuation compares the RMS of the dominant sensor over the last third of the
     hold with its RMS over the last third of the settling phase (open-loop LCO);
     ``lco_returns`` checks that after the release (the wing is tapped with the initial
-    deflection at that moment) the amplitude climbs back above half the open-loop LCO.
+    deflection at that moment) the RMS of the dominant sensor over a window as long as the
+    open loop's climbs back above half the open-loop RMS; the run ends as soon as it does
+    (``settings.release`` is the longest release).
 
     Parameters
     ----------
@@ -553,21 +569,44 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
                             sensor=sensor, flap_limit=sp.flap_limit,
                             flap_rate_limit=sp.flap_rate_limit,
                             disturbance=w if sp.gust_intensity > 0 else None,
-                            sensor_noise=noise if sp.noise > 0 else None)
+                            sensor_noise=noise if sp.noise > 0 else None,
+                            stop=_lco_returned(t, sp))
     if not np.all(np.isfinite(sim.zm)):
         raise CasflutterError(f"the closed-loop truth simulation at V = {V:.4f} blew up")
-    return _suppression_result(float(V), sim, t, sp, started_from_lco=x0 is not None,
-                               speed_factor=factor, gust_rms=float(np.sqrt(np.mean(gust ** 2))))
+    return _suppression_result(float(V), sim, sp, started_from_lco=x0 is not None,
+                               speed_factor=factor,
+                               gust_rms=float(np.sqrt(np.mean(gust[:sim.timepts.size] ** 2))))
 
 
-def _suppression_result(V: float, sim: TruthLoopSimulation, t, sp: SuppressionSettings,
+def _lco_returned(t, sp: SuppressionSettings) -> Callable[[int, np.ndarray], bool]:
+    """``stop(k, zm)`` of a suppression run: after the release, the RMS of the dominant
+    sensor over the last ``settle / 3`` (as many samples as the open-loop window) is above
+    half its open-loop RMS."""
+    open_window = (t >= sp.settle * 2 / 3) & (t < sp.settle)
+    m = int(open_window.sum())
+    k_release = int(np.searchsorted(t, sp.settle + sp.ramp + sp.hold))
+    half = {}
+
+    def returned(k: int, zm: np.ndarray) -> bool:
+        if m == 0 or k < k_release + m - 1:
+            return False
+        if not half:      # the open loop's dominant sensor and half its RMS, once
+            open_rms = np.sqrt(np.mean(zm[open_window] ** 2, axis=0))
+            half["sensor"] = int(np.argmax(open_rms))
+            half["rms"] = 0.5 * float(open_rms[half["sensor"]])
+        last = zm[k - m + 1:k + 1, half["sensor"]]
+        return bool(np.sqrt(np.mean(last ** 2)) > half["rms"])
+
+    return returned
+
+
+def _suppression_result(V: float, sim: TruthLoopSimulation, sp: SuppressionSettings,
                         started_from_lco: bool, speed_factor: float | None = None,
                         gust_rms: float = 0.0) -> SuppressionResult:
     """The RMS and peaks of each phase of a suppression run, the flap's peaks while the
     controller is engaged, and the attenuation of the dominant sensor (see
     :func:`suppression_run`)."""
-    zm = sim.zm
-    T = sp.settle + sp.ramp + sp.hold + sp.release
+    zm, t = sim.zm, sim.timepts
     t_full = sp.settle + sp.ramp
     t_release = t_full + sp.hold
 
@@ -583,7 +622,9 @@ def _suppression_result(V: float, sim: TruthLoopSimulation, t, sp: SuppressionSe
     open_rms = rms(sp.settle * 2 / 3, sp.settle)
     dom = int(np.argmax(open_rms))
     closed_rms = rms(t_full + sp.hold * 2 / 3, t_release)
-    after = rms(T - sp.release / 3, T)
+    m = int(window(sp.settle * 2 / 3, sp.settle).sum())   # the open-loop window's samples
+    released = zm[t >= t_release]
+    after = np.sqrt(np.mean(released[-m:] ** 2, axis=0))
     att = 100.0 * (1.0 - closed_rms[dom] / open_rms[dom]) if open_rms[dom] > 0 else None
     engaged = window(sp.settle, t_release)
     return SuppressionResult(V=V, simulation=sim,

@@ -85,6 +85,12 @@ def test_the_established_lco_meets_the_tunnels_turbulence_through_the_servo(stud
     # response to the turbulence (measured 8.4 against 8.1 m/s^2 on Acc1; the window is the
     # last 2 s of the hold), so the attenuation is set by the tunnel's turbulence
     low = r.suppression.at(1.05)
+    # and it came back after the release: the run ended once its RMS over the open-loop
+    # window was back above half the open loop's, well after the shortest release (the
+    # window) and before the longest (about 16 s after the release on the default run)
+    ss = cfg.suppression
+    t_release = ss.settle + ss.ramp + ss.hold
+    assert t_release + ss.settle / 3 + 2.0 < low.simulation.timepts[-1] < t_release + ss.release
     floor = _gust_floor(r.truth, r.controller, low.V, cfg)
     dom = low.dominant_sensor
     assert low.closed_loop_rms[dom] == pytest.approx(floor[dom], rel=0.2)
