@@ -95,7 +95,7 @@ def _conclusions(res) -> dict:
             "required interval held": ("same", res.interval_ok)})
     if res.suppression is not None:
         out["LCO returns after the controller is released"] = (
-            "same", bool(res.suppression.lco_returns))
+            "same", bool(res.suppression.runs[0].lco_returns))
     return out
 
 

@@ -3,7 +3,8 @@
 - :func:`run` — ``run(config) -> RunResult``: the stages of :mod:`._run` on any problem (a
   truth, a wing or GAF file, a plant family file), each route chosen in one place
   (:data:`ROUTES`); the result has a typed result per stage (:class:`ModelStage`,
-  :class:`FlutterStage`, :class:`LcoResult`, :class:`ControllerStage`, ...) and
+  :class:`FlutterStage`, :class:`LcoResult`, :class:`ControllerStage`,
+  :class:`SuppressionStage`, ...) and
   :meth:`RunResult.summary` (``summary.json``).
 - :func:`design_family` — the family a configuration's controller stage designs on.
 - :func:`load_config` / :class:`RunConfig` — the TOML configuration; each table is the
@@ -18,10 +19,11 @@ from ._control import ControllerStage
 from ._model import ROUTES, FlutterStage, ModelStage, ParametricResult, Route
 from ._result import ClosedLoopChecks, LcoResult, RunResult, SimulationCheck
 from ._run import design_family, model_stages, run
+from ._suppression import SuppressionStage
 
 __all__ = [
     "run", "RunResult", "LcoResult", "ParametricResult", "SimulationCheck", "ClosedLoopChecks",
-    "ModelStage", "FlutterStage", "ControllerStage", "ROUTES", "Route", "design_family",
+    "ModelStage", "FlutterStage", "ControllerStage", "SuppressionStage", "ROUTES", "Route", "design_family",
     "model_stages",
     "RunConfig", "load_config", "default_config_path", "config_path", "flutter_config",
     "STAGES",

@@ -16,7 +16,8 @@ table          settings
                the starts and the design speeds
 ``[verify]``   targets and sweeps of the verification
 ``[closed_loop]`` simulations and a truth sweep of the closed loops above flutter
-``[suppression]`` the gain-ramp run on the truth (:class:`casflutter.truth.SuppressionSettings`)
+``[suppression]`` the gain-ramp runs on the truth, one per speed, in turbulence
+               (:class:`casflutter.truth.SuppressionSettings`)
 ``[parametric]`` the parametric ROM (ROMs at several speeds, interpolated in V)
 ``[sensors]``  the sensor rows ``Hs`` (eq. 7) and their kind
 ``[solver]``   flat Ipopt options for every NLP
@@ -57,7 +58,8 @@ STAGES = ("frozen", "parametric", "lco", "controller", "closed_loop", "suppressi
 
 #: Keys that were renamed: old dotted name -> new one.
 _RENAMED = {"data.band_hz": "data.band", "flutter.vrange": "flutter.V_range",
-            "controller.speed_factors": "controller.speeds"}
+            "controller.speed_factors": "controller.speeds",
+            "suppression.speed_factor": "suppression.speed_factors"}
 
 
 def _positive(name: str, value) -> None:
@@ -467,10 +469,14 @@ class SolverSection:
 
 @dataclass(frozen=True)
 class SuppressionSection(SuppressionSettings):
-    """``[suppression]``: the gain-ramp run on the truth
-    (:class:`casflutter.truth.SuppressionSettings`) with the seed wing's study phases and the
-    flap servo of a wind-tunnel model (±15 deg, 300 deg/s)."""
+    """``[suppression]``: the gain-ramp runs on the truth
+    (:class:`casflutter.truth.SuppressionSettings`, one per entry of ``speed_factors``) with
+    the seed wing's study phases, the flap servo of a wind-tunnel model (±15 deg,
+    300 deg/s), and a tunnel's turbulence and sensor noise."""
 
+    speed_factors: tuple = (1.05, 1.2)
+    """Multiples of the truth's own flutter speed, one run at each, each from the truth's
+    established LCO there."""
     settle: float = 6.0
     """Open-loop time before the ramp."""
     ramp: float = 3.0
@@ -478,12 +484,20 @@ class SuppressionSection(SuppressionSettings):
     hold: float = 6.0
     """Closed-loop time at full gain."""
     release: float = 25.0
-    """Open-loop time after the release: long enough for the LCO to grow back from the tap
-    to half its amplitude (its growth rate at 1.05 Vf is slow)."""
+    """Longest open-loop time after the release: long enough for the LCO to grow back from
+    the tap to half its RMS at 1.05 Vf, where it grows slowly (a run ends as soon as it is
+    back)."""
     flap_limit: float | None = 0.2618
     """Flap position limit [rad] (15 deg); from Python ``None`` for no limit."""
     flap_rate_limit: float | None = 5.236
     """Flap rate limit [rad/s] (300 deg/s); from Python ``None`` for no limit."""
+    gust_intensity: float = 0.005
+    """Turbulence intensity ``σ_w / U`` of the vertical gust (0.5 %, a low-speed tunnel with
+    screens); 0 for none."""
+    gust_scale: float = 0.1
+    """Integral scale ``L_w`` of the turbulence [m]."""
+    noise: float = 0.1
+    """Rms of each sensor's noise [sensor unit: m/s² for the seed wing's accelerometers]."""
 
 
 @dataclass(frozen=True)

@@ -14,15 +14,17 @@ from .._format import result_repr
 from ..aeroelastic import FlutterResult, LoopSimulation
 from .._outputs import plain_json
 from ..lco import LCOBranch
-from ..truth import AeroelasticTruth, SuppressionResult, TruthLco, TruthLoopSweep
+from ..truth import AeroelasticTruth, TruthLco, TruthLoopSweep
 from ._config import RunConfig
 from ._control import ControllerStage
 from ._exports import label_summary
 from ._model import FlutterStage, ModelStage, ParametricResult
+from ._suppression import SuppressionStage
 from ._units import speed_scale, speed_values
 
 __all__ = ["RunResult", "LcoResult", "ParametricResult", "SimulationCheck",
-           "ClosedLoopChecks", "ModelStage", "FlutterStage", "ControllerStage"]
+           "ClosedLoopChecks", "ModelStage", "FlutterStage", "ControllerStage",
+           "SuppressionStage"]
 
 
 @dataclass(frozen=True)
@@ -188,8 +190,8 @@ class RunResult:
         Stage ``controller``: the design and the verification layer's certificates.
     closed_loop : ClosedLoopChecks or None
         Stage ``closed_loop``.
-    suppression : SuppressionResult or None
-        Stage ``suppression`` (paper Fig. 11).
+    suppression : SuppressionStage or None
+        Stage ``suppression`` (paper Fig. 11): one run per ``suppression.speed_factors``.
     skipped : mapping
         Stage (or part of a stage) -> why it did not run.
     timings : mapping
@@ -213,7 +215,7 @@ class RunResult:
     lco: LcoResult | None = None
     control: ControllerStage | None = None
     closed_loop: ClosedLoopChecks | None = None
-    suppression: SuppressionResult | None = None
+    suppression: SuppressionStage | None = None
     skipped: Mapping[str, str] = field(default_factory=dict)
     timings: Mapping[str, float] = field(default_factory=dict)
     out_dir: Path | None = None
@@ -486,7 +488,8 @@ class RunResult:
         dict
             ``problem``, ``route``, ``V0``, ``n_sensors``, ``orders``, ``n_params``,
             ``fit_error_percent``, ``nf``, ``ns``, ``nae``, ``flutter``, ``flutter_truth``,
-            ``lco``, ``controller``, ``suppression`` (``None`` when the stage did not run),
+            ``lco``, ``controller``, ``suppression`` (``runs``: one record per speed; the
+            first run's numbers also at its top level) (``None`` when the stage did not run),
             ``timings_s``, ``seed``; ``skipped`` (stage -> reason) when a stage was
             skipped; and, for the stages that ran, ``v0_history``, ``flutter_frozen``,
             ``flutter_parametric``, ``verification``, ``rfa``, ``family``,
@@ -569,17 +572,22 @@ class RunResult:
                     for c in fl.crossings]}
 
     def _suppression_summary(self) -> dict | None:
-        cfg, sup = self.config, self.suppression
-        if sup is None:
+        """The tunnel's settings, every run's record (``runs``) and, at the top level, the
+        first run's numbers (the keys of a single run)."""
+        cfg, stage = self.config.suppression, self.suppression
+        if stage is None:
             return None
+        sup = stage.runs[0]
         return {"attenuation_percent": sup.attenuation_percent,
                 "lco_returns": sup.lco_returns, "V": sup.V,
                 "open_loop_amplitude": list(sup.open_loop_amplitude),
                 "closed_loop_amplitude": list(sup.closed_loop_amplitude),
                 "dominant_sensor": sup.dominant_sensor,
                 "started_from_lco": sup.started_from_lco,
-                "flap_limit": cfg.suppression.flap_limit,
-                "flap_rate_limit": cfg.suppression.flap_rate_limit}
+                "V_flutter": stage.V_flutter, "flutter_of": stage.reference,
+                "flap_limit": cfg.flap_limit, "flap_rate_limit": cfg.flap_rate_limit,
+                "gust_intensity": cfg.gust_intensity, "gust_scale": cfg.gust_scale,
+                "noise": cfg.noise, "runs": [r.record() for r in stage.runs]}
 
     def _rfa_summary(self) -> dict:
         """The RFA, its flutter in m/s and rad/s and the p–k check (GAF wing files)."""

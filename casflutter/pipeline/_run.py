@@ -26,7 +26,9 @@ logged once and listed in ``RunResult.skipped``):
   (:mod:`casflutter.pipeline._control`);
 - ``closed_loop`` — the ROM and the truth above flutter, open and closed loop, and the
   truth's linear closed loop over speed;
-- ``suppression`` — the truth with the controller gain ramped 0 -> 1 and released (Fig. 11).
+- ``suppression`` — the truth with the controller gain ramped 0 -> 1 and released (Fig. 11)
+  from its established LCO at each of ``suppression.speed_factors`` times its flutter speed,
+  in turbulence with noisy sensors (:mod:`casflutter.pipeline._suppression`).
 
 ``run(config)`` from Python writes nothing unless it is given ``out_dir``; ``casflutter run``
 writes ``casflutter-run/``.  Progress goes through :mod:`logging` (logger
@@ -51,8 +53,7 @@ from ..data import envelope_growth_rate
 from ..errors import CasflutterError, ConfigError, ConvergenceError
 from ..lco import LCOSettings, lco_branch, rom_lco_branch, rom_loop_flutter, speed_convention
 from ..realize import realize
-from ..truth import (closed_loop_truth, suppression_run, truth_lco, truth_loop_matrix,
-                     truth_loop_sweep)
+from ..truth import closed_loop_truth, truth_lco, truth_loop_matrix, truth_loop_sweep
 from ._config import RunConfig, load_config
 from ._control import ControllerStage, controller_stage
 from ._exports import check_output_folder, log_flags, write_outputs
@@ -60,6 +61,7 @@ from ._model import (ROUTES, FlutterStage, ModelStage, Route, controlled_family,
                      frozen_flutter, gaf_model, parametric_flutter, rom_model, route_of,
                      truth_family)
 from ._result import ClosedLoopChecks, LcoResult, RunResult, SimulationCheck, skipped_notes
+from ._suppression import suppression_stage
 
 __all__ = ["run", "model_stages", "design_family"]
 
@@ -314,7 +316,9 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
                                   flutters.truth, cfg.sensors.rows or None)
     if "suppression" in cfg.stages and "suppression" not in skipped:
         with progress.stage("suppression"):
-            sup = _suppression(cfg, truth, model, flutters, lco, control_stage.controller)
+            sup = suppression_stage(cfg, truth, flutters, lco, control_stage.controller,
+                                    mode=_mode(flutters.rom),
+                                    dt=model.identification.model.dt)
     timings = dict(progress.timings, total=time.perf_counter() - progress.t0)
     result = RunResult(config=cfg, problem=problem, route=route.kind, model=model,
                        flutters=flutters, lco=lco, control=control_stage, closed_loop=closed,
@@ -343,29 +347,6 @@ def _controller(cfg: RunConfig, model: ModelStage, flutters: FlutterStage, truth
                       else "[{:.5g}, {:.5g}]".format(*check.stable_interval))
         for name, check in stage.checks.items()))
     return stage
-
-
-def _suppression(cfg: RunConfig, truth, model: ModelStage, flutters: FlutterStage, lco, K):
-    """Stage ``suppression``: the truth's LCO at ``suppression.speed_factor`` times its own
-    flutter speed (paper Fig. 11 was measured on the real wing at an LCO condition), gain
-    ramped 0 -> 1, held and released."""
-    rom = model.identification.model
-    rows = cfg.sensors.rows or None
-    crit = _mode(flutters.rom)
-    V_ref = flutters.truth.Vf if flutters.truth.flutter is not None else flutters.Vf
-    V_run = float(V_ref) * cfg.suppression.speed_factor
-    if lco is not None and lco.truth is not None and abs(lco.truth.V - V_run) <= 1e-9 * V_run:
-        tr = lco.truth   # the LCO stage's truth run at this speed: its converged LCO
-    else:            # the LCO stage did not run at this speed: let the truth's LCO converge
-        tr = truth_lco(truth, V_run, cfg.lco.duration, crit, cfg.lco.initial_deflection,
-                       dt=rom.dt, sensor_rows=rows, sensor=cfg.sensors.kind)
-    x0 = tr.final_state if tr.kind == "lco" else None
-    if x0 is None:
-        log.info("the truth has no LCO at V = %.4f (%s): the suppression run starts from a "
-                 "deflected mode", V_run, tr.kind)
-    return suppression_run(truth, K, float(V_ref), cfg.suppression, dt=rom.dt, mode=crit,
-                           deflection=cfg.lco.initial_deflection, sensor_rows=rows,
-                           sensor=cfg.sensors.kind, x0=x0)
 
 
 def _mode(res: FlutterResult) -> int:

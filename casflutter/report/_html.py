@@ -120,8 +120,7 @@ def _table_i_columns(s: dict, scale) -> tuple[dict, dict]:
         "order of controller K(s)": _fmt(ctrl.get("order")),
         "number of sensors": _fmt(s.get("n_sensors")),
         "stable speed range (controller)": _with_airspeed(ctrl.get("stable_interval"), scale),
-        "LCO attenuation": (_fmt(None) if sup.get("attenuation_percent") is None
-                            else f"{sup['attenuation_percent']:.1f} %"),
+        "LCO attenuation": _attenuation(sup),
     }
     ft = s.get("flutter_truth") or {}
     truth = {   # the truth simulator's own values, where it has one
@@ -133,6 +132,17 @@ def _table_i_columns(s: dict, scale) -> tuple[dict, dict]:
                                                if lco.get("truth_kind") == "lco" else None),
     }
     return ours, truth
+
+
+def _attenuation(sup: dict) -> str:
+    """The suppression runs' attenuations, ``"1.05 Vf: 91.0 %, 1.2 Vf: 16.2 %"`` (or the
+    single run's of a summary without ``runs``)."""
+    runs = [r for r in sup.get("runs") or [] if r.get("attenuation_percent") is not None]
+    if runs:
+        return ", ".join(f"{r['speed_factor']:g} Vf: {r['attenuation_percent']:.1f} %"
+                         for r in runs)
+    att = sup.get("attenuation_percent")
+    return _fmt(None) if att is None else f"{att:.1f} %"
 
 
 def html_report(summary: dict, figures: dict[str, Path], *, title: str = "casflutter run",

@@ -104,7 +104,7 @@ def plot_flap_pulses(t, truth_zm, rom_zm, v, sensor_labels=("Acc1", "Acc2"), *,
 
 def plot_gain_ramp(t, zm, gain, v, sensor_labels=("Acc1", "Acc2"), *, phases=None,
                    open_loop_amplitude=None, dominant: int = 0, flap_limit_deg=None,
-                   time_unit: str = "s", title: str | None = None) -> Figure:
+                   time_unit: str = "s", title: str | None = None, axes=None) -> Figure:
     """Closed-loop history with the controller gain ramped 0 -> 1 and released (Fig. 11).
 
     Parameters
@@ -130,13 +130,20 @@ def plot_gain_ramp(t, zm, gain, v, sensor_labels=("Acc1", "Acc2"), *, phases=Non
     time_unit : str
         The time axis' unit.
     title : str, optional
+    axes : sequence of matplotlib.axes.Axes, optional
+        ``m + 2`` axes to draw into (a column of a larger figure, e.g. one per speed; the
+        title then goes on the top one); default a figure of its own.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
     m = zm.shape[1]
-    fig, axes = plt.subplots(m + 2, 1, sharex=True, figsize=(7.5, 1.8 * (m + 2) + 0.4))
+    own = axes is None
+    if own:
+        fig, axes = plt.subplots(m + 2, 1, sharex=True, figsize=(7.5, 1.8 * (m + 2) + 0.4))
+    else:
+        fig = axes[0].figure
     axes[0].plot(t, gain, "C3")
     axes[0].set_ylabel("controller gain")
     axes[1].plot(t, np.degrees(v), "C2", lw=0.8)
@@ -162,6 +169,10 @@ def plot_gain_ramp(t, zm, gain, v, sensor_labels=("Acc1", "Acc2"), *, phases=Non
         axes[0].text(0.5 * (t2 + t[-1]), 0.5, "released", ha="center", va="center",
                      fontsize=7)
     axes[-1].set_xlabel(f"time [{time_unit}]")
+    if not own:
+        if title:
+            axes[0].set_title(title, fontsize=9)
+        return fig
     fig.suptitle(title or "Fig. 11: flutter suppression, gain ramp and release", fontsize=10)
     fig.tight_layout()
     return fig

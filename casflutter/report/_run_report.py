@@ -177,21 +177,37 @@ def write_figures(out: Path, result) -> dict:
     files["fig10_pole_loci"] = _save(fig10, out / "fig10_pole_loci.png")
     files.update(_margin_figures(out, result))
     if result.suppression is not None:
-        sup = result.suppression
+        files["fig11_gain_ramp"] = _save(_fig11(result, labels, st.time_unit, air),
+                                         out / "fig11_gain_ramp.png")
+    return files
+
+
+def _fig11(result, labels, time_unit: str, air: dict):
+    """Paper Fig. 11, one column per suppression run (speed)."""
+    runs = result.suppression.runs
+    ss = result.config.suppression
+    limit = None if ss.flap_limit is None else float(np.degrees(ss.flap_limit))
+    m = runs[0].simulation.zm.shape[1]
+    fig, grid = plt.subplots(m + 2, len(runs), sharex=True, squeeze=False,
+                             figsize=(6.0 * len(runs) + 1.5, 1.8 * (m + 2) + 0.6))
+    for k, sup in enumerate(runs):
         sim = sup.simulation
-        ss = result.config.suppression
         t0 = float(sim.timepts[0]) + ss.settle
         dom = sup.dominant_sensor
         amp = sup.open_loop_amplitude[dom] if sup.open_loop_amplitude else None
-        limit = None if ss.flap_limit is None else float(np.degrees(ss.flap_limit))
-        files["fig11_gain_ramp"] = _save(plot_gain_ramp(
-            sim.timepts, sim.zm, sim.gain, sim.v, labels,
-            phases=(t0, t0 + ss.ramp, t0 + ss.ramp + ss.hold), open_loop_amplitude=amp,
-            dominant=dom, time_unit=st.time_unit, flap_limit_deg=limit,
-            title=f"Fig. 11: suppression of the truth's LCO at V = {sup.V:.4g}"
-                  + (f" ({sup.V * air['speed_scale']:.4g} m/s)" if air["speed_unit"] else "")),
-            out / "fig11_gain_ramp.png")
-    return files
+        att = ("" if sup.attenuation_percent is None
+               else f", attenuation {sup.attenuation_percent:.1f} %")
+        factor = "" if sup.speed_factor is None else f" ({sup.speed_factor:g} Vf)"
+        airspeed = f", {sup.V * air['speed_scale']:.4g} m/s" if air["speed_unit"] else ""
+        plot_gain_ramp(sim.timepts, sim.zm, sim.gain, sim.v, labels,
+                       phases=(t0, t0 + ss.ramp, t0 + ss.ramp + ss.hold),
+                       open_loop_amplitude=amp, dominant=dom, time_unit=time_unit,
+                       flap_limit_deg=limit, axes=grid[:, k],
+                       title=f"V = {sup.V:.4g}{factor}{airspeed}{att}")
+    fig.suptitle("Fig. 11: suppression of the truth's established LCO in turbulence, gain "
+                 "ramp and release", fontsize=10)
+    fig.tight_layout()
+    return fig
 
 
 def _margin_figures(out: Path, result) -> dict:
@@ -294,15 +310,24 @@ def figure_captions(result) -> dict:
             "sampled-data map). Stable cycles solid, unstable dashed; the open circle marks "
             "the flutter (Hopf / Neimark–Sacker) point.")
     if result.suppression is not None:
-        sup = result.suppression
-        att = ("-" if sup.attenuation_percent is None
-               else f"{sup.attenuation_percent:.1f} %")
+        ss = cfg.suppression
+        each = "; ".join(
+            f"V = {sup.V:.4g} ({sup.speed_factor:g} Vf): attenuation "
+            + ("-" if sup.attenuation_percent is None else f"{sup.attenuation_percent:.1f} %")
+            + f", flap peak {np.degrees(sup.flap_peak):.3g} deg, rate peak "
+            f"{np.degrees(sup.flap_rate_peak):.3g} deg/s, the LCO returns on release: "
+            f"{'yes' if sup.lco_returns else 'no'}" for sup in result.suppression.runs)
+        tunnel = (f"in a Dryden turbulence of intensity {100 * ss.gust_intensity:g} % and "
+                  f"scale {ss.gust_scale:g} m" if ss.gust_intensity > 0 else "without turbulence")
         cap["fig11_gain_ramp"] = (
-            f"Fig. 11. Suppression of the truth's established LCO at V = {sup.V:.4g}: the "
-            "controller gain is ramped 0 -> 1, held and released (shaded: open loop and full "
-            "gain; dashed: the LCO amplitude before the ramp; dotted: the flap travel). "
-            f"Attenuation {att} (RMS of the dominant sensor); the LCO returns on release: "
-            f"{'yes' if sup.lco_returns else 'no'}.")
+            "Fig. 11. Suppression of the truth's established LCO: the controller gain is "
+            "ramped 0 -> 1, held and released (shaded: open loop and full gain; dashed: the "
+            "LCO amplitude before the ramp; dotted: the flap travel), " + tunnel
+            + f", with sensor noise of rms {ss.noise:g}, the flap behind a servo "
+            + ("without a rate limit" if ss.flap_rate_limit is None
+               else f"limited to {np.degrees(ss.flap_rate_limit):.3g} deg/s")
+            + ". Attenuation = 1 - RMS(last third of the full gain) / RMS(open-loop "
+            f"LCO) of the dominant sensor. {each}.")
     cap.update(margins)
     return cap
 

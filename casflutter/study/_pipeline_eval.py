@@ -9,7 +9,7 @@ tables of :class:`casflutter.pipeline.RunConfig`):
 
 - a stage's key: ``data.V0`` (nominal speed of the records), ``rom.orders`` (HWL orders
   ``[mu, na, nb, r, p, q]``), ``rom.nf`` (order of Σf, eq. 5), ``controller.order``,
-  ``controller.starts``, ``lco.speed_factor``, ``suppression.speed_factor``, ``seed`` ...;
+  ``controller.starts``, ``lco.speed_factor``, ``suppression.gust_intensity``, ``seed`` ...;
 - the accelerometers: ``sensors.rows`` (``Hs`` of eq. 7, a list of rows per value, one
   number per mode; default the problem's own rows, the paper's §IV);
 - a truth parameter: ``problem.set.NAME`` (seed wing: ``zeta`` structural damping,

@@ -20,8 +20,9 @@ own linear state space in the speed index ``V`` gives the true flutter speed.
 - :func:`load_problem` -- a problem by name or file, with parameter changes.
 - :func:`truth_records` -- chirp records of a truth (the paper's CFD runs, §IV.A).
 - :func:`truth_lco`, :func:`closed_loop_truth`, :func:`suppression_run`,
-  :func:`truth_loop_sweep` -- the truth's own LCO, and the truth in closed loop with a
-  controller (the wind tunnel, paper Fig. 11).
+  :func:`suppression_runs`, :func:`truth_loop_sweep` -- the truth's own LCO, and the truth in
+  closed loop with a controller (the wind tunnel, paper Fig. 11), in the tunnel's turbulence
+  with noisy sensors (:func:`tunnel_disturbances`).
 - :func:`frozen_aero_truth` -- the truth with its aerodynamics frozen at one speed: what a
   ROM with the V² scaling of eq. 8 represents.
 """
@@ -30,7 +31,7 @@ from ._aero import JONES_A, JONES_B, jones_C, strip_coefficients, theodorsen_T
 from ._base import AeroelasticTruth, AeroMatrices, SimulationResult
 from ._closed_loop import (SuppressionResult, SuppressionSettings, TruthLoopSimulation,
                            TruthLoopSweep, closed_loop_truth, gain_schedule, suppression_run,
-                           truth_loop_matrix, truth_loop_sweep)
+                           suppression_runs, truth_loop_matrix, truth_loop_sweep)
 from ._frozen import frozen_aero_truth
 from ._goland import GolandParams, GolandWing
 from ._lco import TruthLco, truth_lco
@@ -41,6 +42,7 @@ from ._registry import (PROBLEMS, file_problem_names, load_problem, load_problem
                         problem_definition, problem_label, problem_names)
 from ._seed_wing import (SEED_FREQUENCIES_HZ, SEED_MODE_NAMES, SEED_SENSOR_ROWS, SEED_U_REF,
                          SeedWing, SeedWingParams)
+from ._turbulence import dryden_gust, gust_modal_forces, tunnel_disturbances
 from ._typical_section import TypicalSection, TypicalSectionParams
 from ._wing_file import GAFProblem, WingProblem
 
@@ -55,7 +57,8 @@ __all__ = [
     "RecordSettings", "truth_records", "frozen_aero_truth",
     "TruthLco", "truth_lco",
     "TruthLoopSimulation", "closed_loop_truth", "gain_schedule", "SuppressionSettings",
-    "SuppressionResult", "suppression_run", "truth_loop_matrix", "TruthLoopSweep",
-    "truth_loop_sweep",
+    "SuppressionResult", "suppression_run", "suppression_runs", "truth_loop_matrix",
+    "TruthLoopSweep", "truth_loop_sweep", "dryden_gust", "gust_modal_forces",
+    "tunnel_disturbances",
     "JONES_A", "JONES_B", "jones_C", "theodorsen_T", "strip_coefficients",
 ]

@@ -4,7 +4,8 @@
   ``K`` (ZOH at the sample time) and a second-order flap actuator, with a gain schedule
   ``g(t)`` on the controller output (paper Fig. 11 ramps it 0 -> 1);
 - :func:`suppression_run` — paper Fig. 11: the LCO develops, the gain ramps, holds and is
-  released; the attenuation of the dominant sensor;
+  released, in the tunnel's turbulence with noisy sensors; the attenuation of the dominant
+  sensor; :func:`suppression_runs` — one such run per speed, each from the established LCO;
 - :func:`truth_loop_matrix` / :func:`truth_loop_sweep` — the truth's *linear* loop with the
   controller and the actuator, and its spectral abscissa over a range of speeds with the
   closed-loop stable interval around the flutter speed.
@@ -23,11 +24,14 @@ from scipy.optimize import brentq
 
 from .._format import result_repr
 from .._linalg import spectral_abscissa
-from ..errors import CasflutterError, ConfigError
+from .._settings import finite_numbers
+from ..errors import CasflutterError, ConfigError, DimensionError
+from ._lco import truth_lco
+from ._turbulence import tunnel_disturbances
 
 __all__ = ["TruthLoopSimulation", "closed_loop_truth", "gain_schedule", "SuppressionSettings",
-           "SuppressionResult", "suppression_run", "truth_loop_matrix", "TruthLoopSweep",
-           "truth_loop_sweep"]
+           "SuppressionResult", "suppression_run", "suppression_runs", "truth_loop_matrix",
+           "TruthLoopSweep", "truth_loop_sweep"]
 
 
 def _sensor_rows(truth, rows) -> np.ndarray:
@@ -49,6 +53,8 @@ class TruthLoopSimulation:
         Flap angle (actuator output).
     gain : ndarray, shape (K,)
         Gain schedule ``g(t_k)``.
+    v_rate : ndarray, shape (K,)
+        Flap rate (actuator output rate).
     """
 
     __repr__ = result_repr
@@ -57,6 +63,18 @@ class TruthLoopSimulation:
     zm: np.ndarray
     v: np.ndarray
     gain: np.ndarray
+    v_rate: np.ndarray | None = None
+
+
+def _record(values, shape: tuple, name: str) -> np.ndarray | None:
+    """A per-sample input record of ``shape`` as floats (``None`` stays ``None``)."""
+    if values is None:
+        return None
+    out = np.asarray(values, dtype=float)
+    if out.shape != shape:
+        raise DimensionError(f"{name} must have shape {shape} (samples, channels), got "
+                             f"{out.shape}")
+    return out
 
 
 def gain_schedule(settle: float, ramp: float, hold: float) -> Callable[[float], float]:
@@ -89,7 +107,10 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
                       substeps: int = 4, sensor: str = "acceleration",
                       kick: tuple[float, int, float] | None = None,
                       sensor_rows=None, flap_limit: float | None = None,
-                      flap_rate_limit: float | None = None) -> TruthLoopSimulation:
+                      flap_rate_limit: float | None = None, disturbance=None,
+                      sensor_noise=None,
+                      stop: Callable[[int, np.ndarray], bool] | None = None
+                      ) -> TruthLoopSimulation:
     """Sampled-data closed loop of the nonlinear truth with the controller ``K``.
 
     At every sample ``t_k`` the sensors are read, the controller (ZOH discretisation at the
@@ -106,7 +127,15 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     A real flap servo saturates: with ``flap_limit`` the command is clipped to
     ``±flap_limit`` and the actuator stops at that angle; with ``flap_rate_limit`` the
     actuator's rate stops growing at ``±flap_rate_limit`` (its acceleration is cut while the
-    rate is at the limit and pushing outwards, and the rate is clipped after every step).
+    rate is at the limit and pushing outwards, the flap moves at the clipped rate within a
+    Runge--Kutta step, whose stages a sharp command would otherwise carry past the limit,
+    and the rate is clipped after every step).
+
+    A tunnel's turbulence enters as eq. 7's modal disturbance ``w`` (``disturbance``, held over
+    each sample interval, through the truth's own disturbance input of
+    :meth:`~casflutter.truth.AeroelasticTruth.statespace`), and its sensors' noise is added to
+    the readings the controller sees and the record keeps (``sensor_noise``);
+    :func:`~casflutter.truth.tunnel_disturbances` draws both.
 
     Parameters
     ----------
@@ -140,16 +169,27 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
         omitted.
     flap_rate_limit : float, optional
         Largest flap rate [flap unit per time unit]; no limit when omitted.
+    disturbance : array_like, shape (K, N), optional
+        Eq. 7's modal disturbance ``w`` at the samples (zero when omitted).
+    sensor_noise : array_like, shape (K, n_sensors), optional
+        Added to the sensor readings (zero when omitted).
+    stop : callable, optional
+        ``stop(k, zm) -> bool``, called once sample ``k`` is recorded, with the readings so
+        far (``zm[:k + 1]`` are set): ``True`` ends the simulation there, and the record
+        ends with sample ``k``.
 
     Returns
     -------
     TruthLoopSimulation
-        Stopped (NaN from there on) when the state blows up.
+        Stopped (NaN from there on) when the state blows up; cut after the sample at which
+        ``stop`` said so.
 
     Raises
     ------
     ConfigError
         An unknown ``sensor`` or a non-positive limit.
+    DimensionError
+        A disturbance or noise record of the wrong shape.
 
     See Also
     --------
@@ -173,14 +213,21 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     servo = _FlapServo.of(actuator_omega, actuator_zeta, flap_limit, flap_rate_limit)
     t = np.asarray(timepts, dtype=float)
     dt = float(t[1] - t[0])
-    s = truth.layout.initial(x0, truth.state_matrix(V).shape[0])  # the flow at rest
+    nx = truth.state_matrix(V).shape[0]
+    s = truth.layout.initial(x0, nx)  # the flow at rest
     Hs = _sensor_rows(truth, sensor_rows)
+    W = _record(disturbance, (t.size, truth.n_modes), "disturbance")
+    noise = _record(sensor_noise, (t.size, Hs.shape[0]), "sensor_noise")
+    # the disturbance's rate of the truth state, per sample (eq. 7's input of statespace)
+    forcing = None if W is None else W @ np.asarray(truth.statespace(V).B)[:nx, 1:].T
     ZM = np.full((t.size, Hs.shape[0]), np.nan)
     Vf = np.zeros(t.size)
+    Vr = np.zeros(t.size)
     G = np.zeros(t.size)
-    _run_closed_loop(truth, truth.flap_dynamics(V), s, _sampled(K, dt), servo, Hs,
-                     sensor == "acceleration", t, gain, kick, substeps, (ZM, Vf, G))
-    return TruthLoopSimulation(t, ZM, Vf, G)
+    n = _run_closed_loop(truth, truth.flap_dynamics(V), s, _sampled(K, dt), servo, Hs,
+                         sensor == "acceleration", t, gain, kick, substeps, (ZM, Vf, Vr, G),
+                         forcing=forcing, noise=noise, stop=stop)
+    return TruthLoopSimulation(t[:n], ZM[:n], Vf[:n], G[:n], Vr[:n])
 
 
 def _sampled(K: control.StateSpace, dt: float):
@@ -192,34 +239,47 @@ def _sampled(K: control.StateSpace, dt: float):
 
 
 def _run_closed_loop(truth, f, s, controller, servo, Hs, acceleration: bool, t, gain, kick,
-                     substeps: int, records) -> None:
+                     substeps: int, records, *, forcing=None, noise=None, stop=None) -> int:
     """The sample loop of :func:`closed_loop_truth` from the truth state ``s``: read the
     sensors, update the controller (state ``(A, B, C, D, n)`` discretised), hold the command
-    and integrate over the sample; fills ``records = (zm, v, g)`` up to a blow-up."""
+    and integrate over the sample; fills ``records = (zm, v, v', g)`` up to a blow-up.
+    ``forcing`` (samples, states): the disturbance's rate of the state, held over each
+    sample; ``noise`` (samples, sensors): added to the readings; ``stop(k, zm)``: end after
+    sample ``k``.  Returns the number of samples the record keeps."""
     Ak, Bk, Ck, Dk, nk = controller
-    ZM, Vf, G = records
+    ZM, Vf, Vr, G = records
     N, n = truth.n_modes, t.size
     h = float(t[1] - t[0]) / substeps
     xa = np.zeros(2)  # actuator: v, v'
     xk = np.zeros(nk)
+    fw = None  # the disturbance's rate of the state over the current sample interval
     vc = 0.0  # command held over the current sample interval
     kicked = kick is None
     for k in range(n):
         if not kicked and t[k] >= kick[0]:
             s[:2 * N] += truth.layout.vector(truth.displaced_state(kick[1], kick[2]))
             kicked = True
+        if forcing is not None:
+            fw = forcing[k]
         _, acc = f(s, xa[0], xa[1], servo.acceleration(xa, vc))
+        if fw is not None:
+            acc = acc + fw[N:2 * N]
         zm = Hs @ (acc if acceleration else s[:Hs.shape[1]])
+        if noise is not None:
+            zm = zm + noise[k]
         if not np.all(np.isfinite(zm)) or np.abs(s).max() > 1e6:
             break
-        ZM[k], Vf[k], G[k] = zm, xa[0], gain(t[k])
+        ZM[k], Vf[k], Vr[k], G[k] = zm, xa[0], xa[1], gain(t[k])
+        if stop is not None and stop(k, ZM):
+            return k + 1
         vc = G[k] * float((Ck @ xk + Dk @ zm)[0]) if nk else G[k] * float((Dk @ zm)[0])
         vc = float(np.clip(vc, -servo.pos_max, servo.pos_max))
         if nk and G[k] > 0:  # the controller runs from its engagement (state zero before)
             xk = Ak @ xk + Bk @ zm
         if k == n - 1:
             break
-        s, xa = servo.integrate(f, s, xa, vc, h, substeps)
+        s, xa = servo.integrate(f, s, xa, vc, h, substeps, fw)
+    return n
 
 
 @dataclass(frozen=True)
@@ -252,14 +312,17 @@ class _FlapServo:
             vdd = 0.0  # on the end stop
         return vdd
 
-    def integrate(self, f, s, xa, vc: float, h: float, steps: int):
+    def integrate(self, f, s, xa, vc: float, h: float, steps: int, forcing=None):
         """``steps`` Runge--Kutta steps of length ``h`` of the truth ``f`` (its
-        :meth:`flap_dynamics`) and the servo under the held command ``vc``."""
+        :meth:`flap_dynamics`) and the servo under the held command ``vc`` (and the held
+        rate ``forcing`` of the state by a disturbance).  Within a step the flap moves at
+        most at the rate limit: a sharp command would otherwise carry the stages past it."""
 
         def deriv(s_, xa_):
             vdd = self.acceleration(xa_, vc)
-            ds, _ = f(s_, xa_[0], xa_[1], vdd)
-            return ds, np.array([xa_[1], vdd])
+            rate = min(max(xa_[1], -self.rate_max), self.rate_max)
+            ds, _ = f(s_, xa_[0], rate, vdd)
+            return (ds if forcing is None else ds + forcing), np.array([rate, vdd])
 
         for _ in range(steps):
             k1s, k1a = deriv(s, xa)
@@ -274,13 +337,23 @@ class _FlapServo:
         return s, xa
 
 
+def _nonnegative(name: str, value, *, positive: bool = False) -> None:
+    """Refuse a setting that is not a finite number ``>= 0`` (``> 0`` when ``positive``)."""
+    ok = (not isinstance(value, bool) and isinstance(value, (int, float))
+          and np.isfinite(value) and (value > 0 if positive else value >= 0))
+    if not ok:
+        raise ConfigError(f"{name} = {value!r}: must be a finite number "
+                          f"{'> 0' if positive else '>= 0'}")
+
+
 @dataclass(frozen=True)
 class SuppressionSettings:
-    """The gain-ramp run of paper Fig. 11 (times in the problem's time unit)."""
+    """The gain-ramp runs of paper Fig. 11 in a tunnel (times in the problem's time unit):
+    one run per speed factor, in turbulence with noisy sensors when asked."""
 
-    speed_factor: float = 1.05
-    """Run at ``speed_factor`` times the truth's own flutter speed (where the wing itself has
-    an LCO)."""
+    speed_factors: tuple = (1.05,)
+    """Run at each of these multiples of the truth's own flutter speed (where the wing
+    itself has an LCO)."""
     settle: float = 10.0
     """Open loop: the LCO develops."""
     ramp: float = 5.0
@@ -288,17 +361,40 @@ class SuppressionSettings:
     hold: float = 10.0
     """Full gain."""
     release: float = 10.0
-    """Open loop again, after a tap on the wing: the LCO returns."""
+    """Open loop again, after a tap on the wing, until the LCO has returned (the RMS of the
+    dominant sensor over the last ``settle / 3``, the open-loop window, above half the open
+    loop's) and at most this long."""
     flap_limit: float | None = None
     """Largest flap angle of the servo (the truth's flap unit; ``None``: no limit)."""
     flap_rate_limit: float | None = None
     """Largest flap rate of the servo (flap unit per time unit; ``None``: no limit)."""
+    gust_intensity: float = 0.0
+    """Turbulence intensity ``σ_w / U``: the rms of the vertical gust over the airspeed
+    (Dryden spectrum, :mod:`casflutter.truth._turbulence`); 0 for none.  Needs a strip-theory
+    truth (the seed wing)."""
+    gust_scale: float = 0.3
+    """Integral scale ``L_w`` of the turbulence [m]: the Dryden filter's time constant is
+    ``L_w / U``."""
+    noise: float = 0.0
+    """Rms of each sensor's white noise, in the sensors' unit (m/s² for accelerometers); 0 for
+    none."""
 
     def __post_init__(self):
-        for name in ("speed_factor", "settle", "ramp", "hold", "release"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
-                raise ConfigError(f"{name} = {value!r}: must be > 0")
+        factors = self.speed_factors
+        if isinstance(factors, np.ndarray):
+            factors = factors.tolist()
+        if not isinstance(factors, (list, tuple)) or not factors:
+            raise ConfigError(f"speed_factors = {factors!r}: give a list of multiples of the "
+                              "flutter speed, e.g. [1.05, 1.2]")
+        factors = finite_numbers("speed_factors", list(factors), len(factors),
+                                 what="multiples of the flutter speed")
+        if not all(f > 0 for f in factors):
+            raise ConfigError(f"speed_factors = {list(factors)!r}: every factor must be > 0")
+        object.__setattr__(self, "speed_factors", tuple(factors))
+        for name in ("settle", "ramp", "hold", "release", "gust_scale"):
+            _nonnegative(name, getattr(self, name), positive=True)
+        for name in ("gust_intensity", "noise"):
+            _nonnegative(name, getattr(self, name))
         for name in ("flap_limit", "flap_rate_limit"):
             value = getattr(self, name)
             if value is not None and (isinstance(value, bool)
@@ -322,10 +418,11 @@ class SuppressionResult:
         ``100 (1 - rms_closed / rms_open)`` of the dominant sensor (``None`` when the open
         loop is at rest).
     open_loop_rms, closed_loop_rms, released_rms : tuple of float
-        RMS per sensor over the last third of the settling phase, of the hold and of the
-        release.
+        RMS per sensor over the last third of the settling phase, over the last third of the
+        hold, and over the last ``settle / 3`` of the release (the record's end).
     lco_returns : bool
-        After the release the dominant sensor climbs back above half its open-loop RMS.
+        After the release the dominant sensor climbs back above half its open-loop RMS (over
+        a window as long as the open loop's); the run ends there.
     open_loop_amplitude : tuple of float
         Peak ``|zm|`` per sensor over the last third of the settling phase, just before the
         ramp: the amplitude of the LCO the controller is switched on against.
@@ -336,6 +433,12 @@ class SuppressionResult:
         deflected mode.
     dominant_sensor : int
         The sensor with the largest open-loop RMS.
+    speed_factor : float or None
+        ``V`` over the truth's flutter speed.
+    flap_peak, flap_rate_peak : float or None
+        Largest ``|v|`` and ``|v'|`` while the controller is engaged (ramp and hold).
+    gust_rms : float
+        Rms of the gust velocity of the run [m/s] (0 without turbulence).
     """
 
     __repr__ = result_repr
@@ -351,34 +454,61 @@ class SuppressionResult:
     open_loop_amplitude: tuple = ()
     closed_loop_amplitude: tuple = ()
     started_from_lco: bool = False
+    speed_factor: float | None = None
+    flap_peak: float | None = None
+    flap_rate_peak: float | None = None
+    gust_rms: float = 0.0
+
+    def record(self) -> dict:
+        """The run as plain numbers (``summary.json`` → ``suppression.runs``).
+
+        Returns
+        -------
+        dict
+            ``speed_factor``, ``V``, ``attenuation_percent``, ``open_loop_rms``,
+            ``closed_loop_rms`` (per sensor), ``dominant_sensor``, ``flap_peak``,
+            ``flap_rate_peak``, ``lco_returns``, ``started_from_lco``, ``gust_rms``.
+        """
+        return {"speed_factor": self.speed_factor, "V": self.V,
+                "attenuation_percent": self.attenuation_percent,
+                "open_loop_rms": list(self.open_loop_rms),
+                "closed_loop_rms": list(self.closed_loop_rms),
+                "dominant_sensor": self.dominant_sensor, "flap_peak": self.flap_peak,
+                "flap_rate_peak": self.flap_rate_peak, "lco_returns": self.lco_returns,
+                "started_from_lco": self.started_from_lco, "gust_rms": self.gust_rms}
 
 
 def suppression_run(truth, K: control.StateSpace, V_flutter: float,
                     settings: SuppressionSettings | None = None, *, dt: float, mode: int,
-                    deflection: float, sensor_rows=None,
-                    sensor: str = "acceleration", x0=None) -> SuppressionResult:
+                    deflection: float, sensor_rows=None, sensor: str = "acceleration",
+                    x0=None, speed_factor: float | None = None,
+                    seed=0) -> SuppressionResult:
     """Paper Fig. 11 on the truth: the LCO develops, the gain ramps 0 -> 1, holds, is released.
 
     Started from ``x0``, the end state of a simulation in which the truth's LCO has
     converged (:attr:`TruthLco.final_state`), the controller is switched on against the
     established LCO, as in the wind tunnel; without it the run starts from a deflected mode
-    and the LCO must develop during ``settle``.
+    and the LCO must develop during ``settle``.  The tunnel's turbulence and the sensors'
+    noise of ``settings`` act throughout (:func:`~casflutter.truth.tunnel_disturbances`,
+    drawn from ``seed``), and the flap goes through the servo with its limits.
 
     The attenuation compares the RMS of the dominant sensor over the last third of the
     hold with its RMS over the last third of the settling phase (open-loop LCO);
     ``lco_returns`` checks that after the release (the wing is tapped with the initial
-    deflection at that moment) the amplitude climbs back above half the open-loop LCO.
+    deflection at that moment) the RMS of the dominant sensor over a window as long as the
+    open loop's climbs back above half the open-loop RMS; the run ends as soon as it does
+    (``settings.release`` is the longest release).
 
     Parameters
     ----------
     truth : AeroelasticTruth
         The nonlinear simulator (:func:`closed_loop_truth` runs it with the flap servo).
     K : control.StateSpace
-        Controller from the accelerometers to the flap command.
+        Controller from the sensors to the flap command (``v_c = +K zm``).
     V_flutter : float
-        The truth's flutter speed index; the run is at ``settings.speed_factor`` times it.
+        The truth's flutter speed index; the run is at ``speed_factor`` times it.
     settings : SuppressionSettings, optional
-        Durations and speed factor.
+        Durations, servo limits, turbulence and noise.
     dt : float
         Sample time of the loop.
     mode : int
@@ -391,6 +521,10 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
         What the sensors read (:func:`closed_loop_truth`).
     x0 : array_like, optional
         Full truth state to start from (an established LCO at this speed).
+    speed_factor : float, optional
+        Default: the first of ``settings.speed_factors``.
+    seed : int or sequence of int
+        Seed of the turbulence and the noise (``numpy.random.default_rng``).
 
     Returns
     -------
@@ -403,6 +537,7 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
 
     See Also
     --------
+    suppression_runs : one run per speed factor, each from the truth's established LCO.
     closed_loop_truth : the closed-loop simulation it runs.
     truth_lco : the established LCO it starts from.
 
@@ -414,46 +549,84 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
 
     >>> lco = cf.truth_lco(truth, 1.05 * Vf, 20.0, mode=1, deflection=0.01, dt=0.002)  # doctest: +SKIP
     >>> sup = cf.suppression_run(truth, K, Vf, dt=0.002, mode=1, deflection=0.01,
-    ...                          x0=lco.final_state)                        # doctest: +SKIP
+    ...                          x0=lco.final_state, speed_factor=1.05)      # doctest: +SKIP
     >>> sup.attenuation_percent, sup.lco_returns                           # doctest: +SKIP
     """
     sp = settings or SuppressionSettings()
-    V = V_flutter * sp.speed_factor
+    factor = float(sp.speed_factors[0] if speed_factor is None else speed_factor)
+    V = V_flutter * factor
     T = sp.settle + sp.ramp + sp.hold + sp.release
     t = np.arange(0.0, T, dt)
     g = gain_schedule(sp.settle, sp.ramp, sp.hold)
     t_release = sp.settle + sp.ramp + sp.hold
+    n_sensors = _sensor_rows(truth, sensor_rows).shape[0]
+    w, noise, gust = tunnel_disturbances(truth, V, t.size, dt, gust_intensity=sp.gust_intensity,
+                                         gust_scale=sp.gust_scale, noise=sp.noise,
+                                         n_sensors=n_sensors, seed=seed)
     start = truth.displaced_state(mode, deflection) if x0 is None else x0
     sim = closed_loop_truth(truth, K, V, t, start, g,
                             kick=(t_release, mode, deflection), sensor_rows=sensor_rows,
                             sensor=sensor, flap_limit=sp.flap_limit,
-                            flap_rate_limit=sp.flap_rate_limit)
+                            flap_rate_limit=sp.flap_rate_limit,
+                            disturbance=w if sp.gust_intensity > 0 else None,
+                            sensor_noise=noise if sp.noise > 0 else None,
+                            stop=_lco_returned(t, sp))
     if not np.all(np.isfinite(sim.zm)):
         raise CasflutterError(f"the closed-loop truth simulation at V = {V:.4f} blew up")
-    return _suppression_result(float(V), sim, t, sp, started_from_lco=x0 is not None)
+    return _suppression_result(float(V), sim, sp, started_from_lco=x0 is not None,
+                               speed_factor=factor,
+                               gust_rms=float(np.sqrt(np.mean(gust[:sim.timepts.size] ** 2))))
 
 
-def _suppression_result(V: float, sim: TruthLoopSimulation, t, sp: SuppressionSettings,
-                        started_from_lco: bool) -> SuppressionResult:
-    """The RMS and peaks of each phase of a suppression run and the attenuation of the
-    dominant sensor (see :func:`suppression_run`)."""
-    zm = sim.zm
-    T = sp.settle + sp.ramp + sp.hold + sp.release
+def _lco_returned(t, sp: SuppressionSettings) -> Callable[[int, np.ndarray], bool]:
+    """``stop(k, zm)`` of a suppression run: after the release, the RMS of the dominant
+    sensor over the last ``settle / 3`` (as many samples as the open-loop window) is above
+    half its open-loop RMS."""
+    open_window = (t >= sp.settle * 2 / 3) & (t < sp.settle)
+    m = int(open_window.sum())
+    k_release = int(np.searchsorted(t, sp.settle + sp.ramp + sp.hold))
+    half = {}
+
+    def returned(k: int, zm: np.ndarray) -> bool:
+        if m == 0 or k < k_release + m - 1:
+            return False
+        if not half:      # the open loop's dominant sensor and half its RMS, once
+            open_rms = np.sqrt(np.mean(zm[open_window] ** 2, axis=0))
+            half["sensor"] = int(np.argmax(open_rms))
+            half["rms"] = 0.5 * float(open_rms[half["sensor"]])
+        last = zm[k - m + 1:k + 1, half["sensor"]]
+        return bool(np.sqrt(np.mean(last ** 2)) > half["rms"])
+
+    return returned
+
+
+def _suppression_result(V: float, sim: TruthLoopSimulation, sp: SuppressionSettings,
+                        started_from_lco: bool, speed_factor: float | None = None,
+                        gust_rms: float = 0.0) -> SuppressionResult:
+    """The RMS and peaks of each phase of a suppression run, the flap's peaks while the
+    controller is engaged, and the attenuation of the dominant sensor (see
+    :func:`suppression_run`)."""
+    zm, t = sim.zm, sim.timepts
+    t_full = sp.settle + sp.ramp
+    t_release = t_full + sp.hold
+
+    def window(a, b):
+        return (t >= a) & (t < b)
 
     def rms(a, b):
-        sel = (t >= a) & (t < b)
-        return np.sqrt(np.mean(zm[sel] ** 2, axis=0))
+        return np.sqrt(np.mean(zm[window(a, b)] ** 2, axis=0))
 
     def peak(a, b):
-        sel = (t >= a) & (t < b)
-        return np.max(np.abs(zm[sel]), axis=0)
+        return np.max(np.abs(zm[window(a, b)]), axis=0)
 
     open_rms = rms(sp.settle * 2 / 3, sp.settle)
     dom = int(np.argmax(open_rms))
-    t_full = sp.settle + sp.ramp
-    closed_rms = rms(t_full + sp.hold * 2 / 3, t_full + sp.hold)
-    after = rms(T - sp.release / 3, T)
+    closed_rms = rms(t_full + sp.hold * 2 / 3, t_release)
+    m = int(window(sp.settle * 2 / 3, sp.settle).sum())   # the open-loop window's samples
+    released = zm[t >= t_release]
+    after = np.sqrt(np.mean(released[-m:] ** 2, axis=0))
     att = 100.0 * (1.0 - closed_rms[dom] / open_rms[dom]) if open_rms[dom] > 0 else None
+    engaged = window(sp.settle, t_release)
     return SuppressionResult(V=V, simulation=sim,
                              attenuation_percent=None if att is None else float(att),
                              open_loop_rms=tuple(map(float, open_rms)),
@@ -464,8 +637,58 @@ def _suppression_result(V: float, sim: TruthLoopSimulation, t, sp: SuppressionSe
                              open_loop_amplitude=tuple(map(float, peak(sp.settle * 2 / 3,
                                                                        sp.settle))),
                              closed_loop_amplitude=tuple(map(float, peak(
-                                 t_full + sp.hold * 2 / 3, t_full + sp.hold))),
-                             started_from_lco=started_from_lco)
+                                 t_full + sp.hold * 2 / 3, t_release))),
+                             started_from_lco=started_from_lco, speed_factor=speed_factor,
+                             flap_peak=float(np.max(np.abs(sim.v[engaged]))),
+                             flap_rate_peak=float(np.max(np.abs(sim.v_rate[engaged]))),
+                             gust_rms=gust_rms)
+
+
+def suppression_runs(truth, K: control.StateSpace, V_flutter: float,
+                     settings: SuppressionSettings | None = None, *, dt: float, mode: int,
+                     deflection: float, lco_duration: float, sensor_rows=None,
+                     sensor: str = "acceleration", seed: int = 0,
+                     lcos=None) -> tuple[SuppressionResult, ...]:
+    """One :func:`suppression_run` per speed factor of ``settings``, each from the truth's
+    established LCO at that speed.
+
+    The LCO is established by :func:`~casflutter.truth.truth_lco` (the truth released from
+    a deflected mode and continued while it still grows) unless ``lcos`` holds that run;
+    where the truth has no LCO the run starts from the deflected mode
+    (``started_from_lco`` False).  Run ``k`` draws its turbulence and noise from the seed
+    ``(seed, k)``: one seed gives the same runs.
+
+    Parameters
+    ----------
+    truth, K, V_flutter, settings, dt, mode, deflection, sensor_rows, sensor :
+        As :func:`suppression_run`.
+    lco_duration : float
+        Length of each simulation that establishes the LCO.
+    seed : int
+        The runs' seed.
+    lcos : mapping of float to TruthLco, optional
+        The truth's runs of :func:`~casflutter.truth.truth_lco` by speed factor, where
+        already computed (e.g. by an LCO study at the same speeds).
+
+    Returns
+    -------
+    tuple of SuppressionResult
+        In the order of ``settings.speed_factors``.
+    """
+    sp = settings or SuppressionSettings()
+    known = {round(float(f), 9): lco for f, lco in (lcos or {}).items()}
+    out = []
+    for k, factor in enumerate(sp.speed_factors):
+        lco = known.get(round(factor, 9))
+        if lco is None:
+            lco = truth_lco(truth, V_flutter * factor, lco_duration, mode, deflection, dt=dt,
+                            sensor_rows=sensor_rows, sensor=sensor)
+        x0 = lco.final_state if lco.kind == "lco" else None
+        out.append(suppression_run(truth, K, V_flutter, sp, dt=dt, mode=mode,
+                                   deflection=deflection, sensor_rows=sensor_rows,
+                                   sensor=sensor, x0=x0, speed_factor=factor,
+                                   seed=(int(seed), k)))
+    return tuple(out)
 
 
 def truth_loop_matrix(truth, K: control.StateSpace, V: float, *, actuator_omega: float,

@@ -16,8 +16,8 @@ from casflutter.design import SynthesisOptions, SynthesisResult
 from casflutter.ident import (CommonDenominatorResult, IdentificationResult,
                               IdentificationSettings)
 from casflutter.pipeline import (ClosedLoopChecks, ControllerSettings, DataSection, LcoResult,
-                                 RomSection, RunResult, config_path, default_config_path,
-                                 load_config, run)
+                                 RomSection, RunResult, SuppressionStage, config_path,
+                                 default_config_path, load_config, run)
 from casflutter.realize import Realization
 from casflutter.truth import RecordSettings, SuppressionResult, SuppressionSettings
 from casflutter.verify import SpeedSweep, VerificationReport
@@ -59,14 +59,19 @@ def test_the_study_has_a_typed_field_per_stage(study):
     assert isinstance(r.synthesis, SynthesisResult)
     assert isinstance(r.controller, control.StateSpace)
     assert isinstance(r.verification, VerificationReport)
-    assert isinstance(r.suppression, SuppressionResult)
+    assert isinstance(r.suppression, SuppressionStage)
+    assert all(isinstance(s, SuppressionResult) for s in r.suppression.runs)
     assert r.closed_loop is None and r.parametric is None and r.flutter_frozen is None
     # the stages read one another's results: the LFT sits at the ROM's flutter speed, the
     # LCO a little above the flutter point of the sampled-data loop the ROM runs in, the
     # suppression above the truth's
     assert r.lft.Vf == r.flutter.Vf
     assert r.lco.V == pytest.approx(r.config.lco.speed_factor * r.lco.V_hopf_loop)
-    assert r.suppression.V == pytest.approx(r.config.suppression.speed_factor * r.Vf_truth)
+    assert r.suppression.V_flutter == r.Vf_truth and r.suppression.reference == "truth"
+    assert [s.V for s in r.suppression.runs] == pytest.approx(
+        [f * r.Vf_truth for f in r.config.suppression.speed_factors])
+    assert [s.speed_factor for s in r.suppression.runs] == [1.05, 1.2]
+    assert r.suppression.at(1.2) is r.suppression.runs[1]
     assert r.controller.nstates == r.config.controller.order == 1
 
 
@@ -92,7 +97,12 @@ def test_summary_keeps_the_keys_of_summary_json(study):
     assert s["flutter"]["V"] == study.flutter.Vf
     assert s["controller"]["lft_stable_V"] == list(study.verification.exact_V)
     assert s["controller"]["stable_interval"] == list(study.rom_stable_V)
-    assert s["suppression"]["attenuation_percent"] == study.suppression.attenuation_percent
+    sup = study.suppression
+    assert s["suppression"]["attenuation_percent"] == sup.runs[0].attenuation_percent
+    runs = s["suppression"]["runs"]
+    assert [run["speed_factor"] for run in runs] == list(study.config.suppression.speed_factors)
+    assert [run["attenuation_percent"] for run in runs] == list(sup.attenuation_percent)
+    assert {"V", "open_loop_rms", "closed_loop_rms", "flap_peak", "flap_rate_peak"} <= set(runs[0])
     assert set(s["timings_s"]) == {"data", "rom", "realize", "structure", "flutter", "lco",
                                    "controller", "suppression", "total"}
 

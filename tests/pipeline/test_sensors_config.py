@@ -148,11 +148,12 @@ def test_closed_loop_with_mixed_rows_and_unmixed_controller_is_the_same_loop(win
 
 
 def test_suppression_run_uses_the_configured_rows(wing):
-    """The suppression run reads the configured rows (as the run's other stages do)."""
-    base = load_config(updates={"suppression": {"settle": 0.15, "ramp": 0.05, "hold": 0.1,
-                                                "release": 0.05}})
-    mixed = load_config(updates={"suppression": {"settle": 0.15, "ramp": 0.05, "hold": 0.1,
-                                                 "release": 0.05},
+    """The suppression run reads the configured rows (as the run's other stages do); the
+    turbulence is the same for both (one seed), the sensor noise, drawn per configured
+    sensor, is left out."""
+    phases = {"settle": 0.15, "ramp": 0.05, "hold": 0.1, "release": 0.05, "noise": 0.0}
+    base = load_config(updates={"suppression": phases})
+    mixed = load_config(updates={"suppression": phases,
                                  "sensors.rows": (S @ np.asarray(PAPER_ROWS)).tolist()})
     K = control.ss([], [], [], [[3e-3, -1e-3]])
     Kmix = control.ss([], [], [], K.D @ np.linalg.inv(S))

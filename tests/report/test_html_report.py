@@ -89,3 +89,10 @@ def test_report_gives_airspeeds_the_version_and_the_units_of_the_amplitudes():
     assert _row(text, "nominal speed index V0")[0] == "0.69 (19.94 m/s)"
     assert "LCO amplitude per sensor [m/s^2]" in text
     assert "at V = 1.248 (36.07 m/s)" in text
+
+
+def test_the_attenuation_of_each_suppression_run_is_in_table_i():
+    runs = [{"speed_factor": 1.05, "attenuation_percent": 91.04},
+            {"speed_factor": 1.2, "attenuation_percent": 16.21}]
+    s = dict(SUMMARY, suppression={"attenuation_percent": 91.04, "runs": runs})
+    assert _row(html_report(s, {}), "LCO attenuation")[0] == "1.05 Vf: 91.0 %, 1.2 Vf: 16.2 %"

@@ -69,6 +69,17 @@ def test_flap_position_and_rate_limits_hold(wing):
     assert np.abs(np.diff(lim_v)).max() / dt <= rate * (1 + 1e-9)
 
 
+def test_the_rate_limit_holds_against_a_noisy_command(wing):
+    """Sensor noise makes the command jump at every sample, so the servo's acceleration is
+    large inside each Runge--Kutta step: the flap still moves no faster than the limit
+    between samples, and its recorded rate stays within it."""
+    rate = 2.0
+    noise = 50.0 * np.random.default_rng(2).standard_normal((300, 2))
+    dt, lim = _aggressive_loop(wing, flap_limit=0.2, flap_rate_limit=rate, sensor_noise=noise)
+    assert np.abs(np.diff(lim.v)).max() / dt == pytest.approx(rate, rel=1e-9)
+    assert np.abs(lim.v_rate).max() <= rate * (1 + 1e-12)
+
+
 def test_limits_far_away_change_nothing(wing):
     """Limits the loop never reaches leave the simulation bit-identical."""
     _, free = _aggressive_loop(wing)
@@ -96,7 +107,7 @@ def test_suppression_starts_from_the_established_lco(wing):
     from casflutter.aeroelastic import find_flutter
     from casflutter.truth import SuppressionSettings, suppression_run, truth_lco
     Vf = find_flutter(wing.state_matrix, (0.3, 2.0), omega=wing.modal_structure().omega).Vf
-    sp = SuppressionSettings(speed_factor=1.05, settle=1.5, ramp=0.5, hold=1.5, release=0.5,
+    sp = SuppressionSettings(speed_factors=[1.05], settle=1.5, ramp=0.5, hold=1.5, release=0.5,
                              flap_limit=0.2618, flap_rate_limit=5.236)
     lco = truth_lco(wing, 1.05 * Vf, 10.0, 1, 0.01, dt=0.002)  # the run's [lco] settings
     assert lco.kind == "lco" and lco.final_state is not None
@@ -124,3 +135,30 @@ def test_the_controller_starts_at_its_engagement(wing):
     assert open_loop_command > 1e-5            # what a running controller would command
     assert run.v[on] == 0.0 and run.v[on + 1] == 0.0
     assert np.abs(run.v[on + 2:on + 10]).max() > 0   # and the loop does act after that
+
+
+def test_the_release_ends_when_the_lco_is_back(wing):
+    """A suppression run ends at the first sample of the release at which the dominant
+    sensor's RMS over the open-loop window's length (settle / 3) is back above half its
+    open-loop RMS; here against the full-length record of the same loop (the criterion
+    computed on it with numpy): the run is that record's prefix, cut at that sample."""
+    from casflutter.truth import SuppressionSettings, gain_schedule, suppression_run
+    V, dt = 1.3, 0.002
+    sp = SuppressionSettings(settle=0.6, ramp=0.2, hold=0.4, release=1.0)
+    K = control.ss([[-20.0]], [[1e-3, 1e-3]], [[1.0]], [[0.0, 0.0]])
+    run = suppression_run(wing, K, V / 1.05, sp, dt=dt, mode=1, deflection=0.01,
+                          speed_factor=1.05)
+    t, t_release = np.arange(0.0, 2.2, dt), 0.6 + 0.2 + 0.4
+    full = closed_loop_truth(wing, K, V, t, wing.displaced_state(1, 0.01),
+                             gain_schedule(0.6, 0.2, 0.4), kick=(t_release, 1, 0.01)).zm
+    opened = (t >= 0.4) & (t < 0.6)
+    m, dom = int(opened.sum()), run.dominant_sensor
+    half = 0.5 * np.sqrt(np.mean(full[opened, dom] ** 2))
+    k_release = int(np.argmax(t >= t_release))        # the gain is off, the wing tapped
+    returned = [k for k in range(k_release + m - 1, t.size)
+                if np.sqrt(np.mean(full[k - m + 1:k + 1, dom] ** 2)) > half]
+    assert returned and returned[0] < t.size - 1       # the criterion cuts the record short
+    n = returned[0] + 1
+    assert run.simulation.zm.shape == (n, 2) and run.lco_returns
+    np.testing.assert_array_equal(run.simulation.zm, full[:n])
+    np.testing.assert_allclose(run.released_rms, np.sqrt(np.mean(full[n - m:n] ** 2, axis=0)))

@@ -9,6 +9,7 @@ stopped."""
 from __future__ import annotations
 
 import json
+import math
 import sys
 
 from ..._format import sig
@@ -124,8 +125,12 @@ def _main(args) -> int:
     if s["controller"] is not None:
         lines += _controller_lines(s["controller"], res, unit)
     if s["suppression"] is not None:
-        lines.append(f"suppression: attenuation {sig(s['suppression']['attenuation_percent'], 4)} "
-                     f"%, LCO returns on release: {s['suppression']['lco_returns']}")
+        for r in s["suppression"]["runs"]:
+            lines.append(f"suppression at {r['speed_factor']:g} Vf (V = {sig(r['V'], 4)}): "
+                         f"attenuation {sig(r['attenuation_percent'], 4)} %, flap peak "
+                         f"{sig(math.degrees(r['flap_peak']), 3)} deg, rate peak "
+                         f"{sig(math.degrees(r['flap_rate_peak']), 3)} deg/s, LCO returns on "
+                         f"release: {r['lco_returns']}")
     if log_quiet:                    # otherwise the log said it once already
         lines += res.skipped_notes()
     if res.interval_ok is not None or res.closed_loop is not None:
