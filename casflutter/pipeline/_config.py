@@ -219,10 +219,20 @@ class LcoSection:
     branch_points: int = 20
     """Points of the ROM loop's and the truth's LCO branches from their flutter points
     (:mod:`casflutter.lco`, the bifurcation diagrams of the report); 0: none."""
+    speed_following_factors: tuple = (1.05, 1.2)
+    """Multiples of the truth's flutter speed at which the LCO of the ROM that follows the
+    wing over speed (:func:`casflutter.lco.compare_lco`) is put beside the truth's, when the
+    run has both; ``[]``: none."""
 
     def __post_init__(self):
         for name in ("duration", "initial_deflection", "speed_factor"):
             _positive(name, getattr(self, name))
+        factors = finite_numbers("speed_following_factors", self.speed_following_factors,
+                                 what="multiples of the truth's flutter speed")
+        if not all(f > 0 for f in factors):
+            raise ConfigError(f"speed_following_factors = {list(factors)!r}: every factor "
+                              "must be > 0")
+        object.__setattr__(self, "speed_following_factors", tuple(factors))
         _integer("branch_points", self.branch_points, 0)
         if 0 < self.branch_points < 3:
             raise ConfigError(f"branch_points = {self.branch_points}: give 0 (no branches) or "

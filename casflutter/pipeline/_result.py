@@ -13,7 +13,7 @@ import numpy as np
 from .._format import result_repr
 from ..aeroelastic import FlutterResult, LoopSimulation
 from .._outputs import plain_json
-from ..lco import LCOBranch
+from ..lco import LcoComparison, LCOBranch
 from ..truth import AeroelasticTruth, TruthLco, TruthLoopSweep
 from ._config import RunConfig
 from ._control import ControllerStage
@@ -53,6 +53,10 @@ class LcoResult:
     truth_branch, rom_branch : LCOBranch or None
         The LCO branches of the truth and of the ROM loop from their flutter points
         (``lco.branch_points > 0``).
+    speed_following : tuple of LcoComparison
+        The LCO of the ROM that follows the wing over speed beside the truth's, at
+        ``lco.speed_following_factors`` times the truth's flutter speed (empty without a
+        speed-following ROM or a truth).
     """
 
     __repr__ = result_repr
@@ -65,6 +69,7 @@ class LcoResult:
     V_hopf_loop: float | None = None
     truth_branch: LCOBranch | None = None
     rom_branch: LCOBranch | None = None
+    speed_following: tuple[LcoComparison, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -623,7 +628,8 @@ class RunResult:
                                     "points": len(br.points), "completed": br.completed}
                              for name, br in (("truth", self.lco.truth_branch),
                                               ("rom", self.lco.rom_branch))
-                             if br is not None}}
+                             if br is not None},
+                "speed_following": [c.record() for c in self.lco.speed_following]}
 
     def _controller_summary(self) -> dict | None:
         """The controller stage: order, method, the certified intervals and flutter speeds

@@ -51,7 +51,8 @@ from .._outputs import provenance, utc_now
 from ..aeroelastic import AeroelasticSystem, FlutterResult, find_flutter, simulate_loop
 from ..data import envelope_growth_rate
 from ..errors import CasflutterError, ConfigError, ConvergenceError
-from ..lco import LCOSettings, lco_branch, rom_lco_branch, rom_loop_flutter, speed_convention
+from ..lco import (LCOSettings, compare_lco, lco_branch, rom_lco_branch, rom_loop_flutter,
+                   speed_convention)
 from ..realize import realize
 from ..truth import closed_loop_truth, truth_lco, truth_loop_matrix, truth_loop_sweep
 from ._config import RunConfig, load_config
@@ -303,7 +304,7 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
     if "lco" in cfg.stages and "lco" not in skipped:
         with progress.stage("lco"):
             lco = _lco(cfg, truth, model.identification.model, structure, flutters.rom,
-                       flutters.truth)
+                       flutters.truth, model.speed_following)
     control_stage = None
     if "controller" in cfg.stages and "controller" not in skipped:
         with progress.stage("controller"):
@@ -355,7 +356,8 @@ def _mode(res: FlutterResult) -> int:
     return int(m) if m is not None and m >= 0 else 0
 
 
-def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth) -> LcoResult:
+def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth,
+         speed_following=None) -> LcoResult:
     """Paper Fig. 9: the ROM's and the truth's LCO a little above their own Hopf points.
 
     The ROM's own flutter point is that of the loop it is simulated in: the sampled-data
@@ -368,6 +370,10 @@ def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth) -> Lco
     be far above the truth's flutter speed, where the truth diverges); each simulation is
     continued while it still grows.  The Hopf speed of the exact-order continuous ΣAE is
     kept for the record.
+
+    Where the run has the ROM that follows the wing over speed and the truth flutters, that
+    ROM's LCO is put beside the truth's at ``lco.speed_following_factors`` times the truth's
+    flutter speed (issue 32: within 15 % at 1.05 and 1.2 Vf).
     """
     vr, lc = cfg.flutter.V_range, cfg.lco
     exact = realize(model, "auto")
@@ -398,8 +404,21 @@ def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth) -> Lco
     log.info("ROM LCO at V = %.5g (%scontinuous exact-order Hopf %.5g): %s, %.4g Hz", V_lco,
              loop, V_hopf, sim.sensors.kind, sim.sensors.frequency_hz)
     branches = _branches(cfg, truth, model, structure) if lc.branch_points else {}
+    following = ()
+    if (speed_following is not None and tr is not None and flutter_truth.flutter is not None
+            and lc.speed_following_factors):
+        following = compare_lco(speed_following, truth, float(flutter_truth.Vf),
+                                lc.speed_following_factors, duration=lc.duration, mode=crit,
+                                deflection=lc.initial_deflection, dt=model.dt,
+                                truth_lcos={lc.speed_factor: tr},
+                                max_extensions=_MAX_EXTENSIONS)
+        for c in following:
+            log.info("speed-following ROM's LCO at %.4g x truth Vf (V = %.5g): %s, amplitude "
+                     "%s of the truth's", c.speed_factor, c.V, c.rom.sensors.kind,
+                     ", ".join(f"{e:+.1f} %" for e in c.amplitude_error_percent))
     return LcoResult(rom=sim, truth=tr, V=V_lco, V_hopf_exact_order=V_hopf,
-                     flutter_exact_order=fl_exact, V_hopf_loop=V_loop, **branches)
+                     flutter_exact_order=fl_exact, V_hopf_loop=V_loop,
+                     speed_following=following, **branches)
 
 
 def _branches(cfg: RunConfig, truth, model, structure) -> dict:

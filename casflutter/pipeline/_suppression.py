@@ -100,7 +100,8 @@ def suppression_stage(cfg: RunConfig, truth, flutters: FlutterStage, lco,
     V_ref = float(flutters.truth.Vf if has_truth_flutter else flutters.Vf)
     known = {}
     if lco is not None and lco.truth is not None:
-        known[lco.truth.V / V_ref] = lco.truth   # the LCO stage's converged truth run
+        known[lco.truth.V / V_ref] = lco.truth   # the LCO stage's converged truth runs
+        known.update({c.speed_factor: c.truth for c in lco.speed_following})
     runs = suppression_runs(truth, K, V_ref, cfg.suppression, dt=dt, mode=mode,
                             deflection=cfg.lco.initial_deflection,
                             lco_duration=cfg.lco.duration, sensor_rows=cfg.sensors.rows or None,

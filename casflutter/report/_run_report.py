@@ -160,6 +160,12 @@ def write_figures(out: Path, result) -> dict:
             title=f"Fig. 9: LCO of each model {pct:.3g} % above its own flutter speed",
             time_unit=st.time_unit, **air),
             out / "fig9_lco.png")
+        for c in lco.speed_following:
+            files[_following_key(c.speed_factor)] = _save(plot_lco(
+                c.rom, truth=c.truth, labels=labels,
+                title=(f"LCO of the speed-following ROM and of the truth at "
+                       f"{c.speed_factor:g} x the truth's flutter speed"),
+                time_unit=st.time_unit, **air), out / f"{_following_key(c.speed_factor)}.png")
         if lco.truth_branch is not None and lco.rom_branch is not None:
             files["lco_branches"] = _save(plot_bifurcation_pair(lco.truth_branch,
                                                                 lco.rom_branch),
@@ -234,6 +240,12 @@ def _amplitudes(values, units) -> str:
     return ", ".join(f"{a:.4g} {u}".rstrip() for a, u in zip(values, units))
 
 
+def _following_key(speed_factor: float) -> str:
+    """``lco_speed_following_1p2``: the figure of the speed-following ROM's LCO at a
+    multiple of the truth's flutter speed."""
+    return f"lco_speed_following_{speed_factor:g}".replace(".", "p")
+
+
 def figure_captions(result) -> dict:
     """A caption per figure of :func:`write_figures`, for the report.
 
@@ -304,6 +316,15 @@ def figure_captions(result) -> dict:
         else:
             text += f"; sensor amplitudes (half peak to peak) {rom_a}."
         cap["fig9_lco"] = text
+        for c in lco.speed_following:
+            cap[_following_key(c.speed_factor)] = (
+                f"LCO of the ROM that follows the wing over speed (left) and of the truth "
+                f"(right), both at V = {c.V:.4g}, {c.speed_factor:g} x the truth's flutter "
+                f"speed: sensor amplitudes ROM {_amplitudes(c.rom_amplitude, units)}, truth "
+                f"{_amplitudes(c.truth.amplitude, units)} (ROM "
+                + ", ".join(f"{e:+.1f} %" for e in c.amplitude_error_percent)
+                + "); ROM frequency "
+                f"{c.rom.sensors.frequency_hz:.4g} Hz, truth {c.truth.freq_hz:.4g} Hz.")
         cap["lco_branches"] = (
             "LCO branches from the flutter points, continued in the airspeed: the truth "
             "(left, orthogonal collocation) and the ROM loop (right, invariant circles of the "

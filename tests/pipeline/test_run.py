@@ -69,13 +69,27 @@ def test_summary_keys_and_table_i_structure(reduced):
     dom = sup["dominant_sensor"]
     assert runs[0]["open_loop_rms"][dom] == pytest.approx(
         lco["truth_amplitude"][dom] / np.sqrt(2), rel=0.10)
+    # the speed-following ROM's LCO beside the truth's at the same multiples of the truth's
+    # flutter speed; the truth's runs are the LCO stage's and the suppression's starts
+    following = lco["speed_following"]
+    assert [c["speed_factor"] for c in following] == [1.05, 1.2]
+    for c, r in zip(following, runs):
+        assert c["V"] == pytest.approx(c["speed_factor"] * s["flutter_truth"]["V"], rel=1e-12)
+        assert c["V"] == pytest.approx(r["V"], rel=1e-12)
+        assert c["truth_kind"] == "lco" and c["rom_kind"] in ("lco", "divergence", "decay")
+        assert r["open_loop_rms"][dom] == pytest.approx(
+            c["truth_amplitude"][dom] / np.sqrt(2), rel=0.10)
+        np.testing.assert_allclose(c["amplitude_error_percent"], 100 * (
+            np.divide(c["rom_amplitude"], c["truth_amplitude"]) - 1), rtol=1e-12)
+    assert following[0]["truth_amplitude"] == lco["truth_amplitude"]
     assert set(s["controller"]) >= {"order", "gamma", "small_gain_V", "lft_stable_V",
                                     "stable_interval", "truth_stable_interval",
                                     "absolute_flutter_speed", "robust_flutter_speed"}
     assert s["timings_s"]["total"] >= sum(v for k, v in s["timings_s"].items() if k != "total") - 1e-6
     for name in ("summary.json", "rom.npz", "controller.json", "controller.mat", "report.html",
                  "fig7_rom_fit.png", "fig8_flap_pulses.png", "fig9_lco.png",
-                 "fig10_pole_loci.png", "fig11_gain_ramp.png"):
+                 "fig10_pole_loci.png", "fig11_gain_ramp.png", "lco_speed_following_1p05.png",
+                 "lco_speed_following_1p2.png"):
         assert (out / name).is_file(), name
     html = (out / "report.html").read_text()
     assert "data:image/png;base64," in html and "Table I" in html

@@ -122,6 +122,12 @@ def _main(args) -> int:
                 if v is not None))
         if s["lco"] is not None:
             lines.append(f"LCO: {sig(s['lco']['freq_hz'])} {hz} ({s['lco']['kind']})")
+            following = s["lco"].get("speed_following") or []
+            if following:
+                lines.append("speed-following ROM's LCO amplitude vs the truth's: " + "; ".join(
+                    f"{c['speed_factor']:g} Vf " + ", ".join(
+                        f"{e:+.1f} %" for e in c["amplitude_error_percent"])
+                    for c in following))
     if s["controller"] is not None:
         lines += _controller_lines(s["controller"], res, unit)
     if s["suppression"] is not None:
