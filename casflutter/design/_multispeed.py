@@ -87,6 +87,10 @@ class MultiSpeedSettings:
     0: none)."""
     rate_bandwidth: float = 1.0
     """Bandwidth [rad per time unit] of the control-rate filter (e.g. the servo's)."""
+    sensitivity: bool = False
+    """The H∞ plants' channels: at each speed the output and the input sensitivity of the
+    loop (whose diagonal entries bound the loop-at-a-time margins) instead of the family's
+    disturbances to the measurements (:class:`._speeds.DesignChannels`)."""
     strictly_proper: bool | None = None
     """Keep ``Dk = 0``; ``None``: strictly proper exactly when some model's controls reach its
     measurements directly (a feed-through would close an algebraic loop that can become
@@ -500,9 +504,19 @@ def _padded(P, dims: tuple) -> control.StateSpace:
     return control.ss(P.A, B, C, D)
 
 
-def _as_ss(P) -> control.StateSpace:
-    return control.ss(P.A, np.hstack([P.B1, P.B2]), np.vstack([P.C1, P.C2]),
-                      np.block([[P.D11, P.D12], [P.D21, P.D22]]))
+def _as_ss(P, nw: int = 0, nz: int = 0) -> control.StateSpace:
+    """The partitioned plant ``P`` as one state-space system, its ``w`` and ``z`` padded
+    with zero channels to at least ``nw`` and ``nz`` (plants of one synthesis share their
+    sizes; zero channels leave the norm as it is)."""
+    pw, pz = max(0, nw - P.B1.shape[1]), max(0, nz - P.C1.shape[0])
+    nx, nu, ny = P.A.shape[0], P.B2.shape[1], P.C2.shape[0]
+    B1 = np.hstack([P.B1, np.zeros((nx, pw))])
+    C1 = np.vstack([P.C1, np.zeros((pz, nx))])
+    D11 = np.pad(P.D11, ((0, pz), (0, pw)))
+    D12 = np.vstack([P.D12, np.zeros((pz, nu))])
+    D21 = np.hstack([P.D21, np.zeros((ny, pw))])
+    return control.ss(P.A, np.hstack([B1, P.B2]), np.vstack([C1, P.C2]),
+                      np.block([[D11, D12], [D21, P.D22]]))
 
 
 def design_over_speeds(family, interval, order: int = 3, *,
@@ -693,10 +707,14 @@ def _finish(eng: _Engine, fams, K: np.ndarray, order: int, interval: tuple, reac
     s, models = eng.settings, eng.models
     lo, e = reached
     Kss = _controller(eng, K)
-    channels = DesignChannels(s.rate_weight, s.rate_bandwidth)
+    channels = [DesignChannels(s.rate_weight, s.rate_bandwidth, side)
+                for side in (("output", "input") if s.sensitivity else ("",))]
     hv = tuple(float(v) for v in np.linspace(lo, e, s.hinf_speeds)) if s.hinf_speeds else ()
     if hinf_plants is None:
-        hinf = [_as_ss(design_partition(f, V, channels)) for V in hv for f in fams]
+        parts = [design_partition(f, V, ch) for V in hv for f in fams for ch in channels]
+        nw = max((P.B1.shape[1] for P in parts), default=0)
+        nz = max((P.C1.shape[0] for P in parts), default=0)
+        hinf = [_as_ss(P, nw, nz) for P in parts]
     else:
         hinf = [control.ss(P) for P in hinf_plants]
         hv = ()

@@ -11,7 +11,14 @@ outputs ``[z, y]``) with the controller closed as ``u = +K y``:
   controls at the plant's input;
 * ``z`` the measurements (the disturbance-to-sensor channels), and optionally the weighted
   rate of every control through a first-order filter (``z_r = w a (u − x_r)``,
-  ``ẋ_r = a (u − x_r)``): the flap rate a servo can give is limited.
+  ``ẋ_r = a (u − x_r)``): the flap rate a servo can give is limited;
+* or the loop's sensitivities: with ``DesignChannels(sensitivity="output")`` ``w`` is added
+  to the measurements and ``z`` is the measurements, so ``w → z`` is the output sensitivity
+  ``(I − G K)⁻¹``; with ``"input"`` ``w`` is added to the controls at the plant's input and
+  ``z`` is that input, so ``w → z`` is the input sensitivity ``(I − K G)⁻¹``.  The ``i``-th
+  diagonal entry of either is the sensitivity of loop ``i`` broken with the others closed,
+  so ``‖·‖∞ ≤ M`` gives every such loop a disk margin of at least ``1/M``: the per-loop
+  margins that :func:`casflutter.verify.verify_family` reports at both sides.
 
 :class:`SpeedLoops` holds a set of such plants, scaled once for the whole design (balanced
 states, inputs and outputs of order one, time scaled by the plants' geometric-mean pole
@@ -49,18 +56,25 @@ class DesignChannels:
         ``w`` of the control-rate outputs (0: none).
     rate_bandwidth : float
         ``a`` [rad per time unit] of their filter (> 0).
+    sensitivity : {"", "output", "input"}
+        ``""``: the family's disturbances to the measurements; ``"output"`` / ``"input"``:
+        the output / input sensitivity of the loop (module docstring).
     """
 
     __repr__ = result_repr
 
     rate_weight: float = 0.0
     rate_bandwidth: float = 1.0
+    sensitivity: str = ""
 
     def __post_init__(self):
         if not (math.isfinite(self.rate_weight) and self.rate_weight >= 0
                 and math.isfinite(self.rate_bandwidth) and self.rate_bandwidth > 0):
             raise ConfigError(f"rate weight {self.rate_weight!r} (>= 0) and bandwidth "
                               f"{self.rate_bandwidth!r} (> 0, rad per time unit)")
+        if self.sensitivity not in ("", "output", "input"):
+            raise ConfigError(f"sensitivity = {self.sensitivity!r}: allowed '' (the "
+                              "disturbance channels), 'output', 'input'")
 
 
 def design_partition(family, V: float, channels: DesignChannels = DesignChannels()
@@ -91,6 +105,12 @@ def design_partition(family, V: float, channels: DesignChannels = DesignChannels
     B2, C2, D22 = s * B[:, iu], C[iy], s * D[np.ix_(iy, iu)]
     B1, D21 = B[:, iw], D[np.ix_(iy, iw)]
     C1, D11, D12 = C2, D21, D22
+    if channels.sensitivity == "output":        # y = G u + w, z = y
+        B1, D21 = np.zeros((nx, len(iy))), np.eye(len(iy))
+        C1, D11 = C2, D21
+    elif channels.sensitivity == "input":       # u_p = s u + w, y = G u_p, z = u_p
+        B1, D21 = B[:, iu], D[np.ix_(iy, iu)]
+        C1, D11, D12 = np.zeros((nu, nx)), np.eye(nu), s * np.eye(nu)
     if channels.rate_weight > 0:
         a, w = channels.rate_bandwidth, channels.rate_weight
         nw = B1.shape[1]

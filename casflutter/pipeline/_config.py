@@ -269,8 +269,10 @@ class ControllerSettings(SynthesisOptions):
     """H∞ objective of the multi-speed design once the interval is held: ``"lft"`` the
     paper's, γ of the LFTs at ``speeds`` x Vf (eq. 14-16) with the flap-rate weight, so its
     γ compares with the paper's design; ``"sensors"`` each of ``hinf_speeds`` speeds'
-    disturbance-to-sensor channels; ``"auto"``: ``"lft"`` where the run has a ROM loop with
-    a flutter speed, ``"sensors"`` otherwise."""
+    disturbance-to-sensor channels; ``"sensitivity"`` each of those speeds' output
+    sensitivity (disturbances added to the sensors), which bounds every sensor loop's
+    margins; ``"auto"``: ``"lft"`` where the run has a ROM loop with a flutter speed, else
+    ``"sensors"`` where the family names disturbance inputs, else ``"sensitivity"``."""
     random_starts: int = 2
     """Seeded random starts of the multi-speed design at the target order."""
     full_order: bool = False
@@ -337,9 +339,9 @@ class ControllerSettings(SynthesisOptions):
                               "0 <= lo < hi")
         object.__setattr__(self, "interval", iv)
         _integer("n_speeds", self.n_speeds, 2)
-        if self.hinf_objective not in ("auto", "lft", "sensors"):
+        if self.hinf_objective not in ("auto", "lft", "sensors", "sensitivity"):
             raise ConfigError(f"controller.hinf_objective = {self.hinf_objective!r}: allowed "
-                              "'auto', 'lft', 'sensors'")
+                              "'auto', 'lft', 'sensors', 'sensitivity'")
         if self.method not in ("auto", "multispeed", "paper"):
             raise ConfigError(f"controller.method = {self.method!r}: allowed 'auto', "
                               "'multispeed', 'paper'")

@@ -116,10 +116,15 @@ def _multispeed(cfg: RunConfig, family, lft_plants=None) -> MultiSpeedDesign:
         raise CasflutterError("controller.hinf_objective = \"lft\" needs the LFT at the ROM "
                               "loop's flutter speed (eq. 14); this problem has no ROM loop "
                               "with a flutter speed: use \"sensors\" or \"auto\"")
-    hinf = lft_plants if c.hinf_objective in ("lft", "auto") and c.hinf_speeds else None
+    objective = c.hinf_objective
+    if objective == "auto":
+        objective = ("lft" if lft_plants is not None else
+                     "sensors" if family.signals.disturbances else "sensitivity")
+    hinf = lft_plants if objective == "lft" and c.hinf_speeds else None
     settings = MultiSpeedSettings(
         decay=c.interval_decay, n_speeds=c.n_speeds, hinf_speeds=c.hinf_speeds,
         rate_weight=c.flap_rate_weight, rate_bandwidth=c.flap_rate_bandwidth,
+        sensitivity=objective == "sensitivity",
         strictly_proper=c.strictly_proper, random_starts=c.random_starts,
         full_order=c.full_order, reduction_orders=c.reduction_orders,
         synthesis=replace(settings_as(c, SynthesisOptions), ipopt={**cfg.solver.ipopt,

@@ -18,7 +18,8 @@ from casflutter.design import MultiSpeedSettings, design_over_speeds
 from casflutter.verify import verify_family
 
 KEYS = {"problem", "nx", "n_inputs", "n_outputs", "order", "seed", "interval", "held", "reach",
-        "worst_abscissa", "gamma", "wall_time_s", "cpu_time_s", "certified_interval", "status"}
+        "worst_abscissa", "gamma", "wall_time_s", "cpu_time_s", "certified_interval", "status",
+        "objective", "robust_flutter_speed"}
 
 
 def test_records_per_order_and_seed_with_the_certificate(tmp_path):
@@ -33,10 +34,13 @@ def test_records_per_order_and_seed_with_the_certificate(tmp_path):
     assert rec["reach"] == 150.0
     assert doc["summary"]["2"]["held"] == 1 and doc["summary"]["2"]["of"] == 1
     family = load_family("goland_4flaps")
+    # the family names no disturbances: the H-infinity phase bounds the loop's sensitivities
+    assert rec["objective"] == "sensitivity"
     K = design_over_speeds(family, (60.0, 150.0), 2, seed=0,
-                           settings=MultiSpeedSettings(decay=0.05)).controller
+                           settings=MultiSpeedSettings(decay=0.05, sensitivity=True)).controller
     check = verify_family(family, K, speed_range=family.speed_range)
     assert rec["certified_interval"] == pytest.approx(list(check.stable_interval), rel=1e-9)
+    assert rec["robust_flutter_speed"] == pytest.approx(check.robust_flutter_speed, rel=1e-9)
     assert rec["certified_interval"][0] <= 60.0 and rec["certified_interval"][1] >= 150.0
 
 

@@ -82,3 +82,57 @@ def test_a_decay_no_controller_reaches_even_at_the_low_end_is_a_synthesis_error(
 def test_bad_requests_are_refused_before_any_work(family, interval, order, match):
     with pytest.raises(ConfigError, match=match):
         design_over_speeds(family, interval, order, settings=FAST)
+
+
+@pytest.mark.parametrize("side", ["output", "input"])
+def test_the_sensitivity_channels_are_the_loops_sensitivities(family, design, side):
+    """The H∞ plants of ``sensitivity = True``, closed by the design's controller, against
+    the loop's output sensitivity ``(I − s G K)⁻¹`` and input sensitivity ``(I − s K G)⁻¹``
+    formed here with python-control's ``feedback`` on the family's own plant, at frequencies
+    around the flutter mode's, to 1e-7 of the largest entry (rounding in the 50-state
+    frequency responses)."""
+    from casflutter.design._multispeed import _as_ss
+    from casflutter.design._speeds import DesignChannels, design_partition
+
+    V, K, s = 120.0, design.controller, family.feedback_sign
+    sig = family.signals
+    G = family.plant(V)
+    meas, ctrl = sig.output_index(), sig.input_index()
+    G = control.ss(G.A, np.asarray(G.B)[:, ctrl], np.asarray(G.C)[meas, :],
+                   np.asarray(G.D)[np.ix_(meas, ctrl)])
+    loop = G * K if side == "output" else K * G
+    I = control.ss([], [], [], np.eye(loop.noutputs))
+    S = control.feedback(I, loop, sign=s)
+    part = design_partition(family, V, DesignChannels(sensitivity=side))
+    P = _as_ss(part, part.B1.shape[1] + 2, part.C1.shape[0] + 1)    # padded with zeros
+    T = P.lft(K, nu=K.noutputs, ny=K.ninputs)             # F_l(P, K): u = +K y
+    n = S.ninputs
+    for w in (1.0, 30.0, 68.7, 300.0):
+        Tj, Sj = T(1j * w), S(1j * w)
+        np.testing.assert_allclose(Tj[:n, :n], Sj, rtol=1e-6, atol=1e-7 * np.abs(Sj).max())
+        assert np.all(Tj[n:, :] == 0) and np.all(Tj[:, n:] == 0)      # the zero padding
+
+
+@pytest.mark.slow
+def test_the_sensitivity_objective_bounds_every_loops_margins(family):
+    """``sensitivity = True``: the H∞ phase minimises the worst output and input sensitivity
+    over its speeds, so at each of them every loop broken alone (the others closed) has
+    ``|S_ii| <= γ``, hence a phase margin of at least ``2 asin(1 / (2 γ))``.  Checked with
+    the verification layer's own loop-at-a-time margins
+    (:func:`casflutter.verify.loop_margins`), which share no code with the design."""
+    from casflutter.verify import loop_margins
+
+    settings = MultiSpeedSettings(hinf_speeds=3, random_starts=1, full_order=False,
+                                  sensitivity=True)
+    d = design_over_speeds(family, INTERVAL, 2, settings=settings, seed=0)
+    assert d.held and d.synthesis is not None and len(d.hinf_speeds) == 3
+    bound = np.degrees(2 * np.arcsin(1 / (2 * d.gamma)))
+    sig = family.signals
+    meas, ctrl = sig.output_index(), sig.input_index()
+    for V in d.hinf_speeds:
+        G = family.plant(V)
+        G = control.ss(G.A, np.asarray(G.B)[:, ctrl], np.asarray(G.C)[meas, :],
+                       np.asarray(G.D)[np.ix_(meas, ctrl)])
+        for side in ("input", "output"):
+            for lm in loop_margins(G, d.controller, family.feedback_sign, side):
+                assert lm.phase >= bound * (1 - 1e-6), (V, side, lm.phase, bound)

@@ -60,7 +60,7 @@ def _ints(text: str, what: str, low: int) -> list[int]:
 
 
 def design_records(family, interval, orders, seeds, *, problem: str = "", decay: float = 0.05,
-                   on_record=None) -> list[dict[str, Any]]:
+                   objective: str = "auto", on_record=None) -> list[dict[str, Any]]:
     """Design at every order and seed and certify each controller on the family.
 
     Parameters
@@ -75,6 +75,11 @@ def design_records(family, interval, orders, seeds, *, problem: str = "", decay:
         The name written in each record.
     decay : float
         Decay rate required at every speed [rad per time unit].
+    objective : {"auto", "sensors", "sensitivity"}
+        The H∞ phase's channels (:class:`casflutter.design.MultiSpeedSettings`):
+        the family's disturbances to its measurements, or the loop's output and input
+        sensitivities (the per-loop margins); ``"auto"``: ``"sensors"`` when the family
+        names disturbance inputs, else ``"sensitivity"``.
     on_record : callable, optional
         Called with each record as it is finished.
 
@@ -87,19 +92,22 @@ def design_records(family, interval, orders, seeds, *, problem: str = "", decay:
     from ...verify import verify_family
 
     sig, nx = family.signals, family.n_states
-    settings = MultiSpeedSettings(decay=decay)
+    if objective == "auto":
+        objective = "sensors" if sig.disturbances else "sensitivity"
+    settings = MultiSpeedSettings(decay=decay, sensitivity=objective == "sensitivity")
     records = []
     for order in orders:
         for seed in seeds:
             rec = {"problem": problem, "nx": nx, "n_inputs": len(sig.controls),
                    "n_outputs": len(sig.measurements), "order": order, "seed": seed,
-                   "interval": list(interval)}
+                   "interval": list(interval), "objective": objective}
             t, c = time.perf_counter(), time.process_time()
             try:
                 d = design_over_speeds(family, interval, order, settings=settings, seed=seed)
             except SynthesisError as exc:
                 rec.update(held=False, reach=None, worst_abscissa=None, gamma=None,
-                           certified_interval=None, status=f"failed: {exc}",
+                           certified_interval=None, robust_flutter_speed=None,
+                           status=f"failed: {exc}",
                            wall_time_s=time.perf_counter() - t,
                            cpu_time_s=time.process_time() - c)
             else:
@@ -113,6 +121,7 @@ def design_records(family, interval, orders, seeds, *, problem: str = "", decay:
                                       else (lo, interval[1]))
                 rec["certified_interval"] = (None if check.stable_interval is None
                                              else list(check.stable_interval))
+                rec["robust_flutter_speed"] = check.robust_flutter_speed
             records.append(plain_json(rec))
             if on_record is not None:
                 on_record(records[-1])
@@ -157,7 +166,7 @@ def _handler(args: argparse.Namespace) -> int:
     out = check_output_path(args.out, what="--out", suffixes=(".json",))
     family, about = _family(args.problem)
     meta = {"problem": args.problem, "family": about, "decay": args.decay,
-            "provenance": provenance()}
+            "objective": args.objective, "provenance": provenance()}
     records: list = []
 
     def keep(rec):
@@ -166,7 +175,7 @@ def _handler(args: argparse.Namespace) -> int:
 
     _write(out, records, meta)
     design_records(family, (lo, hi), orders, seeds, problem=args.problem, decay=args.decay,
-                   on_record=keep)
+                   objective=args.objective, on_record=keep)
     return 0
 
 
@@ -183,5 +192,10 @@ def register(subparsers) -> None:
     p.add_argument("--seeds", default="0,1,2", help="comma-separated seeds")
     p.add_argument("--decay", type=float, default=0.05,
                    help="decay rate required at every speed [rad per time unit]")
+    p.add_argument("--objective", choices=("auto", "sensors", "sensitivity"), default="auto",
+                   help="H-infinity objective once the interval is held: the family's "
+                        "disturbances to its sensors, or the loop's output and input "
+                        "sensitivities (the per-loop margins); auto: sensors when the family "
+                        "names disturbance inputs, else sensitivity")
     p.add_argument("--out", required=True, help="output JSON file")
     p.set_defaults(func=_handler)
