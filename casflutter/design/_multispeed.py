@@ -496,12 +496,10 @@ def _interval(interval, fams) -> tuple[float, float]:
 
 def _padded(P, dims: tuple) -> control.StateSpace:
     """A stability plant with zero ``w`` and ``z`` channels of the H∞ plants' sizes."""
-    nw, nz = dims
     nx, nu, ny = P.A.shape[0], P.B2.shape[1], P.C2.shape[0]
-    B = np.hstack([np.zeros((nx, nw)), P.B2])
-    C = np.vstack([np.zeros((nz, nx)), P.C2])
-    D = np.block([[np.zeros((nz, nw)), np.zeros((nz, nu))], [np.zeros((ny, nw)), P.D22]])
-    return control.ss(P.A, B, C, D)
+    bare = replace(P, B1=np.zeros((nx, 0)), C1=np.zeros((0, nx)), D11=np.zeros((0, 0)),
+                   D12=np.zeros((0, nu)), D21=np.zeros((ny, 0)))
+    return _as_ss(bare, *dims)
 
 
 def _as_ss(P, nw: int = 0, nz: int = 0) -> control.StateSpace:

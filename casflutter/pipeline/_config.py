@@ -269,9 +269,8 @@ class ControllerSettings(SynthesisOptions):
     """H∞ objective of the multi-speed design once the interval is held: ``"lft"`` the
     paper's, γ of the LFTs at ``speeds`` x Vf (eq. 14-16) with the flap-rate weight, so its
     γ compares with the paper's design; ``"sensors"`` each of ``hinf_speeds`` speeds'
-    disturbance-to-sensor channels; ``"sensitivity"`` each of those speeds' output
-    sensitivity (disturbances added to the sensors), which bounds every sensor loop's
-    margins; ``"auto"``: ``"lft"`` where the run has a ROM loop with a flutter speed, else
+    disturbance-to-sensor channels; ``"sensitivity"`` each of those speeds' output and
+    input sensitivities, which bound every loop-at-a-time margin (sensors and controls); ``"auto"``: ``"lft"`` where the run has a ROM loop with a flutter speed, else
     ``"sensors"`` where the family names disturbance inputs, else ``"sensitivity"``."""
     random_starts: int = 2
     """Seeded random starts of the multi-speed design at the target order."""
