@@ -82,6 +82,9 @@ def _conclusions(res) -> dict:
         out["ROM loop LCO verdict"] = ("same", res.lco.rom.kind)
         if res.lco.truth is not None:
             out["truth LCO verdict"] = ("same", res.lco.truth.kind)
+        for c in res.lco.speed_following:
+            out[f"speed-following ROM LCO verdict at {c.speed_factor:g} Vf"] = (
+                "same", c.rom.sensors.kind)
     if res.controller is not None:
         ver = res.verification
         out.update({
