@@ -32,8 +32,9 @@ hinfstruct/systune (the worst case over a set of models), with the speeds as the
    where a servo saturates, or plants the caller gives, e.g. the paper's LFT at Vf) while the
    loops at the stability speeds keep their decay rate; the dense scan checks the result and
    where it finds a loop slower than the decay rate between the stability speeds, its peaks
-   join them and the phase starts again from the held controller; the held controller is
-   kept if the H∞ phase still loses the interval.
+   join them, the rate asked at them grows by a quarter (room for the loops between them)
+   and the phase starts again from the held controller; the held controller is kept if the
+   H∞ phase still loses the interval.
 
 Every budget is counted in iterations and every random choice takes the seed, so the same seed
 gives the same controller.  The interval the design reports is its own dense scan's; the
@@ -669,17 +670,19 @@ def _hinf_phase(eng: _Engine, hinf: list, dims: tuple, K: np.ndarray, Kss, lo: f
     """The H∞ phase from the held controller (module docstring, step 3): ``(synthesis or
     None, K, Kss)``.  The synthesis keeps the decay rate at the stability speeds only; where
     the dense scan finds a loop slower than that between them, its peaks join the stability
-    speeds and the synthesis starts again from the held controller (``rounds`` times at
-    most).  ``None`` keeps the held controller."""
+    speeds, the rate asked at them grows by a quarter (room for the loops between them) and
+    the synthesis starts again from the held controller (``rounds`` times at most).
+    ``None`` keeps the held controller."""
     s, models = eng.settings, eng.models
     opts = replace(s.synthesis, decay=float(s.decay), strictly_proper=eng.strictly_proper,
                    zero_start=False, full_order_start=False)
     speeds = np.linspace(lo, e, s.n_speeds)
-    for _ in range(rounds):
+    for k in range(rounds):
         stab = [_padded(P, dims) for V in speeds for P in models.parts(V)]
         try:
             syn = synthesize(hinf, models.ny, models.nu, order, starts=0, initial=Kss,
-                             stability_plants=stab, options=opts)
+                             stability_plants=stab,
+                             options=replace(opts, decay=float(s.decay) * (1 + k / 4)))
         except SynthesisError as exc:
             log.info("H-infinity phase: %s; the held controller is kept", exc)
             return None, K, Kss
