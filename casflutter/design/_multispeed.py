@@ -670,21 +670,26 @@ def _hinf_phase(eng: _Engine, hinf: list, dims: tuple, K: np.ndarray, Kss, lo: f
     """The H∞ phase from the held controller (module docstring, step 3): ``(synthesis or
     None, K, Kss)``.  The synthesis keeps the decay rate at the stability speeds only; where
     the dense scan finds a loop slower than that between them, its peaks join the stability
-    speeds, the rate asked at them grows by a quarter (room for the loops between them) and
-    the synthesis starts again from the held controller (``rounds`` times at most).
-    ``None`` keeps the held controller."""
+    speeds, the rate asked at them grows by a quarter (room for the loops between them; the
+    required rate where no controller reaches that) and the synthesis starts again from the
+    held controller (``rounds`` times at most).  ``None`` keeps the held controller."""
     s, models = eng.settings, eng.models
     opts = replace(s.synthesis, decay=float(s.decay), strictly_proper=eng.strictly_proper,
                    zero_start=False, full_order_start=False)
     speeds = np.linspace(lo, e, s.n_speeds)
     for k in range(rounds):
         stab = [_padded(P, dims) for V in speeds for P in models.parts(V)]
-        try:
-            syn = synthesize(hinf, models.ny, models.nu, order, starts=0, initial=Kss,
-                             stability_plants=stab,
-                             options=replace(opts, decay=float(s.decay) * (1 + k / 4)))
-        except SynthesisError as exc:
-            log.info("H-infinity phase: %s; the held controller is kept", exc)
+        syn = None
+        # the faster rate first; where no controller reaches it, the required one
+        for rate in dict.fromkeys((float(s.decay) * (1 + k / 4), float(s.decay))):
+            try:
+                syn = synthesize(hinf, models.ny, models.nu, order, starts=0, initial=Kss,
+                                 stability_plants=stab, options=replace(opts, decay=rate))
+                break
+            except SynthesisError as exc:
+                error = exc
+        if syn is None:
+            log.info("H-infinity phase: %s; the held controller is kept", error)
             return None, K, Kss
         Kh = models.scaling.gain(*(np.atleast_2d(np.asarray(M, dtype=float)).reshape(r, c)
                                    for M, (r, c) in zip(
