@@ -1,7 +1,7 @@
 """Fixed-order robust H∞ synthesis (paper §III.C) and flutter suppression over a speed interval.
 
 Public names: :func:`design_over_speeds` with :class:`MultiSpeedSettings`,
-:class:`MultiSpeedDesign` and :class:`HoldRecord` (one fixed-order controller that keeps a
+:class:`MultiSpeedDesign`, :class:`HoldRecord` and :func:`default_objective` (one fixed-order controller that keeps a
 plant family decaying over a speed interval, with the smallest worst H∞ objective over the
 speeds); :func:`synthesize` with :class:`SynthesisOptions`, :class:`SynthesisResult`,
 :class:`StartRecord` (the H∞ synthesis over one plant or the worst case of several, eq. 16);
@@ -14,7 +14,8 @@ speeds); :func:`synthesize` with :class:`SynthesisOptions`, :class:`SynthesisRes
 γ for every controller with fewer states than controls).
 """
 
-from ._multispeed import HoldRecord, MultiSpeedDesign, MultiSpeedSettings, design_over_speeds
+from ._multispeed import (HoldRecord, MultiSpeedDesign, MultiSpeedSettings, default_objective,
+                          design_over_speeds)
 from ._norm import hinf_norm
 from ._orderbound import (OrderBound, StaticDirectionBound, order_relaxation,
                           static_direction_bound)
@@ -23,6 +24,7 @@ from ._synthesis import (StartRecord, SynthesisOptions, SynthesisResult, synthes
                          verify_closed_loop)
 
 __all__ = ["design_over_speeds", "MultiSpeedSettings", "MultiSpeedDesign", "HoldRecord",
+           "default_objective",
            "synthesize", "SynthesisOptions", "SynthesisResult", "StartRecord",
            "with_flap_rate", "order_relaxation", "OrderBound", "static_direction_bound",
            "StaticDirectionBound", "load_compleib", "partition", "Partition", "exact_hinf_norm",

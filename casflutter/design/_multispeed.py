@@ -61,7 +61,8 @@ from ._problem import verify_closed_loop
 from ._speeds import DesignChannels, Scaling, SpeedLoops, design_partition
 from ._synthesis import SynthesisOptions, SynthesisResult, synthesize
 
-__all__ = ["MultiSpeedSettings", "MultiSpeedDesign", "HoldRecord", "design_over_speeds"]
+__all__ = ["MultiSpeedSettings", "MultiSpeedDesign", "HoldRecord", "design_over_speeds",
+           "default_objective"]
 
 log = logging.getLogger("casflutter.design")
 
@@ -472,6 +473,24 @@ class _Engine:
             else:
                 break
         return K, steps
+
+
+def default_objective(family) -> str:
+    """The H∞ objective of the multi-speed design on ``family`` when the caller names none.
+
+    Parameters
+    ----------
+    family : PlantFamily
+        The family.
+
+    Returns
+    -------
+    str
+        ``"sensors"`` (its disturbances to its measurements) when the family names
+        disturbance inputs, else ``"sensitivity"`` (the loop's output and input
+        sensitivities, which bound every loop-at-a-time margin).
+    """
+    return "sensors" if family.signals.disturbances else "sensitivity"
 
 
 def _families(family) -> tuple:

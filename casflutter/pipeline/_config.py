@@ -270,7 +270,8 @@ class ControllerSettings(SynthesisOptions):
     paper's, γ of the LFTs at ``speeds`` x Vf (eq. 14-16) with the flap-rate weight, so its
     γ compares with the paper's design; ``"sensors"`` each of ``hinf_speeds`` speeds'
     disturbance-to-sensor channels; ``"sensitivity"`` each of those speeds' output and
-    input sensitivities, which bound every loop-at-a-time margin (sensors and controls); ``"auto"``: ``"lft"`` where the run has a ROM loop with a flutter speed, else
+    input sensitivities, which bound every loop-at-a-time margin (sensors and controls);
+    ``"auto"``: ``"lft"`` where the run has a ROM loop with a flutter speed, else
     ``"sensors"`` where the family names disturbance inputs, else ``"sensitivity"``."""
     random_starts: int = 2
     """Seeded random starts of the multi-speed design at the target order."""

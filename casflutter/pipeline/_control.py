@@ -33,7 +33,8 @@ from .._format import result_repr
 from .._settings import settings_as
 from ..aeroelastic import AeroelasticLFT, build_lft
 from ..design import (MultiSpeedDesign, MultiSpeedSettings, SynthesisOptions,
-                      SynthesisResult, design_over_speeds, synthesize, with_flap_rate)
+                      SynthesisResult, default_objective, design_over_speeds, synthesize,
+                      with_flap_rate)
 from ..errors import CasflutterError
 from ..verify import (FamilyVerification, SpeedSweep, VerificationReport, speed_sweep,
                       verify_controller, verify_family)
@@ -118,8 +119,7 @@ def _multispeed(cfg: RunConfig, family, lft_plants=None) -> MultiSpeedDesign:
                               "with a flutter speed: use \"sensors\" or \"auto\"")
     objective = c.hinf_objective
     if objective == "auto":
-        objective = ("lft" if lft_plants is not None else
-                     "sensors" if family.signals.disturbances else "sensitivity")
+        objective = "lft" if lft_plants is not None else default_objective(family)
     hinf = lft_plants if objective == "lft" and c.hinf_speeds else None
     settings = MultiSpeedSettings(
         decay=c.interval_decay, n_speeds=c.n_speeds, hinf_speeds=c.hinf_speeds,

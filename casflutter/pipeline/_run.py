@@ -373,7 +373,7 @@ def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth,
 
     Where the run has the ROM that follows the wing over speed and the truth flutters, that
     ROM's LCO is put beside the truth's at ``lco.speed_following_factors`` times the truth's
-    flutter speed (issue 32: within 15 % at 1.05 and 1.2 Vf).
+    flutter speed.
     """
     vr, lc = cfg.flutter.V_range, cfg.lco
     exact = realize(model, "auto")

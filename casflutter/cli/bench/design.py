@@ -87,13 +87,13 @@ def design_records(family, interval, orders, seeds, *, problem: str = "", decay:
     -------
     list of dict
     """
-    from ...design import MultiSpeedSettings, design_over_speeds
+    from ...design import MultiSpeedSettings, default_objective, design_over_speeds
     from ...errors import SynthesisError
     from ...verify import verify_family
 
     sig, nx = family.signals, family.n_states
     if objective == "auto":
-        objective = "sensors" if sig.disturbances else "sensitivity"
+        objective = default_objective(family)
     settings = MultiSpeedSettings(decay=decay, sensitivity=objective == "sensitivity")
     records = []
     for order in orders:
