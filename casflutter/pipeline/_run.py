@@ -32,7 +32,9 @@ logged once and listed in ``RunResult.skipped``):
 
 ``run(config)`` from Python writes nothing unless it is given ``out_dir``; ``casflutter run``
 writes ``casflutter-run/``.  Progress goes through :mod:`logging` (logger
-``casflutter.pipeline``): one line per stage at INFO.
+``casflutter.pipeline``): one line per stage at INFO.  A run pins the BLAS pools to one
+thread (:func:`casflutter._threads.single_threaded`), as the command line does: the same
+configuration and seed give bit-identical numbers whatever ``OPENBLAS_NUM_THREADS`` says.
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ import numpy as np
 
 from .._linalg import spectral_abscissa
 from .._outputs import provenance, utc_now
+from .._threads import deterministic
 from ..aeroelastic import AeroelasticSystem, FlutterResult, find_flutter, simulate_loop
 from ..data import envelope_growth_rate
 from ..errors import CasflutterError, ConfigError, ConvergenceError
@@ -202,6 +205,7 @@ def model_stages(cfg: RunConfig, problem, progress=None) -> tuple[ModelStage, Fl
     return rom_model(cfg, problem, structure, progress, needs_vf=needs_vf)
 
 
+@deterministic
 def design_family(cfg: RunConfig):
     """The family a run's controller stage designs on, built by its model stages alone.
 
@@ -221,6 +225,7 @@ def design_family(cfg: RunConfig):
     return controlled_family(cfg, model)
 
 
+@deterministic
 def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int | None = None,
         quiet: bool = False, write: bool | None = None, overwrite: bool = False) -> RunResult:
     """Run the stages of a configuration (module docstring), and write its outputs when asked.
