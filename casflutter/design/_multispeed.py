@@ -29,9 +29,10 @@ hinfstruct/systune (the worst case over a set of models), with the speeds as the
 3. **H∞ phase.**  From the controller that holds the interval,
    :func:`casflutter.design.synthesize` minimises the worst H∞ norm of the design plants over
    ``hinf_speeds`` speeds (the disturbance-to-sensor channels, with the control-rate weight
-   where a servo saturates, or plants the caller gives, e.g. the paper's LFT at Vf) while the
-   loops at the stability speeds keep their decay rate; the dense scan checks the result and
-   where it finds a loop slower than the decay rate between the stability speeds, its peaks
+   where a servo saturates, or plants the caller gives, e.g. the paper's LFT at Vf: steps 1
+   and 2 then hold those plants' loops too, since their norm is finite only where they are
+   stable) while the loops at the stability speeds keep their decay rate; the dense scan
+   checks the result and where it finds a loop slower than the decay rate between the stability speeds, its peaks
    join them, the rate asked at them grows by a quarter (room for the loops between them)
    and the phase starts again from the held controller; the held controller is kept if the
    H∞ phase still loses the interval.
@@ -57,6 +58,7 @@ from .._settings import finite_numbers
 from .._threads import single_threaded
 from ..errors import ConfigError, DimensionError, SynthesisError
 from ._bfgs import nonsmooth_bfgs
+from ._plant import partition
 from ._problem import verify_closed_loop
 from ._speeds import DesignChannels, Scaling, SpeedLoops, design_partition
 from ._synthesis import SynthesisOptions, SynthesisResult, synthesize
@@ -237,10 +239,12 @@ def _peaks(values: np.ndarray, threshold: float, most: int = 8) -> list[int]:
 
 
 class _Models:
-    """The families a controller must hold together, their design plants at a speed (cached)
-    and the scaling shared by the whole design."""
+    """The families a controller must hold together, their design plants at a speed (cached),
+    the plants it must hold at every speed set (the caller's H∞ plants, whose objective is
+    finite only where their loop is stable) and the scaling shared by the whole design."""
 
-    def __init__(self, families: Sequence, lo: float, hi: float):
+    def __init__(self, families: Sequence, lo: float, hi: float,
+                 fixed: Sequence[control.StateSpace] = ()):
         self.families = tuple(families)
         sizes = {(len(f.signals.controls), len(f.signals.measurements)) for f in self.families}
         if len(sizes) != 1:
@@ -248,7 +252,9 @@ class _Models:
                                  f"measurements {sorted(sizes)}; one controller needs the same "
                                  "controls and measurements on every model")
         self.nu, self.ny = sizes.pop()
+        self.fixed = [partition(P, self.ny, self.nu) for P in fixed]
         self._cache: dict = {}
+        self._fixed_cache: dict = {}
         probe = np.linspace(lo, hi, 5)
         parts = [p for V in probe for p in self.parts(V)]
         self.scaling = Scaling.of(parts)
@@ -264,19 +270,33 @@ class _Models:
             self._cache[key] = [design_partition(f, key) for f in self.families]
         return self._cache[key]
 
-    def loops(self, speeds, order: int, free: np.ndarray, base: np.ndarray) -> SpeedLoops:
-        """The scaled closed loops of every model at ``speeds``."""
+    def fixed_plants(self, order: int) -> list:
+        """The fixed plants scaled and augmented with ``order`` controller states (cached)."""
+        if order not in self._fixed_cache:
+            self._fixed_cache[order] = [self.scaling.plant(p, order) for p in self.fixed]
+        return self._fixed_cache[order]
+
+    def loops(self, speeds, order: int, free: np.ndarray, base: np.ndarray, *,
+              fixed: bool = True) -> SpeedLoops:
+        """The scaled closed loops of every model at ``speeds`` (and of the fixed plants)."""
         sc = self.scaling
-        return SpeedLoops([sc.plant(p, order) for V in speeds for p in self.parts(V)], free, base)
+        extra = self.fixed_plants(order) if fixed else []
+        return SpeedLoops([sc.plant(p, order) for V in speeds for p in self.parts(V)] + extra,
+                          free, base)
 
     def dense(self, K: np.ndarray, order: int, lo: float, hi: float, n: int
               ) -> tuple[np.ndarray, np.ndarray]:
         """A dense scan of ``[lo, hi]``: the speeds and the worst closed-loop spectral abscissa
-        over the models at each (scaled time; ``inf`` where a loop is ill posed)."""
+        over the models at each, and over the fixed plants (scaled time; ``inf`` where a loop
+        is ill posed)."""
         grid = np.linspace(lo, hi, n) if hi > lo else np.array([lo])
         free = np.zeros(K.shape, bool)
-        values = np.array([float(np.max(self.loops([V], order, free, K).abscissae(
-            np.zeros(0)))) for V in grid])
+        none = np.zeros(0)
+        values = np.array([float(np.max(self.loops([V], order, free, K, fixed=False)
+                                        .abscissae(none))) for V in grid])
+        if self.fixed:
+            fixed = SpeedLoops(self.fixed_plants(order), free, K)
+            values = np.maximum(values, float(np.max(fixed.abscissae(none))))
         return grid, values
 
 
@@ -360,10 +380,16 @@ class _Engine:
     def continue_interval(self, K: np.ndarray, lo: float, hi: float, anchor: str
                           ) -> tuple[np.ndarray, tuple, int]:
         """Continuation in speed from the ``anchor`` end: ``(K, (a, b) held, steps)``;
-        ``()`` when ``K`` does not decay at the anchor."""
+        ``()`` when ``K`` does not decay at the anchor and cannot be made to there."""
         e = self.edge(K, lo, hi, anchor)
         if e is None:
-            return K, (), 0
+            # first hold the anchor speed alone (and the fixed plants, which the start may
+            # not stabilise)
+            end = lo if anchor == "low" else hi
+            K, _, ok = self.hold(K, end, end)
+            e = self.edge(K, lo, hi, anchor) if ok else None
+            if e is None:
+                return K, (), 1
         cur = (lo, e) if anchor == "low" else (e, hi)
         s = self.settings
         step, smallest, rounds = s.first_step * (hi - lo), s.min_step * (hi - lo), 0
@@ -564,7 +590,9 @@ def design_over_speeds(family, interval, order: int = 3, *,
     hinf_plants : sequence of control.StateSpace, optional
         H∞ plants in the partitioned form of :func:`synthesize` (inputs ``[w, u]``, outputs
         ``[z, y]``, ``u = +K y``), e.g. the paper's LFT at Vf (eq. 14); default the
-        disturbance-to-sensor channels of every model at ``hinf_speeds`` speeds.
+        disturbance-to-sensor channels of every model at ``hinf_speeds`` speeds.  Their
+        loops are held at the decay rate with the family's from the first start on: their
+        norm is finite only where the controller stabilises them.
 
     Returns
     -------
@@ -596,7 +624,7 @@ def design_over_speeds(family, interval, order: int = 3, *,
         raise ConfigError(f"order = {order!r}: an integer >= 0")
     order = int(order)
     with single_threaded():
-        models = _Models(fams, lo, hi)
+        models = _Models(fams, lo, hi, fixed=[control.ss(P) for P in hinf_plants or ()])
         sp = models.has_d22 if s.strictly_proper is None else bool(s.strictly_proper)
         if sp and order == 0:
             raise ConfigError("order = 0 with a strictly proper controller leaves nothing to "
