@@ -29,13 +29,15 @@ hinfstruct/systune (the worst case over a set of models), with the speeds as the
 3. **H∞ phase.**  From the controller that holds the interval,
    :func:`casflutter.design.synthesize` minimises the worst H∞ norm of the design plants over
    ``hinf_speeds`` speeds (the disturbance-to-sensor channels, with the control-rate weight
-   where a servo saturates, or plants the caller gives, e.g. the paper's LFT at Vf: steps 1
-   and 2 then hold those plants' loops too, since their norm is finite only where they are
-   stable) while the loops at the stability speeds keep their decay rate; the dense scan
-   checks the result and where it finds a loop slower than the decay rate between the stability speeds, its peaks
-   join them, the rate asked at them grows by a quarter (room for the loops between them)
-   and the phase starts again from the held controller; the held controller is kept if the
-   H∞ phase still loses the interval.
+   where a servo saturates, or plants the caller gives, e.g. the paper's LFT at Vf; their
+   norm is finite only where their loops are stable, so where the held controller does not
+   stabilise them it is first re-held with them, or failing that the first start is
+   continued over the interval with them) while the loops at the stability speeds
+   keep their decay rate; the dense scan checks the result and where it finds a loop slower
+   than the decay rate between the stability speeds, its peaks join them, the rate asked at
+   them grows by a quarter (room for the loops between them) and the phase starts again
+   from the held controller; the held controller is kept if the H∞ phase still loses the
+   interval.
 
 Every budget is counted in iterations and every random choice takes the seed, so the same seed
 gives the same controller.  The interval the design reports is its own dense scan's; the
@@ -240,7 +242,7 @@ def _peaks(values: np.ndarray, threshold: float, most: int = 8) -> list[int]:
 
 class _Models:
     """The families a controller must hold together, their design plants at a speed (cached),
-    the plants it must hold at every speed set (the caller's H∞ plants, whose objective is
+    fixed plants it may be asked to hold besides (the caller's H∞ plants, whose objective is
     finite only where their loop is stable) and the scaling shared by the whole design."""
 
     def __init__(self, families: Sequence, lo: float, hi: float,
@@ -277,26 +279,26 @@ class _Models:
         return self._fixed_cache[order]
 
     def loops(self, speeds, order: int, free: np.ndarray, base: np.ndarray, *,
-              fixed: bool = True) -> SpeedLoops:
+              fixed: bool = False) -> SpeedLoops:
         """The scaled closed loops of every model at ``speeds`` (and of the fixed plants)."""
         sc = self.scaling
         extra = self.fixed_plants(order) if fixed else []
         return SpeedLoops([sc.plant(p, order) for V in speeds for p in self.parts(V)] + extra,
                           free, base)
 
-    def dense(self, K: np.ndarray, order: int, lo: float, hi: float, n: int
-              ) -> tuple[np.ndarray, np.ndarray]:
+    def dense(self, K: np.ndarray, order: int, lo: float, hi: float, n: int, *,
+              fixed: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """A dense scan of ``[lo, hi]``: the speeds and the worst closed-loop spectral abscissa
-        over the models at each, and over the fixed plants (scaled time; ``inf`` where a loop
-        is ill posed)."""
+        over the models at each, and with ``fixed`` over the fixed plants too (scaled time;
+        ``inf`` where a loop is ill posed)."""
         grid = np.linspace(lo, hi, n) if hi > lo else np.array([lo])
         free = np.zeros(K.shape, bool)
         none = np.zeros(0)
-        values = np.array([float(np.max(self.loops([V], order, free, K, fixed=False)
-                                        .abscissae(none))) for V in grid])
-        if self.fixed:
-            fixed = SpeedLoops(self.fixed_plants(order), free, K)
-            values = np.maximum(values, float(np.max(fixed.abscissae(none))))
+        values = np.array([float(np.max(self.loops([V], order, free, K).abscissae(none)))
+                           for V in grid])
+        if fixed and self.fixed:
+            extra = SpeedLoops(self.fixed_plants(order), free, K)
+            values = np.maximum(values, float(np.max(extra.abscissae(none))))
         return grid, values
 
 
@@ -320,9 +322,10 @@ class _Engine:
             F[:nu, :ny] = False
         return F
 
-    def worst(self, K: np.ndarray, lo: float, hi: float) -> tuple[np.ndarray, np.ndarray]:
+    def worst(self, K: np.ndarray, lo: float, hi: float, *, fixed: bool = False
+              ) -> tuple[np.ndarray, np.ndarray]:
         return self.models.dense(K, K.shape[0] - self.models.nu, lo, hi,
-                                 8 * self.settings.n_speeds)
+                                 8 * self.settings.n_speeds, fixed=fixed)
 
     def _minimise(self, loops: SpeedLoops, q: np.ndarray, good: float
                   ) -> tuple[np.ndarray, float]:
@@ -344,31 +347,33 @@ class _Engine:
                 q, best = res.x, worst
         return q, float(best)
 
-    def hold(self, K: np.ndarray, lo: float, hi: float) -> tuple[np.ndarray, float, bool]:
-        """``K`` re-optimised to decay at the rate ``decay`` on ``[lo, hi]``: ``(K, worst on
-        the dense scan (scaled), held)``; a scan peak joins the objective's speeds, twice at
-        most."""
+    def hold(self, K: np.ndarray, lo: float, hi: float, *, fixed: bool = False
+             ) -> tuple[np.ndarray, float, bool]:
+        """``K`` re-optimised to decay at the rate ``decay`` on ``[lo, hi]`` (with ``fixed``
+        the fixed plants' loops too): ``(K, worst on the dense scan (scaled), held)``; a scan
+        peak joins the objective's speeds, twice at most."""
         order = K.shape[0] - self.models.nu
         free = self.free(order)
         speeds = np.linspace(lo, hi, self.settings.n_speeds)
         q = K[free]
         worst = np.inf
         for _ in range(3):
-            loops = self.models.loops(speeds, order, free, K)
+            loops = self.models.loops(speeds, order, free, K, fixed=fixed)
             q, worst = self._minimise(loops, q, -2.0 * self.decay)
             if worst > -self.decay:
                 break
-            scan, values = self.worst(loops.gain(q), lo, hi)
+            scan, values = self.worst(loops.gain(q), lo, hi, fixed=fixed)
             worst = float(np.max(values))
             if worst <= -self.decay:
                 return loops.gain(q), worst, True
             speeds = np.union1d(speeds, scan[_peaks(values, -self.decay)])
         return loops.gain(q), worst, False
 
-    def edge(self, K: np.ndarray, lo: float, hi: float, anchor: str) -> float | None:
+    def edge(self, K: np.ndarray, lo: float, hi: float, anchor: str, *, fixed: bool = False
+             ) -> float | None:
         """How far from the anchor end ``K`` already decays at the rate ``decay`` (``None``
         if not even at the anchor)."""
-        scan, values = self.worst(K, lo, hi)
+        scan, values = self.worst(K, lo, hi, fixed=fixed)
         ok = values <= -self.decay
         if anchor == "high":
             scan, ok = scan[::-1], ok[::-1]
@@ -377,17 +382,17 @@ class _Engine:
         bad = np.flatnonzero(~ok)
         return float(scan[-1] if bad.size == 0 else scan[bad[0] - 1])
 
-    def continue_interval(self, K: np.ndarray, lo: float, hi: float, anchor: str
-                          ) -> tuple[np.ndarray, tuple, int]:
+    def continue_interval(self, K: np.ndarray, lo: float, hi: float, anchor: str, *,
+                          fixed: bool = False) -> tuple[np.ndarray, tuple, int]:
         """Continuation in speed from the ``anchor`` end: ``(K, (a, b) held, steps)``;
-        ``()`` when ``K`` does not decay at the anchor and cannot be made to there."""
-        e = self.edge(K, lo, hi, anchor)
+        ``()`` when ``K`` does not decay at the anchor and cannot be made to there.  With
+        ``fixed`` every step holds the fixed plants' loops too."""
+        e = self.edge(K, lo, hi, anchor, fixed=fixed)
         if e is None:
-            # first hold the anchor speed alone (and the fixed plants, which the start may
-            # not stabilise)
+            # first hold the anchor speed alone
             end = lo if anchor == "low" else hi
-            K, _, ok = self.hold(K, end, end)
-            e = self.edge(K, lo, hi, anchor) if ok else None
+            K, _, ok = self.hold(K, end, end, fixed=fixed)
+            e = self.edge(K, lo, hi, anchor, fixed=fixed) if ok else None
             if e is None:
                 return K, (), 1
         cur = (lo, e) if anchor == "low" else (e, hi)
@@ -398,13 +403,13 @@ class _Engine:
             step = min(step, (hi - cur[1]) if anchor == "low" else (cur[0] - lo))
             trial = ((cur[0], min(hi, cur[1] + step)) if anchor == "low"
                      else (max(lo, cur[0] - step), cur[1]))
-            Kn, worst, ok = self.hold(K, *trial)
+            Kn, worst, ok = self.hold(K, *trial, fixed=fixed)
             log.debug("continuation (%s end): [%.5g, %.5g] worst abscissa %.4g -> %s", anchor,
                       *trial, worst * self.models.scaling.w0, "kept" if ok else "halved")
             if ok:
                 # the new controller may hold beyond the trial: start the next step there
                 e = self.edge(Kn, *((trial[0], hi) if anchor == "low" else (lo, trial[1])),
-                              anchor)
+                              anchor, fixed=fixed)
                 if e is not None:
                     trial = (trial[0], max(trial[1], e)) if anchor == "low" else \
                         (min(trial[0], e), trial[1])
@@ -590,9 +595,9 @@ def design_over_speeds(family, interval, order: int = 3, *,
     hinf_plants : sequence of control.StateSpace, optional
         H∞ plants in the partitioned form of :func:`synthesize` (inputs ``[w, u]``, outputs
         ``[z, y]``, ``u = +K y``), e.g. the paper's LFT at Vf (eq. 14); default the
-        disturbance-to-sensor channels of every model at ``hinf_speeds`` speeds.  Their
-        loops are held at the decay rate with the family's from the first start on: their
-        norm is finite only where the controller stabilises them.
+        disturbance-to-sensor channels of every model at ``hinf_speeds`` speeds.  Where the
+        controller that holds the interval does not stabilise them (their norm is finite
+        only where it does), it is first re-held with their loops at the decay rate.
 
     Returns
     -------
@@ -673,7 +678,7 @@ def design_over_speeds(family, interval, order: int = 3, *,
                 "lower the decay rate", best_spectral_abscissa=float("nan"))
         K, reached = (held, (lo, hi)) if held is not None else best
         return _finish(eng, fams, K, order, (lo, hi), reached, held is not None, records,
-                       hinf_plants, t0)
+                       hinf_plants, plan[0][1], t0)
 
 
 def _fmt(reached: tuple) -> str:
@@ -710,6 +715,27 @@ def _record(eng: _Engine, kind: str, K: np.ndarray, reached: tuple, steps: int, 
 def _controller(eng: _Engine, K: np.ndarray) -> control.StateSpace:
     Ak, Bk, Ck, Dk = eng.models.scaling.controller(K)
     return control.ss(Ak, Bk, Ck, Dk)
+
+
+def _hold_fixed(eng: _Engine, K: np.ndarray, Kss, lo: float, e: float, first: np.ndarray):
+    """Where the held controller does not stabilise the caller's H∞ plants (their norm is
+    finite only where it does), a controller that holds ``[lo, e]`` with them: the held one
+    re-held, else the first start continued in speed with them from ``lo`` (the held
+    controller can be far from any that stabilises them): ``(K, Kss)``, the held controller
+    where neither succeeds."""
+    order = K.shape[0] - eng.models.nu
+    extra = SpeedLoops(eng.models.fixed_plants(order), np.zeros(K.shape, bool), K)
+    if float(np.max(extra.abscissae(np.zeros(0)))) <= -eng.decay:
+        return K, Kss
+    Kf, _, ok = eng.hold(K, lo, e, fixed=True)
+    if not ok:
+        Kf, reached, _ = eng.continue_interval(first, lo, e, "low", fixed=True)
+        ok = reached == (lo, e)
+    if ok:
+        return Kf, _controller(eng, Kf)
+    log.info("H-infinity phase: the held controller does not stabilise the H-infinity "
+             "plants, and none was found that does while holding [%.5g, %.5g]", lo, e)
+    return K, Kss
 
 
 def _hinf_phase(eng: _Engine, hinf: list, dims: tuple, K: np.ndarray, Kss, lo: float,
@@ -755,8 +781,10 @@ def _hinf_phase(eng: _Engine, hinf: list, dims: tuple, K: np.ndarray, Kss, lo: f
 
 
 def _finish(eng: _Engine, fams, K: np.ndarray, order: int, interval: tuple, reached: tuple,
-            held: bool, records: list, hinf_plants, t0: float) -> MultiSpeedDesign:
-    """The H∞ phase on the interval held (module docstring) and the result."""
+            held: bool, records: list, hinf_plants, first: np.ndarray, t0: float
+            ) -> MultiSpeedDesign:
+    """The H∞ phase on the interval held (module docstring) and the result; ``first`` is
+    the first start (scaled gain)."""
     s, models = eng.settings, eng.models
     lo, e = reached
     Kss = _controller(eng, K)
@@ -780,6 +808,8 @@ def _finish(eng: _Engine, fams, K: np.ndarray, order: int, interval: tuple, reac
                                  f"{hinf[0].noutputs} outputs: they need [w, u] with "
                                  f"{models.nu} controls and [z, y] with {models.ny} "
                                  "measurements, and at least one w and one z")
+        if models.fixed:
+            K, Kss = _hold_fixed(eng, K, Kss, lo, e, first)
         syn, K, Kss = _hinf_phase(eng, hinf, (nw, nz), K, Kss, lo, e, order)
         gamma = (float(syn.gamma) if syn is not None else
                  max(verify_closed_loop(P, Kss, models.ny, models.nu)[0] for P in hinf))

@@ -143,8 +143,8 @@ def test_the_sensitivity_objective_bounds_every_loops_margins(family):
 def test_the_callers_hinf_plants_are_held_from_the_start(family):
     """``hinf_plants`` outside the interval: the input-disturbance-to-sensor plant at
     145 m/s, above the open family's flutter, on a design over (60, 120), where the family
-    alone needs no control.  The design holds that plant's loop with the family's, so its
-    H∞ objective is finite and bounds the exact norm of the closed loop formed here with
+    alone needs no control.  The design's controller stabilises that plant too, so its H∞
+    objective is finite and bounds the exact norm of the closed loop formed here with
     python-control's ``feedback`` and computed by the verification layer's ``hinf_norm``."""
     from casflutter.verify import hinf_norm
 
