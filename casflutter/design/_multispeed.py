@@ -14,9 +14,11 @@ hinfstruct/systune (the worst case over a set of models), with the speeds as the
    an interval, smoothed by a log-sum-exp of decreasing temperature, is minimised over the
    controller's matrices by BFGS with the exact gradient of the rightmost eigenvalues
    (:class:`._speeds.SpeedLoops`) and the weak Wolfe line search of Lewis and Overton, which
-   is made for the kinks of such a maximum (:func:`._bfgs.nonsmooth_bfgs`).  An interval counts as held when a dense scan (8x as many
-   speeds) finds the rate ``decay`` everywhere; a peak the scan finds between the objective's
-   speeds joins them and the interval is tried again.  This is continued in speed: starting
+   is made for the kinks of such a maximum (:func:`._bfgs.nonsmooth_bfgs`).  An interval
+   counts as held when a dense scan (8x as many speeds, and three more in each gap beside
+   its six highest local maxima, where a mode that crosses and comes back between two
+   speeds shows its flanks) finds the rate ``decay`` everywhere; a peak the scan finds
+   between the objective's speeds joins them and the interval is tried again.  This is continued in speed: starting
    where a controller already decays, one end is pushed towards the target, the step growing
    1.5x after a success and halving after a failure.
 2. **Starts.**  From the low end (where the open loop is usually stable) the target order is
@@ -74,6 +76,8 @@ log = logging.getLogger("casflutter.design")
 _TAUS = (6.0, 2.0, 0.6, None)
 #: a BFGS run stops when 20 iterations lowered its objective by less than this many decay rates
 _STALL = 0.01
+#: the dense scan's local maxima whose neighbouring gaps are scanned again, and how finely
+_REFINED, _SUBDIVIDE = 6, 3
 
 
 @dataclass(frozen=True)
@@ -85,7 +89,8 @@ class MultiSpeedSettings:
     decay: float = 0.05
     """Decay rate [rad per time unit] the closed loop needs at every speed of the interval."""
     n_speeds: int = 16
-    """Speeds of the stability objective on each interval tried (the dense check uses 8x)."""
+    """Speeds of the stability objective on each interval tried (the dense check uses 8x,
+    refined beside its highest local maxima)."""
     hinf_speeds: int = 5
     """Speeds of the H∞ objective spread over the interval (0: no H∞ phase)."""
     rate_weight: float = 0.0
@@ -286,20 +291,39 @@ class _Models:
         return SpeedLoops([sc.plant(p, order) for V in speeds for p in self.parts(V)] + extra,
                           free, base)
 
-    def dense(self, K: np.ndarray, order: int, lo: float, hi: float, n: int, *,
-              fixed: bool = False) -> tuple[np.ndarray, np.ndarray]:
-        """A dense scan of ``[lo, hi]``: the speeds and the worst closed-loop spectral abscissa
-        over the models at each, and with ``fixed`` over the fixed plants too (scaled time;
-        ``inf`` where a loop is ill posed)."""
-        grid = np.linspace(lo, hi, n) if hi > lo else np.array([lo])
+    def scan(self, K: np.ndarray, order: int, speeds, *, fixed: bool = False) -> np.ndarray:
+        """The worst closed-loop spectral abscissa over the models at each of ``speeds``, and
+        with ``fixed`` over the fixed plants too (scaled time; ``inf`` where a loop is ill
+        posed)."""
         free = np.zeros(K.shape, bool)
         none = np.zeros(0)
         values = np.array([float(np.max(self.loops([V], order, free, K).abscissae(none)))
-                           for V in grid])
-        if fixed and self.fixed:
+                           for V in speeds])
+        if fixed and self.fixed and values.size:
             extra = SpeedLoops(self.fixed_plants(order), free, K)
             values = np.maximum(values, float(np.max(extra.abscissae(none))))
-        return grid, values
+        return values
+
+    def dense(self, K: np.ndarray, order: int, lo: float, hi: float, n: int, *,
+              fixed: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """A dense scan of ``[lo, hi]``: ``n`` equally spaced speeds, then ``_SUBDIVIDE``
+        more in each gap beside the ``_REFINED`` highest local maxima (a closed-loop mode
+        can cross and come back between two speeds of the grid, and its flanks show as a
+        local maximum); the speeds in order and :meth:`scan`'s values at them."""
+        grid = np.linspace(lo, hi, n) if hi > lo else np.array([lo])
+        values = self.scan(K, order, grid, fixed=fixed)
+        if grid.size < 3:
+            return grid, values
+        extra = set()
+        for j in _peaks(values, -np.inf, _REFINED):
+            for a in (j - 1, j):
+                if 0 <= a < grid.size - 1:
+                    extra.update(np.linspace(grid[a], grid[a + 1], _SUBDIVIDE + 2)[1:-1])
+        more = np.array(sorted(extra))
+        speeds = np.concatenate([grid, more])
+        values = np.concatenate([values, self.scan(K, order, more, fixed=fixed)])
+        rank = np.argsort(speeds, kind="stable")
+        return speeds[rank], values[rank]
 
 
 @dataclass

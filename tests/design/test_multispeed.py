@@ -15,7 +15,7 @@ import control
 import numpy as np
 import pytest
 
-from casflutter.aeroelastic import load_family
+from casflutter.aeroelastic import FamilySignals, PlantFamily, load_family
 from casflutter.design import MultiSpeedSettings, design_over_speeds
 from casflutter.errors import ConfigError, SynthesisError
 from casflutter.verify import verify_family
@@ -165,3 +165,34 @@ def test_the_callers_hinf_plants_are_held_from_the_start(family):
     T = control.feedback(G, d.controller, sign=s)          # w -> y, the flaps see w + s K y
     assert np.max(T.poles().real) < 0
     assert hinf_norm(T).gamma <= d.gamma * (1 + 1e-6)
+
+
+class _HiddenSpike(PlantFamily):
+    """A damped oscillator the controller sees, and beside it a mode it can neither move nor
+    see, decaying at 1 rad/s except in a spike to +2 rad/s centred between two speeds of
+    the design's 128-speed grid on (0, 1) (the gap from 64/127 to 65/127)."""
+
+    speed_range = (0.0, 1.0)
+    name = "hidden spike"
+    centre, width = 64.5 / 127, 0.0015
+    signals = FamilySignals(inputs=("u",), outputs=("y",))
+
+    def plant(self, V: float) -> control.StateSpace:
+        a = -1.0 + 3.0 * np.exp(-((V - self.centre) / self.width) ** 2)
+        A = np.array([[-3.0, 5.0, 0.0], [-5.0, -3.0, 0.0], [0.0, 0.0, a]])
+        return control.ss(A, [[0.0], [1.0], [0.0]], [[1.0, 0.0, 0.0]], [[0.0]],
+                          inputs=["u"], outputs=["y"])
+
+
+def test_a_mode_that_crosses_between_two_scan_speeds_is_not_called_held():
+    """The spike is 0.0039 from the nearest speeds of the 128-speed grid, where the mode
+    decays at 0.997 rad/s: a plain grid would call (0, 1) held.  The design must stop before
+    the spike, and its controller leaves that mode unstable there (it cannot touch it)."""
+    fam = _HiddenSpike()
+    settings = MultiSpeedSettings(n_speeds=16, hinf_speeds=0, random_starts=0,
+                                  full_order=False)
+    d = design_over_speeds(fam, (0.0, 1.0), 1, settings=settings, seed=0)
+    assert not d.held
+    assert d.reached[1] < fam.centre - fam.width
+    loop = control.feedback(fam.plant(fam.centre), d.controller, sign=fam.feedback_sign)
+    assert np.max(loop.poles().real) > 1.9
