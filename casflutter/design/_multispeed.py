@@ -18,9 +18,9 @@ hinfstruct/systune (the worst case over a set of models), with the speeds as the
    counts as held when a dense scan (8x as many speeds, and three more in each gap beside
    its six highest local maxima, where a mode that crosses and comes back between two
    speeds shows its flanks) finds the rate ``decay`` everywhere; a peak the scan finds
-   between the objective's speeds joins them and the interval is tried again.  This is continued in speed: starting
-   where a controller already decays, one end is pushed towards the target, the step growing
-   1.5x after a success and halving after a failure.
+   between the objective's speeds joins them and the interval is tried again.  This is
+   continued in speed: starting where a controller already decays, one end is pushed towards
+   the target, the step growing 1.5x after a success and halving after a failure.
 2. **Starts.**  From the low end (where the open loop is usually stable) the target order is
    continued from the zero controller and from seeded random ones.  When none reaches the top,
    a full-order observer-based (LQG) controller of the plant at the top is continued down to

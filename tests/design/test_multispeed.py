@@ -168,9 +168,10 @@ def test_the_callers_hinf_plants_are_held_from_the_start(family):
 
 
 class _HiddenSpike(PlantFamily):
-    """A damped oscillator the controller sees, and beside it a mode it can neither move nor
-    see, decaying at 1 rad/s except in a spike to +2 rad/s centred between two speeds of
-    the design's 128-speed grid on (0, 1) (the gap from 64/127 to 65/127)."""
+    """A damped oscillator (3 rad/s) the controller sees, and beside it the slowest mode,
+    which it can neither move nor see, decaying at 1 rad/s except in a spike to +2 rad/s
+    centred between two speeds of the design's 128-speed grid on (0, 1) (the gap from 64/127
+    to 65/127)."""
 
     speed_range = (0.0, 1.0)
     name = "hidden spike"
