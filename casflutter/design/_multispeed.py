@@ -283,6 +283,14 @@ class _Models:
             self._fixed_cache[order] = [self.scaling.plant(p, order) for p in self.fixed]
         return self._fixed_cache[order]
 
+    def fixed_abscissa(self, K: np.ndarray, order: int) -> float:
+        """The worst spectral abscissa of the fixed plants' loops closed by ``K`` (scaled
+        time; ``-inf`` without fixed plants)."""
+        if not self.fixed:
+            return -np.inf
+        loops = SpeedLoops(self.fixed_plants(order), np.zeros(K.shape, bool), K)
+        return float(np.max(loops.abscissae(np.zeros(0))))
+
     def loops(self, speeds, order: int, free: np.ndarray, base: np.ndarray, *,
               fixed: bool = False) -> SpeedLoops:
         """The scaled closed loops of every model at ``speeds`` (and of the fixed plants)."""
@@ -299,9 +307,8 @@ class _Models:
         none = np.zeros(0)
         values = np.array([float(np.max(self.loops([V], order, free, K).abscissae(none)))
                            for V in speeds])
-        if fixed and self.fixed and values.size:
-            extra = SpeedLoops(self.fixed_plants(order), free, K)
-            values = np.maximum(values, float(np.max(extra.abscissae(none))))
+        if fixed and values.size:
+            values = np.maximum(values, self.fixed_abscissa(K, order))
         return values
 
     def dense(self, K: np.ndarray, order: int, lo: float, hi: float, n: int, *,
@@ -747,9 +754,7 @@ def _hold_fixed(eng: _Engine, K: np.ndarray, Kss, lo: float, e: float, first: np
     re-held, else the first start continued in speed with them from ``lo`` (the held
     controller can be far from any that stabilises them): ``(K, Kss)``, the held controller
     where neither succeeds."""
-    order = K.shape[0] - eng.models.nu
-    extra = SpeedLoops(eng.models.fixed_plants(order), np.zeros(K.shape, bool), K)
-    if float(np.max(extra.abscissae(np.zeros(0)))) <= -eng.decay:
+    if eng.models.fixed_abscissa(K, K.shape[0] - eng.models.nu) <= -eng.decay:
         return K, Kss
     Kf, _, ok = eng.hold(K, lo, e, fixed=True)
     if not ok:

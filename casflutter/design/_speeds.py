@@ -26,7 +26,10 @@ modulus, as :class:`._problem.Problem` does), and evaluates the closed loops of 
 written as a static gain on the augmented plant, ``Kbar = [[Dk, Ck], [Bk, Ak]]``: the
 spectral abscissa of every loop and the exact gradient of the rightmost eigenvalue,
 ``∂ Re λ / ∂ Kbar = Re(Lᵀ (B2ᵀ ȳ)(C2 x)ᵀ Rᵀ) / (yᴴ x)`` with the left and right eigenvectors
-``y``, ``x`` and the well-posedness factors ``L``, ``R`` of a loop with feed-through.
+``y``, ``x`` and the well-posedness factors ``L``, ``R`` of a loop with feed-through.  Only
+the eigenvalues are computed for every loop; the two eigenvectors of the one eigenvalue
+the gradient needs come from inverse iteration (``_eigenvectors``), which costs a
+fraction of the full left-and-right eigendecomposition.
 """
 
 from __future__ import annotations
