@@ -111,8 +111,17 @@ def suppression_stage(cfg: RunConfig, truth, flutters: FlutterStage, lco,
             log.info("the truth has no LCO at V = %.4f: the suppression run starts from a "
                      "deflected mode", r.V)
         log.info("suppression at %.4g x Vf (V = %.4f): attenuation %.1f %%, flap peak %.3g "
-                 "rad, rate peak %.3g rad/s", r.speed_factor, r.V,
+                 "rad, rate peak %.3g rad/s%s", r.speed_factor, r.V,
                  float("nan") if r.attenuation_percent is None else r.attenuation_percent,
-                 r.flap_peak, r.flap_rate_peak)
+                 r.flap_peak, r.flap_rate_peak, _saturation(r))
     return SuppressionStage(runs=runs, V_flutter=V_ref,
                             reference="truth" if has_truth_flutter else "rom")
+
+
+def _saturation(r: SuppressionResult) -> str:
+    """How long the servo sat at its limits during the hold, for the log line."""
+    parts = [f"{what} at its limit {share:.0f} % of the hold"
+             for what, share in (("travel", r.flap_saturated_percent),
+                                 ("rate", r.flap_rate_saturated_percent))
+             if share is not None and share > 0]
+    return "; flap " + ", ".join(parts) if parts else ""

@@ -203,6 +203,8 @@ def _fig11(result, labels, time_unit: str, air: dict):
         amp = sup.open_loop_amplitude[dom] if sup.open_loop_amplitude else None
         att = ("" if sup.attenuation_percent is None
                else f", attenuation {sup.attenuation_percent:.1f} %")
+        if sup.flap_rate_saturated_percent:
+            att += f"\nflap rate at its limit {sup.flap_rate_saturated_percent:.0f} % of the hold"
         factor = "" if sup.speed_factor is None else f" ({sup.speed_factor:g} Vf)"
         airspeed = f", {sup.V * air['speed_scale']:.4g} m/s" if air["speed_unit"] else ""
         plot_gain_ramp(sim.timepts, sim.zm, sim.gain, sim.v, labels,
@@ -336,7 +338,10 @@ def figure_captions(result) -> dict:
             f"V = {sup.V:.4g} ({sup.speed_factor:g} Vf): attenuation "
             + ("-" if sup.attenuation_percent is None else f"{sup.attenuation_percent:.1f} %")
             + f", flap peak {np.degrees(sup.flap_peak):.3g} deg, rate peak "
-            f"{np.degrees(sup.flap_rate_peak):.3g} deg/s, the LCO returns on release: "
+            f"{np.degrees(sup.flap_rate_peak):.3g} deg/s"
+            + (f" (at the rate limit {sup.flap_rate_saturated_percent:.0f} % of the hold)"
+               if sup.flap_rate_saturated_percent else "")
+            + ", the LCO returns on release: "
             f"{'yes' if sup.lco_returns else 'no'}" for sup in result.suppression.runs)
         tunnel = (f"in a Dryden turbulence of intensity {100 * ss.gust_intensity:g} % and "
                   f"scale {ss.gust_scale:g} m" if ss.gust_intensity > 0 else "without turbulence")

@@ -437,6 +437,11 @@ class SuppressionResult:
         ``V`` over the truth's flutter speed.
     flap_peak, flap_rate_peak : float or None
         Largest ``|v|`` and ``|v'|`` while the controller is engaged (ramp and hold).
+    flap_saturated_percent, flap_rate_saturated_percent : float or None
+        Share of the hold [%] during which the flap is at its travel limit and its rate at
+        the rate limit (``None`` where the servo has no such limit).  Near 100 % the servo's
+        authority, not the controller's gain, sets what is left of the LCO: the flap is then
+        a triangle wave lagging the command, whatever the controller asks.
     gust_rms : float
         Rms of the gust velocity of the run [m/s] (0 without turbulence).
     """
@@ -458,6 +463,8 @@ class SuppressionResult:
     flap_peak: float | None = None
     flap_rate_peak: float | None = None
     gust_rms: float = 0.0
+    flap_saturated_percent: float | None = None
+    flap_rate_saturated_percent: float | None = None
 
     def record(self) -> dict:
         """The run as plain numbers (``summary.json`` → ``suppression.runs``).
@@ -467,14 +474,18 @@ class SuppressionResult:
         dict
             ``speed_factor``, ``V``, ``attenuation_percent``, ``open_loop_rms``,
             ``closed_loop_rms`` (per sensor), ``dominant_sensor``, ``flap_peak``,
-            ``flap_rate_peak``, ``lco_returns``, ``started_from_lco``, ``gust_rms``.
+            ``flap_rate_peak``, ``flap_saturated_percent``, ``flap_rate_saturated_percent``,
+            ``lco_returns``, ``started_from_lco``, ``gust_rms``.
         """
         return {"speed_factor": self.speed_factor, "V": self.V,
                 "attenuation_percent": self.attenuation_percent,
                 "open_loop_rms": list(self.open_loop_rms),
                 "closed_loop_rms": list(self.closed_loop_rms),
                 "dominant_sensor": self.dominant_sensor, "flap_peak": self.flap_peak,
-                "flap_rate_peak": self.flap_rate_peak, "lco_returns": self.lco_returns,
+                "flap_rate_peak": self.flap_rate_peak,
+                "flap_saturated_percent": self.flap_saturated_percent,
+                "flap_rate_saturated_percent": self.flap_rate_saturated_percent,
+                "lco_returns": self.lco_returns,
                 "started_from_lco": self.started_from_lco, "gust_rms": self.gust_rms}
 
 
@@ -627,6 +638,14 @@ def _suppression_result(V: float, sim: TruthLoopSimulation, sp: SuppressionSetti
     after = np.sqrt(np.mean(released[-m:] ** 2, axis=0))
     att = 100.0 * (1.0 - closed_rms[dom] / open_rms[dom]) if open_rms[dom] > 0 else None
     engaged = window(sp.settle, t_release)
+    hold = window(t_full, t_release)
+
+    def at_limit(x, limit):
+        # the servo stops its angle and its rate exactly at the limits (_FlapServo)
+        if limit is None or not hold.any():
+            return None
+        return float(100.0 * np.mean(np.abs(x[hold]) >= limit * (1.0 - 1e-6)))
+
     return SuppressionResult(V=V, simulation=sim,
                              attenuation_percent=None if att is None else float(att),
                              open_loop_rms=tuple(map(float, open_rms)),
@@ -641,7 +660,10 @@ def _suppression_result(V: float, sim: TruthLoopSimulation, sp: SuppressionSetti
                              started_from_lco=started_from_lco, speed_factor=speed_factor,
                              flap_peak=float(np.max(np.abs(sim.v[engaged]))),
                              flap_rate_peak=float(np.max(np.abs(sim.v_rate[engaged]))),
-                             gust_rms=gust_rms)
+                             gust_rms=gust_rms,
+                             flap_saturated_percent=at_limit(sim.v, sp.flap_limit),
+                             flap_rate_saturated_percent=at_limit(sim.v_rate,
+                                                                  sp.flap_rate_limit))
 
 
 def suppression_runs(truth, K: control.StateSpace, V_flutter: float,

@@ -116,6 +116,30 @@ def test_a_suppression_run_in_turbulence_is_reproducible_and_recorded(wing):
     assert 0 < rec["flap_peak"] <= 0.2618 * (1 + 1e-9)
     assert 0 < rec["flap_rate_peak"] <= 5.236 * (1 + 1e-9)
     assert rec["gust_rms"] == pytest.approx(0.005 * wing.airspeed(a.V), rel=0.5)
+    # the servo's rate limit is far above what this gentle controller asks of it
+    assert rec["flap_saturated_percent"] == 0.0 and rec["flap_rate_saturated_percent"] == 0.0
+
+
+def test_a_servo_too_slow_for_the_command_is_reported_at_its_rate_limit(wing):
+    """The share of the hold the servo spends at its limits, against what the limits
+    physically do: the free servo follows this controller's command with a flap of about
+    0.2 deg moving at up to about 10 deg/s (measured).  A rate limit of 0.5 deg/s holds the
+    flap at its rate limit nearly the whole hold (>= 90 %); a limit of 500 deg/s never binds
+    (0 %); a servo without a rate limit has no share (None).  The travel limit of 15 deg is
+    far away throughout (0 %)."""
+    base = dict(speed_factors=(1.05,), settle=0.4, ramp=0.1, hold=0.6, release=0.1,
+                flap_limit=0.2618)
+    K = control.ss([[-50.0]], [[0.0, 1.0]], [[-0.05]], [[0.0, 0.0]])
+    kw = dict(dt=0.002, mode=1, deflection=0.01)
+    slow, fast = (suppression_run(wing, K, 1.085, SuppressionSettings(
+        flap_rate_limit=np.radians(rate), **base), **kw) for rate in (0.5, 500.0))
+    assert slow.flap_rate_saturated_percent >= 90.0
+    assert fast.flap_rate_saturated_percent == 0.0
+    # the slow servo did bind: the free flap moves at well above 0.5 deg/s
+    assert fast.flap_rate_peak > 10 * np.radians(0.5)
+    assert slow.flap_saturated_percent == fast.flap_saturated_percent == 0.0
+    free = suppression_run(wing, K, 1.085, SuppressionSettings(**base), **kw)
+    assert free.flap_rate_saturated_percent is None
 
 
 @pytest.mark.parametrize("changes, words", [

@@ -135,8 +135,10 @@ def _main(args) -> int:
             lines.append(f"suppression at {r['speed_factor']:g} Vf (V = {sig(r['V'], 4)}): "
                          f"attenuation {sig(r['attenuation_percent'], 4)} %, flap peak "
                          f"{sig(math.degrees(r['flap_peak']), 3)} deg, rate peak "
-                         f"{sig(math.degrees(r['flap_rate_peak']), 3)} deg/s, LCO returns on "
-                         f"release: {r['lco_returns']}")
+                         f"{sig(math.degrees(r['flap_rate_peak']), 3)} deg/s"
+                         + (f" (at the rate limit {r['flap_rate_saturated_percent']:.0f} % of "
+                            "the hold)" if r.get("flap_rate_saturated_percent") else "")
+                         + f", LCO returns on release: {r['lco_returns']}")
     if log_quiet:                    # otherwise the log said it once already
         lines += res.skipped_notes()
     if res.interval_ok is not None or res.closed_loop is not None:
