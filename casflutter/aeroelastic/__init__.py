@@ -33,7 +33,8 @@
   Q(ik), and :func:`pk_flutter`, the p-k flutter solution on a Q(ik) table.
 """
 
-from ._family import FEEDBACK_SIGNS, FamilySignals, GriddedFamily, MatrixFamily, PlantFamily
+from ._family import (FEEDBACK_SIGNS, FamilySignals, GriddedFamily, MatrixFamily, PlantFamily,
+                      RealisationGap)
 from ._family_flutter import family_flutter
 from ._family_io import family_record, load_family, write_family
 from ._flap_wing import FlapWingFamily
@@ -52,7 +53,8 @@ from ._tracking import EigenTracking, eig_sorted_by_reference, track_eigenvalues
 from ._truth_loop import TruthLoop
 
 __all__ = [
-    "PlantFamily", "MatrixFamily", "FamilySignals", "GriddedFamily", "FEEDBACK_SIGNS",
+    "PlantFamily", "MatrixFamily", "FamilySignals", "GriddedFamily", "RealisationGap",
+    "FEEDBACK_SIGNS",
     "load_family", "write_family", "family_record", "FlapWingFamily", "family_flutter",
     "AeroelasticSystem", "AeroelasticLoop", "LoopFamily", "ParametricSystem", "ServoSystem",
     "aeroelastic_loop",

@@ -34,7 +34,8 @@ import numpy as np
 from ..data import check_grid_speeds, check_stack
 from ..errors import ConfigError, DimensionError
 
-__all__ = ["FEEDBACK_SIGNS", "FamilySignals", "PlantFamily", "MatrixFamily", "GriddedFamily"]
+__all__ = ["FEEDBACK_SIGNS", "FamilySignals", "PlantFamily", "MatrixFamily", "GriddedFamily",
+           "RealisationGap"]
 
 #: The sign ``s`` of ``u = s K y`` for each feedback convention.
 FEEDBACK_SIGNS = {"positive": 1.0, "negative": -1.0}
@@ -375,6 +376,25 @@ class MatrixFamily(PlantFamily):
         return self.matrices(V)[0]
 
 
+@dataclass(frozen=True)
+class RealisationGap:
+    """A grid interval of a :class:`GriddedFamily` across which the states seem to change
+    meaning (:meth:`GriddedFamily.realisation_gaps`).
+
+    Attributes
+    ----------
+    lo, hi : float
+        The grid speeds at its ends.
+    pole_distance : float
+        How far (relative) the farthest pole of the plant interpolated halfway lies from
+        every pole of both ends.
+    """
+
+    lo: float
+    hi: float
+    pole_distance: float
+
+
 class GriddedFamily(MatrixFamily):
     """A plant family given at a grid of speeds, linearly interpolated between them.
 
@@ -383,7 +403,7 @@ class GriddedFamily(MatrixFamily):
     (``speed_degree = 1``, the grid speeds are the breakpoints): a closed loop's exact
     stable interval can be certified piece by piece.  The states must mean the same thing at
     every grid speed (the same realisation), as they do in a model exported on a grid of
-    flight conditions.
+    flight conditions; :meth:`realisation_gaps` names the intervals where they seem not to.
 
     Parameters
     ----------
@@ -472,6 +492,57 @@ class GriddedFamily(MatrixFamily):
     def n_states(self) -> int:
         """Number of states."""
         return int(self._mats[0].shape[1])
+
+    def realisation_gaps(self, *, ends_tol: float = 0.1, middle_tol: float = 0.3
+                         ) -> tuple[RealisationGap, ...]:
+        """Grid intervals across which the states seem to change meaning.
+
+        Interpolating the matrices elementwise is meaningful only when the states are the
+        same at every grid speed.  A family exported speed by speed in coordinates of its
+        own (a modal basis re-normalised or re-ordered at each speed, a minimal realisation
+        per speed) gives neighbouring plants with nearly the same poles whose matrices
+        are unrelated: halfway between them the interpolated plant is a system that exists
+        at neither speed, and the analyses would certify or design on it.  An interval is
+        named when every pole of each end lies within ``ends_tol`` (relative) of a pole of
+        the other end, yet the plant interpolated halfway has a pole farther than
+        ``middle_tol`` from every pole of both ends.  In one realisation the poles move
+        continuously with the matrices (by at most the matrices' change, for
+        well-conditioned eigenvectors), so this does not happen; an interval whose ends'
+        poles differ by more than ``ends_tol`` is not judged.
+
+        Parameters
+        ----------
+        ends_tol, middle_tol : float
+            Relative pole distances (to ``max(|λ|, 1e-3 max |λ|)``: poles near the origin,
+            such as an aircraft's rigid-body modes, count in absolute terms).
+
+        Returns
+        -------
+        tuple of RealisationGap
+            One per named interval, in speed order (empty for a family in one
+            realisation).
+        """
+        A = self._mats[0]
+        ends = [np.linalg.eigvals(a) for a in A]
+        size = max(float(np.max(np.abs(lam))) for lam in ends) if ends[0].size else 0.0
+        floor = max(1e-3 * size, np.finfo(float).tiny)
+
+        def far(lam, ref):
+            # relative distance of each of lam to the nearest of ref
+            d = np.min(np.abs(lam[:, None] - ref[None, :]), axis=1)
+            return d / np.maximum(np.abs(lam), floor)
+
+        gaps = []
+        for j in range(self.speeds.size - 1):
+            a, b = ends[j], ends[j + 1]
+            if a.size == 0 or max(far(a, b).max(), far(b, a).max()) > ends_tol:
+                continue
+            mid = np.linalg.eigvals(0.5 * (A[j] + A[j + 1]))
+            worst = float(far(mid, np.concatenate([a, b])).max())
+            if worst > middle_tol:
+                gaps.append(RealisationGap(float(self.speeds[j]), float(self.speeds[j + 1]),
+                                           worst))
+        return tuple(gaps)
 
     def __repr__(self) -> str:
         s = self.signals

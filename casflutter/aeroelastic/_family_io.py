@@ -11,6 +11,7 @@ as a grid.
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +22,8 @@ from ..errors import ConfigError, DataError
 from ._family import FamilySignals, GriddedFamily, PlantFamily
 
 __all__ = ["load_family", "write_family", "family_record"]
+
+log = logging.getLogger(__name__)
 
 
 def load_family(source) -> GriddedFamily:
@@ -37,7 +40,8 @@ def load_family(source) -> GriddedFamily:
     -------
     GriddedFamily
         Signals named, roles and units as the file says; interpolated linearly between
-        the grid speeds.
+        the grid speeds.  A warning is logged where the states seem to change meaning
+        between grid speeds (:meth:`GriddedFamily.realisation_gaps`).
 
     Raises
     ------
@@ -71,9 +75,21 @@ def load_family(source) -> GriddedFamily:
                                 output_units=rec.output_units)
     except ConfigError as exc:
         raise ConfigError(f"{where}: {exc}") from None
-    return GriddedFamily(rec.speeds, rec.A, rec.B, rec.C, rec.D, signals,
-                         speed_unit=rec.speed_unit, time_unit=rec.time_unit,
-                         feedback=rec.feedback, name=rec.name)
+    family = GriddedFamily(rec.speeds, rec.A, rec.B, rec.C, rec.D, signals,
+                           speed_unit=rec.speed_unit, time_unit=rec.time_unit,
+                           feedback=rec.feedback, name=rec.name)
+    gaps = family.realisation_gaps()
+    if gaps:
+        g = gaps[0]
+        log.warning(
+            "%s: the states seem to change meaning between grid speeds in %d of %d intervals "
+            "(first %g-%g %s: both ends have the same poles within 10 %%, but the plant "
+            "interpolated halfway has a pole %.0f %% away from all of them).  The family is "
+            "interpolated elementwise, which needs the same states at every speed: export it "
+            "in one realisation (the same modal basis, normalisation and lag states at every "
+            "speed)", where, len(gaps), family.speeds.size - 1, g.lo, g.hi, family.speed_unit,
+            100 * g.pole_distance)
+    return family
 
 
 def family_record(family: PlantFamily, speeds, *, name: str | None = None,

@@ -73,3 +73,62 @@ def test_the_50_state_family_has_the_planned_size_and_signals():
     assert sig.controls == ("flap_1", "flap_2", "flap_3", "flap_4")
     assert sig.measurements[:2] == ("gyro_50", "gyro_100")
     assert set(sig.output_units) == {"rad/s", "m/s^2"} and fam.feedback == "negative"
+
+
+def _recoordinated(rec, transforms):
+    """The record's models, each in the coordinates ``x = T x'`` of its own ``T``."""
+    A, B, C, D = (np.asarray(M) for M in (rec.A, rec.B, rec.C, rec.D))
+    inv = [np.linalg.inv(T) for T in transforms]
+    fields = {k: getattr(rec, k) for k in ("speeds", "speed_unit", "feedback", "input_names",
+                                           "output_names")}
+    return type(rec)(**fields, A=np.stack([Ti @ a @ T for Ti, a, T in zip(inv, A, transforms)]),
+                     B=np.stack([Ti @ b for Ti, b in zip(inv, B)]),
+                     C=np.stack([c @ T for c, T in zip(C, transforms)]), D=D)
+
+
+def test_models_exported_each_in_its_own_coordinates_are_named(caplog):
+    """The shipped 50-state family is in one realisation: no interval is named and nothing
+    is logged.  The same 41 models, each in coordinates of its own (a seeded orthogonal
+    change of basis; or every other model with its states re-ordered and a fifth of them
+    sign-flipped, as a modal solver re-normalising its mode shapes would give), are the same
+    plants at the grid speeds (frequency responses equal to 1e-5, the rounding of the
+    50-state resolvent in another basis; an independent check), but
+    interpolated between them they are not: every interval is named, and the loader warns
+    with the first of them."""
+    rec = read_family_file(problems_dir() / "goland_4flaps" / "problem.toml")
+    with caplog.at_level("WARNING", logger="casflutter"):
+        assert load_family(rec).realisation_gaps() == ()
+    assert not caplog.records
+    n, k = np.asarray(rec.A).shape[1], len(rec.speeds)
+    rng = np.random.default_rng(7)
+    rotated = [np.linalg.qr(rng.standard_normal((n, n)))[0] for _ in range(k)]
+    relabelled = [np.eye(n) if j % 2 == 0 else
+                  np.eye(n)[rng.permutation(n)] @ np.diag(np.where(rng.random(n) < 0.2, -1, 1))
+                  for j in range(k)]
+    for transforms in (rotated, relabelled):
+        other = _recoordinated(rec, transforms)
+        ref = load_family(rec)
+        caplog.clear()
+        with caplog.at_level("WARNING", logger="casflutter"):
+            fam = load_family(other)
+        for V in (rec.speeds[0], rec.speeds[20], rec.speeds[-1]):
+            for w in (1.0, 30.0, 300.0):
+                g0 = np.asarray(ref.plant(V)(1j * w))
+                g1 = np.asarray(fam.plant(V)(1j * w))
+                assert_allclose(g1, g0, rtol=1e-5, atol=1e-5 * np.abs(g0).max())
+        gaps = fam.realisation_gaps()
+        assert [(g.lo, g.hi) for g in gaps] == list(zip(rec.speeds[:-1], rec.speeds[1:]))
+        assert all(g.pole_distance > 0.3 for g in gaps)
+        assert len(caplog.records) == 1
+        assert "states seem to change meaning" in caplog.text and "40 of 40" in caplog.text
+        assert f"first {rec.speeds[0]:g}-{rec.speeds[1]:g} m/s" in caplog.text
+
+
+def test_a_coarse_grid_in_one_realisation_is_not_named():
+    """The seed wing's own loop sampled at 4 speeds over (0.05, 2.4), one realisation: its
+    poles move far between neighbours (up to the flutter mode's instability), and no
+    interval is named."""
+    loop = TruthLoop(SeedWing(), 251.3)
+    speeds = np.linspace(0.05, 2.4, 4)
+    fam = load_family(family_record(loop, speeds))
+    assert fam.realisation_gaps() == ()
