@@ -10,6 +10,11 @@ objective over the speeds the budget allows.  It is a multi-model problem in the
 HIFOO (stabilise first, then minimise the worst H∞ norm over the plants) and of
 hinfstruct/systune (the worst case over a set of models), with the speeds as the models:
 
+0. **What the family allows.**  A mode that the controls do not reach or the measurements do
+   not see is in every closed loop (:mod:`._out_of_reach`): where one does not decay, or
+   decays slower than a ``decay`` given, the design is refused before any work; where the
+   settings leave ``decay`` open and such a mode is slower than ``DEFAULT_DECAY``, the
+   design asks for half its rate instead (a warning says so).
 1. **Hold the interval.**  The worst closed-loop spectral abscissa over ``n_speeds`` speeds of
    an interval, smoothed by a log-sum-exp of decreasing temperature, is minimised over the
    controller's matrices by BFGS with the exact gradient of the rightmost eigenvalues
@@ -62,6 +67,7 @@ from .._settings import finite_numbers
 from .._threads import single_threaded
 from ..errors import ConfigError, DimensionError, SynthesisError
 from ._bfgs import nonsmooth_bfgs
+from ._out_of_reach import modes_out_of_reach
 from ._plant import partition
 from ._problem import verify_closed_loop
 from ._speeds import DesignChannels, Scaling, SpeedLoops, design_partition
@@ -72,6 +78,8 @@ __all__ = ["MultiSpeedSettings", "MultiSpeedDesign", "HoldRecord", "design_over_
 
 log = logging.getLogger("casflutter.design")
 
+#: the decay rate asked when the settings leave it open and the family allows it
+DEFAULT_DECAY = 0.05
 #: BFGS temperatures of the smoothed maximum in multiples of the decay rate, last the maximum
 _TAUS = (6.0, 2.0, 0.6, None)
 #: a BFGS run stops when 20 iterations lowered its objective by less than this many decay rates
@@ -86,8 +94,11 @@ class MultiSpeedSettings:
 
     __repr__ = result_repr
 
-    decay: float = 0.05
-    """Decay rate [rad per time unit] the closed loop needs at every speed of the interval."""
+    decay: float | None = None
+    """Decay rate [rad per time unit] the closed loop needs at every speed of the interval.
+    ``None``: 0.05, or half the rate of the slowest mode that no controller moves where
+    that is slower (a warning says so); a rate given that such a mode does not allow is
+    refused before any work."""
     n_speeds: int = 16
     """Speeds of the stability objective on each interval tried (the dense check uses 8x,
     refined beside its highest local maxima)."""
@@ -130,7 +141,9 @@ class MultiSpeedSettings:
     def __post_init__(self):
         if isinstance(self.synthesis, Mapping):
             object.__setattr__(self, "synthesis", SynthesisOptions(**self.synthesis))
-        checks = {"decay": math.isfinite(self.decay) and self.decay >= 0,
+        checks = {"decay": self.decay is None or (isinstance(self.decay, (int, float))
+                                                   and math.isfinite(self.decay)
+                                                   and self.decay >= 0),
                   "n_speeds": int(self.n_speeds) == self.n_speeds and self.n_speeds >= 2,
                   "hinf_speeds": int(self.hinf_speeds) == self.hinf_speeds
                   and self.hinf_speeds >= 0,
@@ -148,7 +161,8 @@ class MultiSpeedSettings:
                   "min_step": 0 < self.min_step <= self.first_step}
         bad = [k for k, ok in checks.items() if not ok]
         if bad:
-            raise ConfigError(f"invalid MultiSpeedSettings field(s) {bad}: need decay >= 0, "
+            raise ConfigError(f"invalid MultiSpeedSettings field(s) {bad}: need decay >= 0 "
+                              "(or None), "
                               "n_speeds >= 2, hinf_speeds >= 0, rate_weight >= 0, "
                               "rate_bandwidth > 0, random_starts >= 0, reduction orders "
                               ">= 1, max_iter >= 1, max_rounds >= 1, 0 < min_step <= "
@@ -219,6 +233,9 @@ class MultiSpeedDesign:
         What was held, in a sentence.
     wall_time : float
         Seconds.
+    decay : float
+        The decay rate held: the settings' unless a mode no controller moves decays slower
+        (then half that mode's rate).
     """
 
     __repr__ = result_repr
@@ -235,6 +252,7 @@ class MultiSpeedDesign:
     starts: tuple
     message: str
     wall_time: float
+    decay: float = float("nan")
 
 
 def _peaks(values: np.ndarray, threshold: float, most: int = 8) -> list[int]:
@@ -344,7 +362,8 @@ class _Engine:
     @property
     def decay(self) -> float:
         """The decay rate in the scaled time."""
-        return self.settings.decay / self.models.scaling.w0
+        rate = self.settings.decay
+        return (DEFAULT_DECAY if rate is None else rate) / self.models.scaling.w0
 
     def free(self, order: int) -> np.ndarray:
         nu, ny = self.models.nu, self.models.ny
@@ -639,7 +658,11 @@ def design_over_speeds(family, interval, order: int = 3, *,
     Raises
     ------
     ConfigError
-        A bad interval (outside a family's range), order or setting.
+        A bad interval (outside a family's range), order or setting; a family with a mode
+        that no controller moves (the controls do not reach it or the measurements do not
+        see it) and that does not decay, or decays slower than the ``settings.decay`` given,
+        named.  Where the settings leave ``decay`` open, the design asks for half such a
+        mode's rate instead and logs a warning.
     DimensionError
         Families with different numbers of controls and measurements, or H∞ plants that do
         not fit them.
@@ -661,6 +684,7 @@ def design_over_speeds(family, interval, order: int = 3, *,
     order = int(order)
     with single_threaded():
         models = _Models(fams, lo, hi, fixed=[control.ss(P) for P in hinf_plants or ()])
+        s = _reachable_decay(models, s, lo, hi)
         sp = models.has_d22 if s.strictly_proper is None else bool(s.strictly_proper)
         if sp and order == 0:
             raise ConfigError("order = 0 with a strictly proper controller leaves nothing to "
@@ -710,6 +734,44 @@ def design_over_speeds(family, interval, order: int = 3, *,
         K, reached = (held, (lo, hi)) if held is not None else best
         return _finish(eng, fams, K, order, (lo, hi), reached, held is not None, records,
                        hinf_plants, plan[0][1], t0)
+
+
+def _reachable_decay(models: _Models, s: MultiSpeedSettings, lo: float, hi: float
+                     ) -> MultiSpeedSettings:
+    """The settings with a decay rate the family allows.
+
+    A mode that the controls do not reach or the measurements do not see stays in every
+    closed loop (:mod:`._out_of_reach`).  Where one decays slower than the rate asked at one
+    of five speeds of the interval, no controller can meet that rate: a rate the settings
+    give is refused, and where they leave it open the design asks for half the slowest such
+    mode's rate instead of ``DEFAULT_DECAY``, and says so.  Where one does not decay at all,
+    no controller stabilises the family: refused before any work.
+    """
+    asked = DEFAULT_DECAY if s.decay is None else float(s.decay)
+    slowest = None
+    for V in np.linspace(lo, hi, 5):
+        for fam, P in zip(models.families, models.parts(V)):
+            for mode in modes_out_of_reach(P.A, P.B2, P.C2, asked)[:1]:
+                if slowest is None or mode.eigenvalue.real > slowest[1].eigenvalue.real:
+                    slowest = (float(V), mode, fam)
+    if slowest is None:
+        return replace(s, decay=asked)
+    V, mode, fam = slowest
+    where = f"{fam.name} at V = {V:.5g} {fam.speed_unit}"
+    rate = -mode.eigenvalue.real
+    if rate <= 0:
+        raise ConfigError(
+            f"{where}: {mode.describe()} does not decay, and no controller moves it, so none "
+            "can stabilise the family; give the family a control that reaches it and a "
+            "measurement that sees it, or leave the mode out (e.g. rigid-body positions "
+            "that the sensors do not measure)")
+    what = (f"{where}: {mode.describe()} decays at only {rate:.4g} per {fam.time_unit} and "
+            f"no controller moves it, so no loop decays at the rate {asked:g}")
+    if s.decay is not None:
+        raise ConfigError(f"{what} asked; ask for a decay rate below {rate:.4g} (e.g. "
+                          f"{0.5 * rate:.3g}), or leave it out to have it chosen")
+    log.warning("%s; the design asks for %.4g (half that mode's rate)", what, 0.5 * rate)
+    return replace(s, decay=0.5 * rate)
 
 
 def _fmt(reached: tuple) -> str:
@@ -857,4 +919,4 @@ def _finish(eng: _Engine, fams, K: np.ndarray, order: int, interval: tuple, reac
                             reached=(float(lo), float(e)), held=bool(held),
                             worst_abscissa=worst, gamma=gamma, hinf_speeds=hv, synthesis=syn,
                             starts=tuple(records), message=message,
-                            wall_time=time.perf_counter() - t0)
+                            wall_time=time.perf_counter() - t0, decay=float(s.decay))

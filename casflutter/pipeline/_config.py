@@ -256,9 +256,10 @@ class ControllerSettings(SynthesisOptions):
     interval: tuple = (0.05, 2.4)
     """``[lo, hi]`` over which the loop must decay (``method = "multispeed"``), in the
     family's speed unit (the speed index for a ROM loop)."""
-    interval_decay: float = 0.05
+    interval_decay: float | None = None
     """Decay rate [rad per time unit] required of the closed loop at every speed of
-    ``interval``."""
+    ``interval``; left out: 0.05, or half the rate of the family's slowest mode that no
+    controller moves where that is slower (:class:`casflutter.design.MultiSpeedSettings`)."""
     n_speeds: int = 16
     """Speeds of the stability objective on each interval the design tries (its dense
     check uses 8x as many)."""
@@ -353,8 +354,12 @@ class ControllerSettings(SynthesisOptions):
                 isinstance(o, int) and not isinstance(o, bool) and o >= 1 for o in ro):
             raise ConfigError(f"controller.reduction_orders = {ro!r}: a list of integers >= 1")
         object.__setattr__(self, "reduction_orders", tuple(ro))
-        if not (isinstance(self.interval_decay, (int, float)) and self.interval_decay >= 0):
-            raise ConfigError(f"interval_decay = {self.interval_decay!r}: must be >= 0")
+        if self.interval_decay is not None and not (
+                isinstance(self.interval_decay, (int, float))
+                and not isinstance(self.interval_decay, bool)
+                and math.isfinite(self.interval_decay) and self.interval_decay >= 0):
+            raise ConfigError(f"interval_decay = {self.interval_decay!r}: a number >= 0 (or "
+                              "leave it out to have it chosen)")
         mg = finite_numbers("margins", self.margins, 2, what="[gain margin dB, phase margin deg]")
         if not (mg[0] >= 0 and 0 <= mg[1] <= 180):
             raise ConfigError(f"controller.margins = {list(mg)!r}: a gain margin >= 0 dB and a "

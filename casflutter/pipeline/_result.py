@@ -659,7 +659,7 @@ class RunResult:
         if c.design is not None:
             d = c.design
             out.update(interval=list(d.interval), held=bool(d.held), reach=d.reached[1],
-                       design_gamma=d.gamma, design_message=d.message)
+                       interval_decay=d.decay, design_gamma=d.gamma, design_message=d.message)
         if c.verification is not None:
             ver = c.verification
             out.update(gamma=ver.gamma, small_gain_V=_pair(ver.small_gain_V),

@@ -3,7 +3,8 @@
 One JSON record per controller order and seed (:func:`casflutter.design.design_over_speeds`
 over ``--interval``): ``problem``, ``nx``, ``n_inputs``, ``n_outputs``, ``order``, ``seed``,
 ``interval``, ``held`` (the design's dense scan finds the decay rate over the whole
-interval), ``reach`` (the top of the interval it holds from ``lo``), ``worst_abscissa``,
+interval), ``reach`` (the top of the interval it holds from ``lo``), ``decay`` (the rate
+held: ``--decay``, or the one the design chose), ``worst_abscissa``,
 ``gamma``, ``wall_time_s`` and ``cpu_time_s``, and the verification layer's certificate of
 the same controller on the family (``certified_interval``: the stable interval containing
 the range's start, :func:`casflutter.verify.verify_family`), and a ``summary`` with the
@@ -59,7 +60,8 @@ def _ints(text: str, what: str, low: int) -> list[int]:
     return values
 
 
-def design_records(family, interval, orders, seeds, *, problem: str = "", decay: float = 0.05,
+def design_records(family, interval, orders, seeds, *, problem: str = "",
+                   decay: float | None = None,
                    objective: str = "auto", on_record=None) -> list[dict[str, Any]]:
     """Design at every order and seed and certify each controller on the family.
 
@@ -73,8 +75,9 @@ def design_records(family, interval, orders, seeds, *, problem: str = "", decay:
         Controller orders and seeds.
     problem : str
         The name written in each record.
-    decay : float
-        Decay rate required at every speed [rad per time unit].
+    decay : float, optional
+        Decay rate required at every speed [rad per time unit] (default: chosen by
+        :class:`casflutter.design.MultiSpeedSettings`; each record says which).
     objective : {"auto", "sensors", "sensitivity"}
         The H∞ phase's channels (:class:`casflutter.design.MultiSpeedSettings`):
         the family's disturbances to its measurements, or the loop's output and input
@@ -111,7 +114,7 @@ def design_records(family, interval, orders, seeds, *, problem: str = "", decay:
                            wall_time_s=time.perf_counter() - t,
                            cpu_time_s=time.process_time() - c)
             else:
-                rec.update(held=bool(d.held), reach=d.reached[1],
+                rec.update(held=bool(d.held), reach=d.reached[1], decay=d.decay,
                            worst_abscissa=d.worst_abscissa, gamma=d.gamma,
                            wall_time_s=time.perf_counter() - t,
                            cpu_time_s=time.process_time() - c, status=d.message)
@@ -190,8 +193,10 @@ def register(subparsers) -> None:
                    help="the speeds to hold, in the family's speed unit")
     p.add_argument("--orders", default="2,3,4", help="comma-separated controller orders")
     p.add_argument("--seeds", default="0,1,2", help="comma-separated seeds")
-    p.add_argument("--decay", type=float, default=0.05,
-                   help="decay rate required at every speed [rad per time unit]")
+    p.add_argument("--decay", type=float, default=None,
+                   help="decay rate required at every speed [rad per time unit] (default: "
+                        "0.05, or half the rate of the family's slowest mode that no "
+                        "controller moves where that is slower)")
     p.add_argument("--objective", choices=("auto", "sensors", "sensitivity"), default="auto",
                    help="H-infinity objective once the interval is held: the family's "
                         "disturbances to its sensors, or the loop's output and input "
