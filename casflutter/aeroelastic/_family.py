@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
+from .._format import result_repr
 from ..data import check_grid_speeds, check_stack
 from ..errors import ConfigError, DimensionError
 
@@ -389,6 +390,8 @@ class RealisationGap:
         How far (relative) the farthest pole of the plant interpolated halfway lies from
         every pole of both ends.
     """
+
+    __repr__ = result_repr
 
     lo: float
     hi: float

@@ -76,9 +76,9 @@ def modes_out_of_reach(A, B, C, slower_than: float) -> list[OutOfReach]:
     n = A.shape[0]
     B = np.asarray(B, dtype=float).reshape(n, -1)
     C = np.asarray(C, dtype=float).reshape(-1, n)
-    scale = float(np.linalg.norm(A, 2))
-    if n == 0 or scale == 0.0:
+    if n == 0:
         return []
+    scale = float(np.linalg.norm(A, 2)) or 1.0
     # the controls and measurements in the units of A: a gain scale does not move a mode
     Bs, Cs = (M * (scale / nm) if (nm := float(np.linalg.norm(M, 2))) > 0 else M
               for M in (B, C))

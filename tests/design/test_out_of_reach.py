@@ -16,7 +16,7 @@ import pytest
 
 from casflutter._resources import problems_dir
 from casflutter.design import load_compleib
-from casflutter.design._out_of_reach import modes_out_of_reach
+from casflutter.design._out_of_reach import OutOfReach, modes_out_of_reach
 
 
 def _control_part(name: str):
@@ -86,3 +86,8 @@ def test_a_fully_reachable_and_seen_plant_has_none():
     out = modes_out_of_reach(A, [[0.0], [1.0]], [[0.0, 0.0]], 1.0)
     assert len(out) == 1 and not out[0].seen and out[0].reached
     assert "unseen by the measurements" in out[0].describe()
+    # an integrator (A = 0) that no control drives keeps its pole at 0; one that is driven
+    # and read does not
+    assert modes_out_of_reach([[0.0]], [[0.0]], [[1.0]], 0.05) == [
+        OutOfReach(0j, reached=False, seen=True)]
+    assert modes_out_of_reach([[0.0]], [[1.0]], [[1.0]], 0.05) == []
