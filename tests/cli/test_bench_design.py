@@ -48,6 +48,8 @@ def test_records_per_order_and_seed_with_the_certificate(tmp_path):
     (["--interval", "150", "60"], "LO < HI"),
     (["--interval", "60", "150", "--orders", "two"], "--orders"),
     (["--interval", "60", "150", "--problem", "no_such_problem"], "neither a plant family"),
+    # the family's lag pole at -2.986 rad/s (60 m/s) is in every closed loop
+    (["--interval", "60", "150", "--decay", "5"], "ask for a decay rate below 2.986"),
 ])
 def test_bad_arguments_are_refused_before_any_work(tmp_path, capsys, args, words):
     out = tmp_path / "b.json"

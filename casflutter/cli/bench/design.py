@@ -176,7 +176,6 @@ def _handler(args: argparse.Namespace) -> int:
         records.append(rec)
         _write(out, records, meta)
 
-    _write(out, records, meta)
     design_records(family, (lo, hi), orders, seeds, problem=args.problem, decay=args.decay,
                    objective=args.objective, on_record=keep)
     return 0
