@@ -13,8 +13,8 @@ hinfstruct/systune (the worst case over a set of models), with the speeds as the
 0. **What the family allows.**  A mode that the controls do not reach or the measurements do
    not see is in every closed loop (:mod:`._out_of_reach`): where one does not decay, or
    decays slower than a ``decay`` given, the design is refused before any work; where the
-   settings leave ``decay`` open and such a mode is slower than ``DEFAULT_DECAY``, the
-   design asks for half its rate instead (a warning says so).
+   settings leave ``decay`` open (0.05) and such a mode is slower, the design asks for half
+   its rate instead (a warning says so).
 1. **Hold the interval.**  The worst closed-loop spectral abscissa over ``n_speeds`` speeds of
    an interval, smoothed by a log-sum-exp of decreasing temperature, is minimised over the
    controller's matrices by BFGS with the exact gradient of the rightmost eigenvalues
@@ -252,7 +252,7 @@ class MultiSpeedDesign:
     starts: tuple
     message: str
     wall_time: float
-    decay: float = float("nan")
+    decay: float
 
 
 def _peaks(values: np.ndarray, threshold: float, most: int = 8) -> list[int]:
@@ -361,9 +361,9 @@ class _Engine:
 
     @property
     def decay(self) -> float:
-        """The decay rate in the scaled time."""
-        rate = self.settings.decay
-        return (DEFAULT_DECAY if rate is None else rate) / self.models.scaling.w0
+        """The decay rate in the scaled time (of the settings :func:`_reachable_decay`
+        resolved)."""
+        return self.settings.decay / self.models.scaling.w0
 
     def free(self, order: int) -> np.ndarray:
         nu, ny = self.models.nu, self.models.ny
