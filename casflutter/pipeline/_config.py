@@ -45,8 +45,8 @@ from ..design import SynthesisOptions
 from ..errors import ConfigError
 from ..ident import HWLOrders, IdentificationSettings
 from ..structure import SENSOR_KINDS, check_sensor_rows
-from ..truth import (RecordSettings, SuppressionSettings, file_problem_names, load_problem,
-                     problem_definition, problem_names)
+from ..truth import (AeroelasticTruth, RecordSettings, SuppressionSettings, file_problem_names,
+                     load_problem, problem_definition, problem_names)
 
 __all__ = ["RunConfig", "ProblemSection", "DataSection", "RomSection", "FlutterSection",
            "LcoSection", "ControllerSettings", "VerifySection", "ClosedLoopSection",
@@ -250,7 +250,11 @@ class ControllerSettings(SynthesisOptions):
     (:func:`casflutter.design.design_over_speeds`).  ``"paper"``: the paper's design, γ of
     the LFT at Vf (eq. 14-16) with the flap-rate weight, its interval only measured.
     ``"auto"``: ``"multispeed"`` on a plant family and on a ROM whose time follows the
-    speed (``rom.convective``), ``"paper"`` on the paper's frozen ROM of eq. 8."""
+    speed (``rom.convective``), ``"paper"`` on the paper's frozen ROM of eq. 8.  On the HWL
+    ROM (``rom.method = "hwl"``) ``"multispeed"`` designs on the ROM made to follow the wing
+    over speed (:attr:`casflutter.pipeline.ModelStage.speed_following`), not on the frozen
+    loop of eq. 8, which misplaces the flutter mode's control reversal; the paper's γ (the
+    LFT at the frozen loop's Vf) stays its H∞ objective (``hinf_objective = "auto"``)."""
     order: int = 3
     """Controller order (the paper's 3)."""
     interval: tuple = (0.05, 2.4)
@@ -591,12 +595,22 @@ class RunConfig:
         if self.controller.method == "auto":
             method = "multispeed" if n_modes is None or self.rom.convective else "paper"
             object.__setattr__(self, "controller", replace(self.controller, method=method))
-        if (self.controller.method == "multispeed" and "controller" in stages
-                and n_modes is not None and not self.rom.convective):
+        multispeed_rom = (self.controller.method == "multispeed" and "controller" in stages
+                          and n_modes is not None and not self.rom.convective)
+        if multispeed_rom and self.rom.method != "hwl":
             raise ConfigError("controller.method = \"multispeed\" designs on the ROM loop with "
                               "the flap behind the servo at every speed of the interval, which "
                               "the ROM of eq. 8 (Σf frozen at V0) does not stand for: set "
-                              "rom.convective = true")
+                              "rom.convective = true, or identify the HWL ROM (rom.method = "
+                              "\"hwl\"), whose speed-following loop the design then uses")
+        if (multispeed_rom and isinstance(problem, AeroelasticTruth)
+                and self.rom.orders[3] < self.data.coupling_delay):
+            raise ConfigError(f"controller.method = \"multispeed\" designs on the HWL ROM made "
+                              f"to follow the wing over speed, which removes the records' "
+                              f"coupling delay ({self.data.coupling_delay} sample"
+                              f"{'s' if self.data.coupling_delay != 1 else ''}) from the "
+                              f"ROM's input delay r = {self.rom.orders[3]}: identify with r >= "
+                              f"{self.data.coupling_delay} (rom.orders[3])")
         if self.rom.convective and "controller" in stages and self.verify.sweep:
             raise ConfigError("verify.sweep sweeps the LFT frozen at Vf; with rom.convective "
                               "= true the run certifies the scaled loop itself at every "

@@ -490,20 +490,37 @@ def family_model(cfg: RunConfig, record, progress) -> tuple[ModelStage, FlutterS
 def controlled_family(cfg: RunConfig, model: ModelStage):
     """The design family of a model: its family, a ROM loop behind the flap servo.
 
+    The multi-speed design on the HWL ROM takes its loop made to follow the wing over speed
+    (:attr:`ModelStage.speed_following`): the frozen loop of eq. 8 stands for the wing near
+    V0 only, and its flutter mode's control reversal comes 30 % late on the seed wing.
+
     Parameters
     ----------
     cfg : RunConfig
-        The configuration (``controller.servo_omega``).
+        The configuration (``controller.method``, ``controller.servo_omega``).
     model : ModelStage
         The model stages' result.
 
     Returns
     -------
     PlantFamily
+
+    Raises
+    ------
+    CasflutterError
+        A multi-speed design on an HWL ROM that has no speed-following loop.
     """
     servo = cfg.controller.servo_omega
-    if model.system is not None and servo > 0:
-        return model.system.with_servo(servo)
+    system = model.system
+    if (cfg.controller.method == "multispeed" and isinstance(system, AeroelasticSystem)
+            and system.convective_V0 is None and model.rfa_system is None):
+        if model.speed_following is None:
+            raise CasflutterError("controller.method = \"multispeed\": the ROM has no loop "
+                                  "that follows the wing over speed (rom.method = \"hwl\" "
+                                  "with rom.convective = false makes one)")
+        system = model.speed_following.system
+    if system is not None and servo > 0:
+        return system.with_servo(servo)
     return model.family
 
 
