@@ -140,6 +140,22 @@ def _paper(cfg: RunConfig, P, lft) -> SynthesisResult:
                       options=options)
 
 
+def _warn_without_margins(checks: Mapping, interval, unit: str, margins) -> None:
+    """Warn, per model, where the loop is certified stable inside the requested interval but
+    its loop-at-a-time margins fall below ``margins`` there: stable, not robustly so.  The
+    multi-speed design asks only for a decay rate, and a loop that passes close to the
+    critical point meets it; the verification's robust flutter speed says where it does."""
+    lo, hi = interval
+    for name, check in checks.items():
+        robust, top = check.robust_flutter_speed, check.stable_interval
+        if robust is None or top is None or robust >= min(hi, top[1]):
+            continue
+        log.warning("controller: on %s the loop is certified stable to %.5g %s, but its "
+                    "margins (%g dB / %g deg) hold only to %.5g (%s): within the requested "
+                    "(%.5g, %.5g) it is stable, not robustly so", name, top[1], unit,
+                    margins[0], margins[1], robust, check.robust_reason, lo, hi)
+
+
 def verification_range(family, cfg: RunConfig) -> tuple[float, float]:
     """The speeds a controller is certified over: the family's own range where it is
     finite, else from 0 to the larger of the flutter search's top and the design interval's
@@ -209,6 +225,8 @@ def controller_stage(cfg: RunConfig, family, *, system=None, Vf: float | None = 
     for name, ref in dict(references).items():
         checks[name] = verify_family(ref, K, speed_range=verification_range(ref, cfg),
                                      margins=c.margins)
+    if design is not None:
+        _warn_without_margins(checks, design.interval, family.speed_unit, c.margins)
     ver = sweep = None
     if lft is not None:
         ver = verify_controller(lft.P, K, lft.nmeas, lft.ncon, Vf=Vf, n_delta=lft.n_delta)
