@@ -151,9 +151,10 @@ def _warn_without_margins(checks: Mapping, interval, unit: str, margins) -> None
         if robust is None or top is None or robust >= min(hi, top[1]):
             continue
         log.warning("controller: on %s the loop is certified stable to %.5g %s, but its "
-                    "margins (%g dB / %g deg) hold only to %.5g (%s): within the requested "
-                    "(%.5g, %.5g) it is stable, not robustly so", name, top[1], unit,
-                    margins[0], margins[1], robust, check.robust_reason, lo, hi)
+                    "margins (%g dB / %g deg) hold only to %.5g (%s): from there to %.5g, "
+                    "inside the requested (%.5g, %.5g), it is stable, not robustly so", name,
+                    top[1], unit, margins[0], margins[1], robust, check.robust_reason,
+                    min(hi, top[1]), lo, hi)
 
 
 def verification_range(family, cfg: RunConfig) -> tuple[float, float]:

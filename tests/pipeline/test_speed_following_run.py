@@ -43,8 +43,8 @@ def test_the_multispeed_design_is_made_on_the_loop_that_follows_the_wing(
     with the design) and finds it decaying at 15 speeds of the interval, which reaches 34 %
     above the wing's flutter speed; the run certifies the interval on it and on the wing
     itself (to 1 %, the ROM's flutter-speed error with room; measured 1.492 and 1.477).
-    The loop is held with little margin (robust flutter speed 0.37 on both, the gain margin
-    at the flap), and the run says so for each model."""
+    The run warns for each model exactly where the verification's robust flutter speed lies
+    inside the interval held (measured 0.37 on both: the gain margin at the flap)."""
     cfg = load_config(updates={
         "stages": ["controller"], "controller.method": "multispeed", "controller.order": 3,
         "controller.interval": [0.05, 1.45], "controller.hinf_speeds": 0,
@@ -62,10 +62,13 @@ def test_the_multispeed_design_is_made_on_the_loop_that_follows_the_wing(
     assert c["truth_stable_interval"][0] == 0.0
     assert c["truth_stable_interval"][1] >= 0.99 * 1.45
     warned = [r.getMessage() for r in caplog.records if "not robustly so" in r.getMessage()]
-    for model, key in (("design", "robust_flutter_speed"),
-                       ("truth", "truth_robust_flutter_speed")):
-        assert c[key] < 1.45          # the margins fail inside the interval held
-        assert any(f"on {model} " in w and f"{c[key]:.5g}" in w for w in warned), model
+    for model, key, held in (("design", "robust_flutter_speed", "stable_interval"),
+                             ("truth", "truth_robust_flutter_speed", "truth_stable_interval")):
+        robust = c[key]
+        inside = robust is not None and robust < min(1.45, c[held][1])
+        said = robust is not None and any(
+            f"on {model} " in w and f"hold only to {robust:.5g}" in w for w in warned)
+        assert said == inside, (model, robust)
 
 
 def test_the_multispeed_design_needs_the_records_delay_in_the_rom():
