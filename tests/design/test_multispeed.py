@@ -117,7 +117,7 @@ def _with_hidden_mode(rate: float) -> _Constant:
 def test_a_slow_mode_out_of_reach_sets_the_decay_rate_left_open(caplog):
     """The hidden mode decays at 0.01, below the 0.05 asked by default: the design asks for
     half of it, says so, and holds (0, 1) at that rate.  Independent check: the loop closed
-    here with python-control has the hidden mode at -0.01 and decays at every speed.  A rate
+    here with python-control keeps the hidden mode at -0.01 and decays at the rate held.  A rate
     given explicitly that the mode forbids is refused, and a hidden mode that grows makes
     every design impossible: both named before any work."""
     fam = _with_hidden_mode(0.01)
@@ -127,8 +127,8 @@ def test_a_slow_mode_out_of_reach_sets_the_decay_rate_left_open(caplog):
     assert "decays at only 0.01" in caplog.text and "asks for 0.005" in caplog.text
     assert d.decay == pytest.approx(0.005) and d.held
     poles = control.feedback(fam.plant(0.5), d.controller, sign=fam.feedback_sign).poles()
-    assert np.min(np.abs(poles + 0.01)) < 1e-12
-    assert np.max(poles.real) == pytest.approx(-0.01, abs=1e-12)
+    assert np.min(np.abs(poles + 0.01)) < 1e-9           # the hidden mode stays, unmoved
+    assert np.max(poles.real) <= -d.decay * (1 - 1e-6)   # and the loop decays at the rate
     with pytest.raises(ConfigError, match="decays at only 0.01 .* rate 0.05 asked"):
         design_over_speeds(fam, (0.0, 1.0), 1, seed=0,
                            settings=replace(settings, decay=0.05))
