@@ -13,9 +13,10 @@ a gridded family read from a file), and one of two methods:
 Then the verification layer, which shares no code with the design, certifies the controller
 on the design family and on every reference model the problem has (the truth's own
 linearisation with the flap behind the same servo): the stable speed interval, the absolute
-and robust flutter speeds and the margins (:func:`casflutter.verify.verify_family`), and, on
-a ROM loop, the paper's γ and small-gain interval of the LFT at Vf
-(:func:`casflutter.verify.verify_controller`).
+and robust flutter speeds and the margins (:func:`casflutter.verify.verify_family`), how far
+the design family's response lies from the reference's (:func:`casflutter.verify.model_mismatch`:
+where the design family's certificate stops carrying over), and, on a ROM loop, the paper's γ
+and small-gain interval of the LFT at Vf (:func:`casflutter.verify.verify_controller`).
 """
 
 from __future__ import annotations
@@ -36,13 +37,17 @@ from ..design import (MultiSpeedDesign, MultiSpeedSettings, SynthesisOptions,
                       SynthesisResult, default_objective, design_over_speeds, synthesize,
                       with_flap_rate)
 from ..errors import CasflutterError
-from ..verify import (FamilyVerification, SpeedSweep, VerificationReport, speed_sweep,
-                      verify_controller, verify_family)
+from ..verify import (FamilyVerification, ModelMismatch, SpeedSweep, VerificationReport,
+                      model_mismatch, speed_sweep, verify_controller, verify_family)
 from ._config import RunConfig
 
 __all__ = ["ControllerStage", "controller_stage"]
 
 log = logging.getLogger("casflutter.pipeline")
+
+#: speeds at which the design family's response is compared with each reference's: equally
+#: spaced over the reference's verification range, its start left out
+MISMATCH_SPEEDS = 5
 
 
 @dataclass(frozen=True)
@@ -69,6 +74,11 @@ class ControllerStage:
     checks : mapping of str to FamilyVerification
         The verification layer's certificate on each model: ``"design"`` (the design family)
         and, with a truth, ``"truth"`` (its own linearisation, flap behind the servo).
+    mismatch : mapping of str to ModelMismatch
+        For each reference of ``checks`` (the truth), how far the design family's
+        control-to-measurement response lies from it at five speeds spread over both
+        verification ranges (:func:`casflutter.verify.model_mismatch`): where a
+        certificate on the design family stops carrying over.
     design_time_s : float
         Seconds spent designing (the verification not included).
     sweep : SpeedSweep or None
@@ -86,6 +96,7 @@ class ControllerStage:
     lft: AeroelasticLFT | None = None
     verification: VerificationReport | None = None
     checks: Mapping[str, FamilyVerification] = field(default_factory=dict)
+    mismatch: Mapping[str, ModelMismatch] = field(default_factory=dict)
     design_time_s: float = float("nan")
     sweep: SpeedSweep | None = None
 
@@ -223,9 +234,20 @@ def controller_stage(cfg: RunConfig, family, *, system=None, Vf: float | None = 
     t_design = time.perf_counter() - t0
     rng = verification_range(family, cfg)
     checks = {"design": verify_family(family, K, speed_range=rng, margins=c.margins)}
+    mismatch = {}
     for name, ref in dict(references).items():
         checks[name] = verify_family(ref, K, speed_range=verification_range(ref, cfg),
                                      margins=c.margins)
+        lo, hi = verification_range(ref, cfg)
+        lo, hi = max(lo, rng[0]), min(hi, rng[1])
+        mismatch[name] = replace(model_mismatch(ref, family,
+                                                np.linspace(lo, hi, MISMATCH_SPEEDS + 1)[1:]),
+                                 model="design model", reference=name)
+        m = mismatch[name]
+        log.debug("design model against the %s: worst relative response error %s at V = %s "
+                  "(%.3g-%.3g rad per %s, the lightly damped modes)", name,
+                  ", ".join(f"{e:.3g}" for e in m.worst()),
+                  ", ".join(f"{V:.3g}" for V in m.speeds), *m.band, family.time_unit)
     if design is not None:
         _warn_without_margins(checks, design.interval, family.speed_unit, c.margins)
     ver = sweep = None
@@ -237,4 +259,5 @@ def controller_stage(cfg: RunConfig, family, *, system=None, Vf: float | None = 
                                 V=np.linspace(lo * Vf, hi * Vf, cfg.verify.n_sweep))
     return ControllerStage(controller=K, method=c.method, family=family, design=design,
                            synthesis=syn, lft=lft, verification=ver, checks=checks,
+                           mismatch=mismatch,
                            design_time_s=t_design, sweep=sweep)

@@ -633,7 +633,8 @@ class RunResult:
 
     def _controller_summary(self) -> dict | None:
         """The controller stage: order, method, the certified intervals and flutter speeds
-        on the design family and on the truth, the paper's γ, the design time."""
+        on the design family and on the truth, the design family's response error against
+        the truth (``model_error``), the paper's γ, the design time."""
         c = self.control
         if c is None:
             return None
@@ -656,6 +657,11 @@ class RunResult:
         truth = certified("truth")
         if truth:
             out.update({"truth_" + k: v for k, v in truth.items()})
+        if c.mismatch:
+            out["model_error"] = {name: {"speeds": m.speeds.tolist(),
+                                         "worst_relative_error": m.worst().tolist(),
+                                         "band": list(m.band)}
+                                  for name, m in c.mismatch.items()}
         if c.design is not None:
             d = c.design
             out.update(interval=list(d.interval), held=bool(d.held), reach=d.reached[1],

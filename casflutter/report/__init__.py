@@ -10,7 +10,7 @@ from ._html import PAPER_TABLE_I, VF_FLAG_FRACTION, flutter_speed_flags, html_re
 from ._labels import frequency_unit, sensor_labels
 from ._lco_plots import plot_bifurcation, plot_bifurcation_pair
 from ._margin_plots import (plot_closed_loop_damping, plot_family_verification,
-                            plot_margins_vs_speed)
+                            plot_margins_vs_speed, plot_model_mismatch)
 from ._pipeline_plots import plot_flap_pulses, plot_gain_ramp, plot_hankel, plot_rom_fit
 from ._run_report import figure_captions, flap_pulse_comparison, write_figures, write_html
 
@@ -20,4 +20,4 @@ __all__ = ["plot_vg_vf", "plot_root_locus", "plot_lco", "plot_pole_loci", "plot_
            "write_html", "flap_pulse_comparison", "figure_captions", "sensor_labels",
            "speed_axes", "frequency_unit", "flutter_speed_flags", "VF_FLAG_FRACTION",
            "plot_family_vg_vf", "family_branches", "plot_margins_vs_speed",
-           "plot_closed_loop_damping", "plot_family_verification"]
+           "plot_closed_loop_damping", "plot_family_verification", "plot_model_mismatch"]

@@ -1,8 +1,9 @@
 """Figures of a controller verified on a plant family (:func:`casflutter.verify.verify_family`):
 loop-at-a-time gain and phase margins against the speed at the plant inputs and outputs, with
 the thresholds and the absolute and robust flutter speeds marked, and the closed loop's
-damping against the speed.  Names and units are the family's.  Each function returns a
-Figure."""
+damping against the speed, and how far the design model's response lies from the plant's
+(:func:`casflutter.verify.model_mismatch`).  Names and units are the family's.  Each function
+returns a Figure."""
 
 from __future__ import annotations
 
@@ -10,7 +11,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-__all__ = ["plot_margins_vs_speed", "plot_closed_loop_damping", "plot_family_verification"]
+from ._labels import frequency_unit
+
+__all__ = ["plot_margins_vs_speed", "plot_closed_loop_damping", "plot_family_verification",
+           "plot_model_mismatch"]
 
 #: at most this many least-damped closed-loop eigenvalues are drawn per speed
 _N_DAMPING = 12
@@ -179,5 +183,42 @@ def plot_family_verification(result) -> Figure:
         a.tick_params(labelbottom=False)
     plot_margins_vs_speed(result, axes=axes)
     plot_closed_loop_damping(result, ax=fig.add_subplot(grid[2, :]))
+    fig.tight_layout()
+    return fig
+
+
+def plot_model_mismatch(mismatch, *, ax=None) -> Figure:
+    """The relative response error of a design model against a reference plant against the
+    frequency, one line per speed.
+
+    Parameters
+    ----------
+    mismatch : casflutter.verify.ModelMismatch
+        The comparison.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (a new figure by default).
+
+    Returns
+    -------
+    Figure
+        ``σmax(G_ref − G) / σmax(G)`` on log axes, the band of the reference's lightly damped
+        modes shaded and 10 % dotted.
+    """
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(7.5, 4.2))
+    else:
+        fig = ax.figure
+    m = mismatch
+    colours = plt.cm.viridis(np.linspace(0.0, 0.9, len(m.speeds)))
+    for k, V in enumerate(m.speeds):
+        ax.loglog(m.omega, m.relative_error[k], color=colours[k], lw=1.2,
+                  label=f"V = {V:.4g} {m.speed_unit}")
+    ax.axvspan(*m.band, color="0.9", zorder=0, label="lightly damped modes")
+    ax.axhline(0.1, color="0.3", ls=":", lw=1.0, label="10 %")
+    ax.set_xlabel(f"frequency [{frequency_unit(m.time_unit) or 'rad/s'}]")
+    ax.set_ylabel("σmax(G_ref − G) / σmax(G)")
+    ax.set_title(f"Response error of the {m.model} against the {m.reference}", fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8, ncol=2)
     fig.tight_layout()
     return fig

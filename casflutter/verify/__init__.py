@@ -7,7 +7,8 @@ paper's LFT or on any loop polynomial in the speed index (a truth's own linearis
 the time response of a loop whose speed changes under controllers switched with the speed;
 and on any plant family (:class:`casflutter.aeroelastic.PlantFamily`) the certified stable
 interval of a controller, its absolute and robust flutter speeds and its loop-at-a-time
-margins (:func:`verify_family`).
+margins (:func:`verify_family`), and how far a model family's response lies from the plant's
+it stands for (:func:`model_mismatch`).
 Uses python-control, slycot, numpy and scipy only; shares no code with
 :mod:`casflutter.design`, whose results it re-checks.
 """
@@ -23,6 +24,7 @@ from ._interval import (StabilityInterval, bialternate_sum, feedback_stability_i
 from ._io import (PlantData, controller_from_json, controller_to_json, load_controller,
                   load_plant, plant_from_json, plant_to_json, save_json)
 from ._lft import lft_closed_loop, partition_plant
+from ._mismatch import ModelMismatch, model_mismatch
 from ._margins import (LoopMargins, MarginTable, broken_loops, classical_margins, disk_margin,
                        loop_margins)
 from ._report import VerificationReport, delta_family, verify_controller, verify_lft
@@ -43,5 +45,5 @@ __all__ = [
     "verify_family", "FamilyVerification", "ClosedLoopCrossing", "FamilyController",
     "match_controller", "certified_interval", "CertifiedInterval", "PieceCertificate",
     "LoopMargins", "MarginTable", "classical_margins", "broken_loops", "loop_margins",
-    "disk_margin",
+    "disk_margin", "ModelMismatch", "model_mismatch",
 ]

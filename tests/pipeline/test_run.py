@@ -89,7 +89,7 @@ def test_summary_keys_and_table_i_structure(reduced):
     for name in ("summary.json", "rom.npz", "controller.json", "controller.mat", "report.html",
                  "fig7_rom_fit.png", "fig8_flap_pulses.png", "fig9_lco.png",
                  "fig10_pole_loci.png", "fig11_gain_ramp.png", "lco_speed_following_1p05.png",
-                 "lco_speed_following_1p2.png"):
+                 "lco_speed_following_1p2.png", "margins_truth.png", "model_error_truth.png"):
         assert (out / name).is_file(), name
     html = (out / "report.html").read_text()
     assert "data:image/png;base64," in html and "Table I" in html
