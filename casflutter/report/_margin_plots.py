@@ -187,7 +187,7 @@ def plot_family_verification(result) -> Figure:
     return fig
 
 
-def plot_model_mismatch(mismatch, *, ax=None) -> Figure:
+def plot_model_mismatch(mismatch, *, crossings=(), ax=None) -> Figure:
     """The relative response error of a design model against a reference plant against the
     frequency, one line per speed.
 
@@ -195,6 +195,11 @@ def plot_model_mismatch(mismatch, *, ax=None) -> Figure:
     ----------
     mismatch : casflutter.verify.ModelMismatch
         The comparison.
+    crossings : sequence of casflutter.verify.ClosedLoopCrossing, optional
+        Where a controller's loop on the reference loses stability
+        (:attr:`casflutter.verify.FamilyVerification.crossings`): each destabilising one is
+        marked at its frequency (a real eigenvalue at the lowest frequency drawn), so that
+        the error there can be read off.
     ax : matplotlib.axes.Axes, optional
         Where to draw (a new figure by default).
 
@@ -205,7 +210,7 @@ def plot_model_mismatch(mismatch, *, ax=None) -> Figure:
         modes shaded and 10 % dotted.
     """
     if ax is None:
-        fig, ax = plt.subplots(figsize=(7.5, 4.2))
+        fig, ax = plt.subplots(figsize=(9.0, 4.2))
     else:
         fig = ax.figure
     m = mismatch
@@ -215,10 +220,17 @@ def plot_model_mismatch(mismatch, *, ax=None) -> Figure:
                   label=f"V = {V:.4g} {m.speed_unit}")
     ax.axvspan(*m.band, color="0.9", zorder=0, label="lightly damped modes")
     ax.axhline(0.1, color="0.3", ls=":", lw=1.0, label="10 %")
+    lost = [c for c in crossings if c.direction == "destabilizing"]
+    for j, c in enumerate(lost):
+        w = max(float(c.omega), float(m.omega[0]))
+        ax.axvline(w, color="tab:red", ls="--", lw=1.0,
+                   label=f"closed loop on the {m.reference} goes unstable" if j == 0 else None)
+        ax.annotate(f"V = {c.speed:.4g}", (w, 0.02), xycoords=("data", "axes fraction"),
+                    rotation=90, va="bottom", ha="right", fontsize=7, color="tab:red")
     ax.set_xlabel(f"frequency [{frequency_unit(m.time_unit) or 'rad/s'}]")
     ax.set_ylabel("σmax(G_ref − G) / σmax(G)")
     ax.set_title(f"Response error of the {m.model} against the {m.reference}", fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8, ncol=2)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
     return fig

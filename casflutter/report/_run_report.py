@@ -228,7 +228,8 @@ def _margin_figures(out: Path, result) -> dict:
                                       out / f"margins_{name}.png")
              for name, check in result.control.checks.items()}
     for name, mismatch in result.control.mismatch.items():
-        files[f"model_error_{name}"] = _save(plot_model_mismatch(mismatch),
+        lost = result.control.checks[name].crossings
+        files[f"model_error_{name}"] = _save(plot_model_mismatch(mismatch, crossings=lost),
                                              out / f"model_error_{name}.png")
     return files
 
@@ -279,7 +280,8 @@ def figure_captions(result) -> dict:
         f"from the {name}'s at five speeds: σmax(G_{name} − G) / σmax(G) against the "
         f"frequency (0.1: a gain error of 10 % or a phase error of about 6°).  Where it is "
         f"large near the frequencies the closed loop needs, a certificate on the design model "
-        f"need not carry over to the {name}.")
+        f"need not carry over to the {name}; the red lines mark where the controller's loop "
+        f"on the {name} loses stability (speed and frequency).")
         for name in (result.control.mismatch if result.control is not None else ())})
     if result.route == "family":
         return {"vg_vf": ("V–g and V–f of the plant family's open-loop branches, crossings "

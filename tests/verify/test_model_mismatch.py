@@ -70,3 +70,22 @@ def test_families_that_cannot_be_compared_are_refused():
         model_mismatch(one, _oscillator(), [0.5])
     with pytest.raises(ValueError, match="speeds"):
         model_mismatch(_oscillator(), _oscillator(), [])
+
+
+def test_the_figure_draws_each_speed_and_marks_where_the_plant_is_lost():
+    from casflutter.report import plot_model_mismatch
+    from casflutter.verify import ClosedLoopCrossing
+
+    m = model_mismatch(_oscillator(1.1), _oscillator(), [0.5, 1.5])
+    lost = [ClosedLoopCrossing(speed=1.2, omega=12.0, direction="destabilizing", kind="flutter"),
+            ClosedLoopCrossing(speed=1.4, omega=0.0, direction="destabilizing",
+                               kind="divergence"),
+            ClosedLoopCrossing(speed=1.6, omega=30.0, direction="stabilizing", kind="flutter")]
+    ax = plot_model_mismatch(m, crossings=lost).axes[0]
+    curves = [ln for ln in ax.get_lines() if len(ln.get_xdata()) == m.omega.size]
+    assert len(curves) == 2
+    np.testing.assert_allclose(curves[1].get_ydata(), m.relative_error[1])
+    # one red line per destabilising crossing: at its frequency, a real one at the grid's start
+    marks = sorted(float(ln.get_xdata()[0]) for ln in ax.get_lines()
+                   if isinstance(ln.get_color(), str) and ln.get_color() == "tab:red")
+    assert marks == pytest.approx([m.omega[0], 12.0])
