@@ -236,9 +236,8 @@ def controller_stage(cfg: RunConfig, family, *, system=None, Vf: float | None = 
     checks = {"design": verify_family(family, K, speed_range=rng, margins=c.margins)}
     mismatch = {}
     for name, ref in dict(references).items():
-        checks[name] = verify_family(ref, K, speed_range=verification_range(ref, cfg),
-                                     margins=c.margins)
         lo, hi = verification_range(ref, cfg)
+        checks[name] = verify_family(ref, K, speed_range=(lo, hi), margins=c.margins)
         lo, hi = max(lo, rng[0]), min(hi, rng[1])
         mismatch[name] = replace(model_mismatch(ref, family,
                                                 np.linspace(lo, hi, MISMATCH_SPEEDS + 1)[1:]),

@@ -259,7 +259,13 @@ def broken_loops(P: control.StateSpace, K: control.StateSpace, sign: float, side
 
 def _omega_grid(L: control.StateSpace, n: int = 400) -> np.ndarray:
     """Log grid over the poles' range, with every pole's frequency |Im p| and modulus."""
-    p = np.asarray(L.poles())
+    return omega_grid_of(np.asarray(L.poles()), n)
+
+
+def omega_grid_of(p: np.ndarray, n: int = 400) -> np.ndarray:
+    """Log grid a decade either side of the moduli of the poles ``p``, with every pole's
+    frequency |Im p| and modulus (where the responses peak)."""
+    p = np.asarray(p)
     mag = np.abs(p[np.abs(p) > 0])
     lo = max(1e-3, 0.1 * float(mag.min())) if mag.size else 1e-2
     hi = 10.0 * float(mag.max()) if mag.size else 1e2

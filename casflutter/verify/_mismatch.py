@@ -23,8 +23,9 @@ import numpy as np
 
 from .._format import result_repr
 from ..errors import DimensionError
+from ._margins import omega_grid_of
 
-__all__ = ["ModelMismatch", "model_mismatch", "LIGHT_DAMPING"]
+__all__ = ["ModelMismatch", "model_mismatch"]
 
 
 @dataclass(frozen=True)
@@ -108,15 +109,6 @@ def _poles(reference, speeds) -> np.ndarray:
                            for V in speeds])
 
 
-def _default_omega(poles: np.ndarray, n: int) -> np.ndarray:
-    """A log grid a decade either side of the poles' magnitudes."""
-    mags = np.abs(poles)
-    mags = mags[np.isfinite(mags) & (mags > 0)]
-    if mags.size == 0:
-        return np.logspace(-2, 3, n)
-    return np.logspace(np.log10(mags.min()) - 1, np.log10(mags.max()) + 1, n)
-
-
 def _light_band(poles: np.ndarray, omega: np.ndarray) -> tuple[float, float]:
     """Half the lowest to twice the highest natural frequency of the lightly damped poles
     (the whole grid without any)."""
@@ -143,7 +135,8 @@ def model_mismatch(reference, model, speeds, omega=None, *, n_omega: int = 400
         Speeds inside both families' ranges.
     omega : sequence of float, optional
         Frequencies [rad per time unit]; default ``n_omega`` points on a log grid a decade
-        either side of the reference's open-loop pole magnitudes.
+        either side of the reference's open-loop pole moduli, with the poles' own
+        frequencies (the margins' grid, :mod:`._margins`).
     n_omega : int
         Points of the default grid.
 
@@ -178,7 +171,7 @@ def model_mismatch(reference, model, speeds, omega=None, *, n_omega: int = 400
         model.check_speed(float(V))
     controls, measurements = _channels(reference, model)
     poles = _poles(reference, speeds)
-    w = (_default_omega(poles, int(n_omega)) if omega is None
+    w = (omega_grid_of(poles[np.isfinite(poles)], int(n_omega)) if omega is None
          else np.asarray(omega, dtype=float).ravel())
     if w.size == 0 or not np.all(np.isfinite(w)) or np.any(w < 0):
         raise ValueError("omega: give one or more finite frequencies >= 0 [rad per time unit]")

