@@ -73,7 +73,10 @@ def nonsmooth_bfgs(fun: Callable, x0: np.ndarray, *, max_iter: int = 200,
     ----------
     fun : callable
         ``fun(x) -> (f, g)``: the value and a gradient where it exists (``f = inf`` marks a
-        point outside the domain; the line search then shortens the step).
+        point outside the domain; the line search then shortens the step).  ``g`` may be a
+        callable of no arguments that returns the gradient: it is called only where the
+        line search needs it (a trial step that fails the sufficient-decrease test needs
+        the value alone), which saves the gradient's cost on those steps.
     x0 : ndarray
         Start (``fun(x0)`` finite).
     max_iter : int
@@ -99,6 +102,7 @@ def nonsmooth_bfgs(fun: Callable, x0: np.ndarray, *, max_iter: int = 200,
     f = float(f)
     if not np.isfinite(f):
         return BFGSResult(x, f, 0, 1, "not finite")
+    g = _gradient(g)
     n = x.size
     H = np.eye(n)
     evaluations, history, reason, it = 1, [f], "iterations", 0
@@ -122,7 +126,7 @@ def nonsmooth_bfgs(fun: Callable, x0: np.ndarray, *, max_iter: int = 200,
             evaluations += 1
             if not np.isfinite(ft) or ft > f + c1 * t * slope:
                 hi = t              # not enough decrease: shorten
-            elif float(gt @ d) < c2 * slope:
+            elif float((gt := _gradient(gt)) @ d) < c2 * slope:
                 lo = t              # still steeply downhill: lengthen
             else:
                 accepted = True
@@ -130,7 +134,7 @@ def nonsmooth_bfgs(fun: Callable, x0: np.ndarray, *, max_iter: int = 200,
             t = 0.5 * (lo + hi) if np.isfinite(hi) else 2.0 * t
         if not accepted:
             if np.isfinite(ft) and ft < f:
-                x, f, g = xt, ft, gt
+                x, f, g = xt, ft, _gradient(gt)
             reason = "line search"
             break
         s, y = xt - x, gt - g
@@ -148,3 +152,8 @@ def nonsmooth_bfgs(fun: Callable, x0: np.ndarray, *, max_iter: int = 200,
             reason = "stalled"
             break
     return BFGSResult(x, f, it, evaluations, reason)
+
+
+def _gradient(g) -> np.ndarray:
+    """The gradient of an evaluation (``fun``'s second value, evaluated if a callable)."""
+    return np.asarray(g() if callable(g) else g, dtype=float)

@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 import scipy.linalg as sla
@@ -265,9 +265,12 @@ class SpeedLoops:
         G = L.T @ np.real(np.outer(a, b)) @ R.T
         return G[self.free]
 
-    def smoothed(self, q: np.ndarray, tau: float | None) -> tuple[float, np.ndarray]:
+    def smoothed(self, q: np.ndarray, tau: float | None, *, lazy: bool = False
+                 ) -> tuple[float, np.ndarray | Callable[[], np.ndarray]]:
         """The worst abscissa over the loops, or its log-sum-exp of temperature ``tau``
-        (``tau → 0`` is the maximum), and its gradient in ``q``."""
+        (``tau → 0`` is the maximum), and its gradient in ``q``; with ``lazy`` the gradient
+        as a callable of no arguments, which computes the eigenvectors it needs only when
+        called (:func:`._bfgs.nonsmooth_bfgs` does not, for a rejected trial step)."""
         K = self.gain(q)
         loops = [self._loop(K, j) for j in range(len(self.parts))]
         a = np.array([np.inf if lp is None else float(np.max(lp[1].real)) for lp in loops])
@@ -275,13 +278,20 @@ class SpeedLoops:
         if not np.isfinite(a[k]):
             return np.inf, np.zeros(q.size)
         if tau is None:
-            return float(a[k]), self._gradient(k, *loops[k])
-        w = np.exp((a - a[k]) / tau)
-        total = float(np.sum(w))
-        # a loop whose weight is below 1e-16 of the total adds less than that to the gradient
-        grad = sum((w[j] / total) * self._gradient(j, *loops[j]) for j in range(len(loops))
-                   if w[j] > 1e-16 * total)
-        return float(a[k] + tau * math.log(total)), grad
+            value = float(a[k])
+
+            def grad():
+                return self._gradient(k, *loops[k])
+        else:
+            w = np.exp((a - a[k]) / tau)
+            total = float(np.sum(w))
+            value = float(a[k] + tau * math.log(total))
+
+            def grad():
+                # a loop whose weight is below 1e-16 of the total adds less than that
+                return sum((w[j] / total) * self._gradient(j, *loops[j])
+                           for j in range(len(loops)) if w[j] > 1e-16 * total)
+        return value, (grad if lazy else grad())
 
 
 _GETRF, _GETRS = sla.get_lapack_funcs(("getrf", "getrs"), dtype=np.complex128)

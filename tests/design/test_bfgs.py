@@ -56,3 +56,33 @@ def test_target_and_stall_stop_early():
 def test_start_outside_the_domain_is_reported():
     res = nonsmooth_bfgs(lambda x: (np.inf, np.zeros_like(x)), np.ones(2))
     assert res.reason == "not finite" and res.iterations == 0
+
+
+def test_a_lazy_gradient_gives_the_same_iterates_and_is_called_only_where_needed():
+    """The gradient passed as a callable is evaluated only for the start and the trial steps
+    that pass the sufficient-decrease test, and the run is the eager run's, step for step
+    (the same result, iterations and evaluations)."""
+    rng = np.random.default_rng(3)
+    a, c = rng.standard_normal((5, 2)), rng.standard_normal(5)
+    calls = []
+
+    def value_and_gradient(x):
+        r = a @ x - c
+        k = int(np.argmax(np.abs(r)))
+        return float(abs(r[k])), np.sign(r[k]) * a[k]
+
+    def lazy(x):
+        v, g = value_and_gradient(x)
+
+        def gradient():
+            calls.append(1)
+            return g
+        return v, gradient
+
+    eager = nonsmooth_bfgs(value_and_gradient, np.array([3.0, -2.0]), max_iter=500)
+    res = nonsmooth_bfgs(lazy, np.array([3.0, -2.0]), max_iter=500)
+    assert np.array_equal(res.x, eager.x) and res.fun == eager.fun
+    assert (res.iterations, res.evaluations, res.reason) == \
+        (eager.iterations, eager.evaluations, eager.reason)
+    # every evaluation that was not a rejected trial step asked for its gradient once
+    assert 1 + res.iterations <= len(calls) < res.evaluations

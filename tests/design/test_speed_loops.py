@@ -53,6 +53,9 @@ def test_the_smoothed_worst_abscissa_and_its_gradient(loops, tau):
     h = 1e-6
     fd = (L.smoothed(q + h * d, tau)[0] - L.smoothed(q - h * d, tau)[0]) / (2 * h)
     assert grad @ d == pytest.approx(fd, rel=1e-5, abs=1e-8)
+    # the lazy form: the same value, and the same gradient once asked for
+    lazy_value, lazy_grad = L.smoothed(q, tau, lazy=True)
+    assert lazy_value == value and np.array_equal(lazy_grad(), grad)
 
 
 def _check_pair(M, lam, x, y):
