@@ -315,7 +315,10 @@ def test_exact_arithmetic_agrees_with_floating_point_where_it_is_clear():
 
 
 def _static_minimum(p: Partition, K0: np.ndarray, rounds: int) -> float:
-    """Local minimum over static gains of max(σ̄ T(0), σ̄ T(∞)), computed here."""
+    """Local minimum over static gains of max(σ̄ T(0), σ̄ T(∞)), computed here: Nelder-Mead
+    restarted from its last point ``rounds`` times at most, and until a restart lowers the
+    value by less than 1e-7 of it (on this nonsmooth function each restart of the simplex
+    moves on, slowly: how many it needs depends on the start)."""
     from scipy.optimize import minimize
     empty = (np.zeros((0, 0)), np.zeros((0, K0.shape[1])), np.zeros((K0.shape[0], 0)))
 
@@ -326,7 +329,9 @@ def _static_minimum(p: Partition, K0: np.ndarray, rounds: int) -> float:
     for _ in range(rounds):
         r = minimize(f, x, method="Nelder-Mead",
                      options={"maxfev": 20000, "xatol": 1e-10, "fatol": 1e-12, "adaptive": True})
-        x, val = r.x, r.fun
+        x, val, last = r.x, r.fun, val
+        if last - val < 1e-7 * abs(val):
+            break
     return float(val)
 
 
@@ -356,5 +361,5 @@ def test_he6_order0_certificate_is_reached_by_static_gains(he6):
     P, p, nmeas, ncon, _ = he6
     cert = static_direction_bound(P, nmeas, ncon, order=0, exact=True)
     K0 = np.asarray(synthesize(P, nmeas, ncon, 0, starts=1, seed=0).controller.D, float)
-    best = _static_minimum(p, K0, rounds=6)
+    best = _static_minimum(p, K0, rounds=40)
     assert cert.value * (1 - 1e-9) <= best <= cert.value * (1 + 1e-4)
