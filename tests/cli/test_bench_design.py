@@ -57,3 +57,17 @@ def test_bad_arguments_are_refused_before_any_work(tmp_path, capsys, args, words
     assert main(base + args) == 1
     assert words in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_a_problem_name_with_a_run_configuration_gives_its_design_family(tmp_path):
+    """``--problem NAME`` of a problem that ships a ``run.toml`` (as the help's ``seed_wing``)
+    is that run's design family, the same as the run configuration's file given by path:
+    here the Goland wing's RFA loop."""
+    from casflutter._resources import problems_dir
+    from casflutter.cli.bench.design import _family
+    by_name, what = _family("goland_gaf")
+    by_path, _ = _family(str(problems_dir() / "goland_gaf" / "run.toml"))
+    assert "run configuration goland_gaf" in what
+    A_name, A_path = (f.plant(1.2).A for f in (by_name, by_path))
+    assert A_name.shape == A_path.shape and A_name.shape[0] >= 10
+    assert (A_name == A_path).all()

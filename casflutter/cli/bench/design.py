@@ -34,15 +34,19 @@ __all__ = ["register", "design_records"]
 
 def _family(problem: str):
     """The family ``--problem`` names, and its description."""
+    from pathlib import Path
+
     from ...aeroelastic import load_family
-    from ...pipeline import design_family, load_config
+    from ...pipeline import config_path, design_family, load_config
 
     try:
         fam = load_family(problem)
         return fam, f"plant family {problem}"
     except ConfigError as family_error:
         try:
-            cfg = load_config(problem)
+            # a RUN.toml file, else a problems/ name with a run.toml
+            path = problem if Path(problem).is_file() else config_path(problem, "run")
+            cfg = load_config(path)
         except ConfigError:
             raise ConfigError(f"--problem {problem!r} is neither a plant family ({family_error}) "
                               "nor a run configuration (a problems/ name with a run.toml, or "
