@@ -59,7 +59,7 @@ def test_bad_arguments_are_refused_before_any_work(tmp_path, capsys, args, words
     assert not out.exists()
 
 
-def test_a_problem_name_with_a_run_configuration_gives_its_design_family(tmp_path):
+def test_a_problem_name_with_a_run_configuration_gives_its_design_family():
     """``--problem NAME`` of a problem that ships a ``run.toml`` (as the help's ``seed_wing``)
     is that run's design family, the same as the run configuration's file given by path:
     here the Goland wing's RFA loop."""
