@@ -236,13 +236,13 @@ def controller_stage(cfg: RunConfig, family, *, system=None, Vf: float | None = 
     checks = {"design": verify_family(family, K, speed_range=rng, margins=c.margins)}
     mismatch = {}
     for name, ref in dict(references).items():
-        lo, hi = verification_range(ref, cfg)
-        checks[name] = verify_family(ref, K, speed_range=(lo, hi), margins=c.margins)
-        lo, hi = max(lo, rng[0]), min(hi, rng[1])
-        mismatch[name] = replace(model_mismatch(ref, family,
-                                                np.linspace(lo, hi, MISMATCH_SPEEDS + 1)[1:]),
-                                 model="design model", reference=name)
-        m = mismatch[name]
+        ref_range = verification_range(ref, cfg)
+        checks[name] = verify_family(ref, K, speed_range=ref_range, margins=c.margins)
+        # the speeds both verification ranges share, their start left out
+        lo, hi = max(ref_range[0], rng[0]), min(ref_range[1], rng[1])
+        m = replace(model_mismatch(ref, family, np.linspace(lo, hi, MISMATCH_SPEEDS + 1)[1:]),
+                    model="design model", reference=name)
+        mismatch[name] = m
         log.debug("design model against the %s: worst relative response error %s at V = %s "
                   "(%.3g-%.3g rad per %s, the lightly damped modes)", name,
                   ", ".join(f"{e:.3g}" for e in m.worst()),

@@ -268,14 +268,14 @@ def figure_captions(result) -> dict:
         Figure name -> caption.
     """
     cfg = result.config
-    margins = {f"margins_{name}": (
+    control = {f"margins_{name}": (
         f"Loop-at-a-time gain and phase margins at the plant inputs and outputs against the "
         f"speed, and the closed-loop damping, of the controller on the {name} model "
         f"({check.family}); the thresholds {check.gain_margin_db:g} dB / "
         f"{check.phase_margin_deg:g}° are dashed, the absolute and robust flutter speeds marked.")
         for name, check in (result.control.checks.items() if result.control is not None
                             else ())}
-    margins.update({f"model_error_{name}": (
+    control.update({f"model_error_{name}": (
         f"How far the design model's response from the controls to the measurements lies "
         f"from the {name}'s at five speeds: σmax(G_{name} − G) / σmax(G) against the "
         f"frequency (0.1: a gain error of 10 % or a phase error of about 6°).  Where it is "
@@ -285,7 +285,7 @@ def figure_captions(result) -> dict:
         for name in (result.control.mismatch if result.control is not None else ())})
     if result.route == "family":
         return {"vg_vf": ("V–g and V–f of the plant family's open-loop branches, crossings "
-                          "marked."), **margins}
+                          "marked."), **control}
     if result.identification is None:   # a GAF wing file: the RFA's V-g/V-f only
         return {"vg_vf": "V–g and V–f of ΣAE(V) with Σf frozen at the flutter airspeed.",
                 "vg_vf_airspeed": ("V–g and V–f of the RFA's ΣAE(U) against the airspeed: the "
@@ -368,7 +368,7 @@ def figure_captions(result) -> dict:
                else f"limited to {np.degrees(ss.flap_rate_limit):.3g} deg/s")
             + ". Attenuation = 1 - RMS(last third of the full gain) / RMS(open-loop "
             f"LCO) of the dominant sensor. {each}.")
-    cap.update(margins)
+    cap.update(control)
     return cap
 
 

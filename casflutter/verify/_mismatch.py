@@ -113,8 +113,7 @@ def _light_band(poles: np.ndarray, omega: np.ndarray) -> tuple[float, float]:
     """Half the lowest to twice the highest natural frequency of the lightly damped poles
     (the whole grid without any)."""
     wn = np.abs(poles)
-    light = np.isfinite(wn) & (wn > 0) & (poles.imag > 0)
-    light &= -poles.real < LIGHT_DAMPING * np.where(wn > 0, wn, 1.0)
+    light = np.isfinite(wn) & (poles.imag > 0) & (-poles.real < LIGHT_DAMPING * wn)
     if not np.any(light):
         return float(omega.min()), float(omega.max())
     return 0.5 * float(wn[light].min()), 2.0 * float(wn[light].max())

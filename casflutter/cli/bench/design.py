@@ -34,8 +34,6 @@ __all__ = ["register", "design_records"]
 
 def _family(problem: str):
     """The family ``--problem`` names, and its description."""
-    from pathlib import Path
-
     from ...aeroelastic import load_family
     from ...pipeline import config_path, design_family, load_config
 
