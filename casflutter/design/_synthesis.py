@@ -188,12 +188,15 @@ class StartRecord:
     stab_iterations, outer_iterations : int
         Iterations of the two phases.
     converged : bool
-        True when the stopping test (model sees no decrease) was met.
+        True when the stopping test was met: the local model sees no decrease within a
+        trust region no smaller than a tenth of the first one.
     wall_time : float
         Seconds spent on this start.
     status : str
         ``"converged"`` (the stopping test met), ``"stopped"`` (iteration or time budget
-        spent, stalled, or abandoned for a far better start), ``"not-stabilized"`` (no stable,
+        spent, stalled, abandoned for a far better start, or the trust region collapsed:
+        trial points that left the feasible set or did not decrease shrank it until the
+        local model, which still predicts a decrease, could not be followed), ``"not-stabilized"`` (no stable,
         well-posed loop at the end of the stabilisation phase) or ``"failed"`` (a numerical
         failure ended the start: a singular loop or Hamiltonian, non-finite numbers, a solver
         that did not converge; see ``reason``).
@@ -448,6 +451,15 @@ class _Phase:
             gscale = float(np.max(gnorm[act]))
         return max(1e-8, 0.1 * gscale / delta0) * np.eye(self.prob.n)
 
+    def _stationary(self, H: np.ndarray, fv: np.ndarray, G: np.ndarray, con: list,
+                    delta: np.ndarray, tol: float) -> bool:
+        """Whether the local model predicts a decrease below ``tol`` within ``delta``."""
+        step = self.qp.solve(H, fv, G, np.minimum(np.array([c.value for c in con]), 0.0),
+                             np.array([c.grad for c in con]).reshape(len(con), self.prob.n),
+                             delta)
+        self.statuses.append(step.status)
+        return -step.model <= tol
+
     def _updated(self, H: np.ndarray, step, obj: list, con: list, Kn: np.ndarray
                  ) -> tuple[np.ndarray, bool]:
         """The damped BFGS update of the Lagrangian's curvature after an accepted step, and
@@ -507,7 +519,15 @@ class _Phase:
             pred_rel = pred / scale
             if pred <= opts.tol * scale:
                 if fresh:
-                    converged = True
+                    # a radius that rejected trial points have shrunk far below the first
+                    # one predicts little whether or not the model is stationary: converged
+                    # only if the model sees no decrease at a tenth of the first radius
+                    converged = delta >= 0.1 * delta0 or self._stationary(
+                        H, fv, G, con, 0.1 * delta0 * free, opts.tol * scale)
+                    if not converged:
+                        log.debug("%s %s it %d: stopped, the trust region collapsed to %.3g "
+                                  "(the model predicts a decrease its trial points do not "
+                                  "give)", label, self.kind, it, delta)
                     break
                 # the quasi-Newton curvature may hide a descent direction (kinks inflate it):
                 # decide on a fresh model before stopping
@@ -821,9 +841,10 @@ def _run_start(prob: Problem, qp: CutQP, opts: SynthesisOptions, s: int, kind: s
         hist, conv, outer, pred = r2.history, r2.converged, r2.iterations, r2.pred
         a_h = float(np.max(prob.alphas(K)[0])) * prob.w0
         log.debug("%s: gamma %.6g after %d H-inf iterations (%s)", label, gam, outer,
-                 "converged" if conv else "budget spent")
+                 "converged" if conv else "stopped")
         status, reason = ("converged", "") if conv else (
-            "stopped", "iteration or time budget spent, stalled or abandoned")
+            "stopped", "iteration or time budget spent, stalled, abandoned, or the trust "
+            "region collapsed")
         if not np.isfinite(gam):
             status, reason = "failed", "no finite norm at the stabilised gain"
     else:
