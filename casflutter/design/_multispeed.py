@@ -27,7 +27,8 @@ hinfstruct/systune (the worst case over a set of models), with the speeds as the
    continued in speed: starting where a controller already decays, one end is pushed towards
    the target, the step growing 1.5x after a success and halving after a failure.
 2. **Starts.**  From the low end (where the open loop is usually stable) the target order is
-   continued from the zero controller and from seeded random ones.  When none reaches the top,
+   continued from a seeded controller with small couplings (near zero) and from seeded
+   random ones with larger couplings.  When none reaches the top,
    a full-order observer-based (LQG) controller of the plant at the top is continued down to
    the low end (more states give the continuation room to pass a control reversal, where the
    phase a controller needs flips), and its order is then lowered to the target one step at a
@@ -118,7 +119,8 @@ class MultiSpeedSettings:
     measurements directly (a feed-through would close an algebraic loop that can become
     singular at some speed)."""
     random_starts: int = 2
-    """Seeded random starts at the target order from the low end (after the zero start)."""
+    """Seeded random starts at the target order from the low end, after the first one (a
+    seeded controller with small couplings, near zero)."""
     full_order: bool = True
     """Continue a full-order LQG controller of the top speed down to the low end, and lower
     its order, when no low-order start reaches the top."""
@@ -176,7 +178,8 @@ class HoldRecord:
     Attributes
     ----------
     kind : str
-        ``"given"``, ``"zero"``, ``"random"`` or ``"full-order"``.
+        ``"given"`` (a controller the caller gave), ``"random"`` (a seeded one) or
+        ``"full-order"``.
     order : int
         Order of the controller it ended with.
     reached : tuple of float

@@ -41,7 +41,7 @@ from ..verify import (FamilyVerification, ModelMismatch, SpeedSweep, Verificatio
                       model_mismatch, speed_sweep, verify_controller, verify_family)
 from ._config import RunConfig
 
-__all__ = ["ControllerStage", "controller_stage"]
+__all__ = ["ControllerStage", "controller_stage", "multispeed_settings"]
 
 log = logging.getLogger("casflutter.pipeline")
 
@@ -122,6 +122,31 @@ def _paper_plant(system, Vf: float, cfg: RunConfig):
     return lft, [plant(float(f)) for f in c.speeds]
 
 
+def multispeed_settings(cfg: RunConfig, objective: str) -> MultiSpeedSettings:
+    """The multi-speed design's settings of a run configuration's ``[controller]`` table.
+
+    Parameters
+    ----------
+    cfg : RunConfig
+        The run configuration.
+    objective : {"lft", "sensors", "sensitivity"}
+        The H∞ objective, resolved (``"auto"`` chosen by the caller).
+
+    Returns
+    -------
+    MultiSpeedSettings
+    """
+    c = cfg.controller
+    return MultiSpeedSettings(
+        decay=c.interval_decay, n_speeds=c.n_speeds, hinf_speeds=c.hinf_speeds,
+        rate_weight=c.flap_rate_weight, rate_bandwidth=c.flap_rate_bandwidth,
+        sensitivity=objective == "sensitivity",
+        strictly_proper=c.strictly_proper, random_starts=c.random_starts,
+        full_order=c.full_order, reduction_orders=c.reduction_orders,
+        synthesis=replace(settings_as(c, SynthesisOptions), ipopt={**cfg.solver.ipopt,
+                                                                   **c.ipopt}))
+
+
 def _multispeed(cfg: RunConfig, family, lft_plants=None) -> MultiSpeedDesign:
     c = cfg.controller
     if c.hinf_objective == "lft" and lft_plants is None:
@@ -132,16 +157,9 @@ def _multispeed(cfg: RunConfig, family, lft_plants=None) -> MultiSpeedDesign:
     if objective == "auto":
         objective = "lft" if lft_plants is not None else default_objective(family)
     hinf = lft_plants if objective == "lft" and c.hinf_speeds else None
-    settings = MultiSpeedSettings(
-        decay=c.interval_decay, n_speeds=c.n_speeds, hinf_speeds=c.hinf_speeds,
-        rate_weight=c.flap_rate_weight, rate_bandwidth=c.flap_rate_bandwidth,
-        sensitivity=objective == "sensitivity",
-        strictly_proper=c.strictly_proper, random_starts=c.random_starts,
-        full_order=c.full_order, reduction_orders=c.reduction_orders,
-        synthesis=replace(settings_as(c, SynthesisOptions), ipopt={**cfg.solver.ipopt,
-                                                                   **c.ipopt}))
-    return design_over_speeds(family, tuple(c.interval), c.order, settings=settings,
-                              seed=cfg.seed, hinf_plants=hinf)
+    return design_over_speeds(family, tuple(c.interval), c.order,
+                              settings=multispeed_settings(cfg, objective), seed=cfg.seed,
+                              hinf_plants=hinf)
 
 
 def _paper(cfg: RunConfig, P, lft) -> SynthesisResult:

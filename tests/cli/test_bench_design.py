@@ -65,9 +65,46 @@ def test_a_problem_name_with_a_run_configuration_gives_its_design_family():
     here the Goland wing's RFA loop."""
     from casflutter._resources import problems_dir
     from casflutter.cli.bench.design import _family
-    by_name, what = _family("goland_gaf")
-    by_path, _ = _family(str(problems_dir() / "goland_gaf" / "run.toml"))
+    by_name, what, _ = _family("goland_gaf")
+    by_path, _, _ = _family(str(problems_dir() / "goland_gaf" / "run.toml"))
     assert "run configuration goland_gaf" in what
     A_name, A_path = (f.plant(1.2).A for f in (by_name, by_path))
     assert A_name.shape == A_path.shape and A_name.shape[0] >= 10
     assert (A_name == A_path).all()
+
+
+@pytest.mark.parametrize("problem, from_run", [("goland_gaf", True), ("goland_4flaps", False)])
+def test_a_run_configuration_designs_with_its_controller_settings(tmp_path, monkeypatch,
+                                                                  problem, from_run):
+    """The bench measures the design ``casflutter run`` makes: a run configuration's
+    ``[controller]`` settings (goland_gaf's: no full-order start, ``Dk = 0``, 40 H-inf
+    iterations), a family file the design's defaults."""
+    import casflutter.design as design
+    from casflutter.errors import SynthesisError
+    from casflutter.pipeline import config_path, load_config
+
+    seen = []
+
+    def capture(family, interval, order, *, settings, seed):
+        seen.append(settings)
+        raise SynthesisError("captured")
+
+    monkeypatch.setattr(design, "design_over_speeds", capture)
+    out = tmp_path / "b.json"
+    assert main(["-q", "bench", "design", "--problem", problem, "--interval", "100", "130",
+                 "--orders", "2", "--seeds", "0", "--out", str(out)]) == 0
+    (settings,) = seen
+    (rec,) = json.loads(out.read_text())["records"]
+    assert rec["status"] == "failed: captured" and rec["held"] is False
+    if from_run:
+        c = load_config(config_path(problem, "run")).controller
+        assert (settings.full_order, settings.strictly_proper, settings.random_starts,
+                settings.n_speeds) == (c.full_order, c.strictly_proper, c.random_starts,
+                                       c.n_speeds)
+        assert settings.synthesis.max_outer == c.max_outer == 40
+        assert settings.full_order is False
+    else:
+        defaults = MultiSpeedSettings()
+        assert (settings.full_order, settings.random_starts, settings.synthesis.max_outer) \
+            == (defaults.full_order, defaults.random_starts, defaults.synthesis.max_outer)
+        assert settings.full_order is True

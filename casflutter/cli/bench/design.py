@@ -14,7 +14,12 @@ what it finished; ``--out`` is checked before any work.
 ``--problem`` names a plant family (a ``kind = "plant_family"`` file or a folder of
 ``problems/`` holding one) or a run configuration (a ``problems/`` name with a ``run.toml``,
 or a ``RUN.toml`` path), whose model stages build the family the run designs on (for the
-seed wing: the ROM loop that follows the wing over speed, flap behind its servo).
+seed wing: the ROM loop that follows the wing over speed, flap behind its servo).  A run
+configuration's ``[controller]`` table gives the design's settings (starts, speeds, decay
+rate, flap-rate weight, budgets), so the bench measures the design that ``casflutter run``
+makes; its H∞ objective too, except the paper's LFT (``"lft"``), which needs the ROM loop's
+flutter speed and is replaced by the family's own (``--objective auto``).  A family file
+takes the defaults of :class:`casflutter.design.MultiSpeedSettings`.
 """
 
 from __future__ import annotations
@@ -23,6 +28,7 @@ import argparse
 import json
 import statistics
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -33,13 +39,14 @@ __all__ = ["register", "design_records"]
 
 
 def _family(problem: str):
-    """The family ``--problem`` names, and its description."""
+    """The family ``--problem`` names, its description, and the run configuration it comes
+    from (``None`` for a family file)."""
     from ...aeroelastic import load_family
     from ...pipeline import config_path, design_family, load_config
 
     try:
         fam = load_family(problem)
-        return fam, f"plant family {problem}"
+        return fam, f"plant family {problem}", None
     except ConfigError as family_error:
         try:
             # a RUN.toml file, else a problems/ name with a run.toml
@@ -49,7 +56,8 @@ def _family(problem: str):
             raise ConfigError(f"--problem {problem!r} is neither a plant family ({family_error}) "
                               "nor a run configuration (a problems/ name with a run.toml, or "
                               "a RUN.toml file)") from None
-        return design_family(cfg), f"the design family of the run configuration {problem}"
+        return (design_family(cfg), f"the design family of the run configuration {problem}",
+                cfg)
 
 
 def _ints(text: str, what: str, low: int) -> list[int]:
@@ -63,8 +71,8 @@ def _ints(text: str, what: str, low: int) -> list[int]:
 
 
 def design_records(family, interval, orders, seeds, *, problem: str = "",
-                   decay: float | None = None,
-                   objective: str = "auto", on_record=None) -> list[dict[str, Any]]:
+                   decay: float | None = None, objective: str = "auto", settings=None,
+                   on_record=None) -> list[dict[str, Any]]:
     """Design at every order and seed and certify each controller on the family.
 
     Parameters
@@ -78,13 +86,16 @@ def design_records(family, interval, orders, seeds, *, problem: str = "",
     problem : str
         The name written in each record.
     decay : float, optional
-        Decay rate required at every speed [rad per time unit] (default: chosen by
-        :class:`casflutter.design.MultiSpeedSettings`; each record says which).
+        Decay rate required at every speed [rad per time unit] (default: the settings',
+        else chosen by :class:`casflutter.design.MultiSpeedSettings`; each record says
+        which).
     objective : {"auto", "sensors", "sensitivity"}
         The H∞ phase's channels (:class:`casflutter.design.MultiSpeedSettings`):
         the family's disturbances to its measurements, or the loop's output and input
         sensitivities (the per-loop margins); ``"auto"``: ``"sensors"`` when the family
         names disturbance inputs, else ``"sensitivity"``.
+    settings : MultiSpeedSettings, optional
+        The design's other settings (default: the class's defaults).
     on_record : callable, optional
         Called with each record as it is finished.
 
@@ -99,7 +110,9 @@ def design_records(family, interval, orders, seeds, *, problem: str = "",
     sig, nx = family.signals, family.n_states
     if objective == "auto":
         objective = default_objective(family)
-    settings = MultiSpeedSettings(decay=decay, sensitivity=objective == "sensitivity")
+    base = MultiSpeedSettings() if settings is None else settings
+    settings = replace(base, decay=base.decay if decay is None else decay,
+                       sensitivity=objective == "sensitivity")
     records = []
     for order in orders:
         for seed in seeds:
@@ -169,9 +182,19 @@ def _handler(args: argparse.Namespace) -> int:
     if not lo < hi:
         raise ConfigError(f"--interval {lo} {hi}: need LO < HI")
     out = check_output_path(args.out, what="--out", suffixes=(".json",))
-    family, about = _family(args.problem)
+    family, about, cfg = _family(args.problem)
+    objective, settings = args.objective, None
+    if cfg is not None:
+        from ...pipeline import multispeed_settings
+
+        ran = cfg.controller.hinf_objective
+        if objective == "auto" and ran in ("sensors", "sensitivity"):
+            objective = ran
+        settings = multispeed_settings(cfg, objective)
     meta = {"problem": args.problem, "family": about, "decay": args.decay,
-            "objective": args.objective, "provenance": provenance()}
+            "objective": objective,
+            "settings": "the run configuration's [controller]" if cfg is not None
+            else "MultiSpeedSettings' defaults", "provenance": provenance()}
     records: list = []
 
     def keep(rec):
@@ -179,7 +202,7 @@ def _handler(args: argparse.Namespace) -> int:
         _write(out, records, meta)
 
     design_records(family, (lo, hi), orders, seeds, problem=args.problem, decay=args.decay,
-                   objective=args.objective, on_record=keep)
+                   objective=objective, settings=settings, on_record=keep)
     return 0
 
 
@@ -189,7 +212,8 @@ def register(subparsers) -> None:
                                              "family; writes JSON")
     p.add_argument("--problem", required=True, metavar="P_OR_FILE",
                    help="a plant family (file or problems/ name) or a run configuration "
-                        "whose design family is used (e.g. seed_wing)")
+                        "whose design family and [controller] settings are used (e.g. "
+                        "seed_wing)")
     p.add_argument("--interval", nargs=2, type=float, required=True, metavar=("LO", "HI"),
                    help="the speeds to hold, in the family's speed unit")
     p.add_argument("--orders", default="2,3,4", help="comma-separated controller orders")
