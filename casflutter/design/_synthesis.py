@@ -195,9 +195,9 @@ class StartRecord:
     status : str
         ``"converged"`` (the stopping test met), ``"stopped"`` (iteration or time budget
         spent, stalled, abandoned for a far better start, or the trust region collapsed:
-        trial points that left the feasible set or did not decrease shrank it until the
-        local model, which still predicts a decrease, could not be followed), ``"not-stabilized"`` (no stable,
-        well-posed loop at the end of the stabilisation phase) or ``"failed"`` (a numerical
+        trial points that left the feasible set or did not decrease shrank it while the
+        local model still predicts a decrease), ``"not-stabilized"`` (no stable, well-posed
+        loop at the end of the stabilisation phase) or ``"failed"`` (a numerical
         failure ended the start: a singular loop or Hamiltonian, non-finite numbers, a solver
         that did not converge; see ``reason``).
     reason : str

@@ -129,8 +129,9 @@ def multispeed_settings(cfg: RunConfig, objective: str) -> MultiSpeedSettings:
     ----------
     cfg : RunConfig
         The run configuration.
-    objective : {"lft", "sensors", "sensitivity"}
-        The H∞ objective, resolved (``"auto"`` chosen by the caller).
+    objective : str
+        The H∞ objective (``[controller] hinf_objective`` or the caller's choice): the
+        settings bound the loop's sensitivities when it is ``"sensitivity"``.
 
     Returns
     -------
