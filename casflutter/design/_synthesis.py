@@ -496,7 +496,7 @@ class _Phase:
         memory: list[list[float]] = [[] for _ in prob.aug]
         delta0 = delta = opts.trust_region * max(1.0, float(np.max(np.abs(K))))
         H, fresh, cuts = None, True, None
-        converged, it, pred_rel = False, 0, np.inf
+        converged, collapsed, it, pred_rel = False, False, 0, np.inf
         for it in range(1, max_iter + 1):
             if self.done(f) or time.perf_counter() > self.deadline or \
                     self._stop(it, f, history, history_at, label):
@@ -524,7 +524,8 @@ class _Phase:
                     # only if the model sees no decrease at a tenth of the first radius
                     converged = delta >= 0.1 * delta0 or self._stationary(
                         H, fv, G, con, 0.1 * delta0 * free, opts.tol * scale)
-                    if not converged:
+                    collapsed = not converged
+                    if collapsed:
                         log.debug("%s %s it %d: stopped, the trust region collapsed to %.3g "
                                   "(the model predicts a decrease its trial points do not "
                                   "give)", label, self.kind, it, delta)
@@ -560,14 +561,18 @@ class _Phase:
             log.debug("%s %s it %d: rejected (ratio %.3g), radius %.3g", label, self.kind, it,
                       ratio, delta)
             if delta < 1e-10 * max(1.0, float(np.max(np.abs(K)))):
+                collapsed = True
                 break
-        return _PhaseResult(K, float(f), tuple(history), converged, it, float(pred_rel))
+        return _PhaseResult(K, float(f), tuple(history), converged, it, float(pred_rel),
+                            collapsed)
 
 
 @dataclass(frozen=True)
 class _PhaseResult:
     """Where a phase ended: the gain, its objective, the accepted objectives, whether the
-    stopping test was met, the iterations and the last model's relative decrease."""
+    stopping test was met, the iterations, the last model's relative decrease, and whether
+    the trust region collapsed (rejected trial points shrank it while the model still
+    predicts a decrease)."""
 
     K: np.ndarray
     f: float
@@ -575,6 +580,7 @@ class _PhaseResult:
     converged: bool
     iterations: int
     pred: float
+    collapsed: bool = False
 
 
 def _stalled(history: list, at: list, it: int, window: int, tol: float) -> bool:
@@ -843,8 +849,10 @@ def _run_start(prob: Problem, qp: CutQP, opts: SynthesisOptions, s: int, kind: s
         log.debug("%s: gamma %.6g after %d H-inf iterations (%s)", label, gam, outer,
                  "converged" if conv else "stopped")
         status, reason = ("converged", "") if conv else (
-            "stopped", "iteration or time budget spent, stalled, abandoned, or the trust "
-            "region collapsed")
+            "stopped", "the trust region collapsed: trial steps did not give the decrease "
+            "the local model predicts (a kink the model does not resolve, as at a nonsmooth "
+            "local minimum, or a constraint the step leaves)" if r2.collapsed else
+            "iteration or time budget spent, stalled or abandoned")
         if not np.isfinite(gam):
             status, reason = "failed", "no finite norm at the stabilised gain"
     else:

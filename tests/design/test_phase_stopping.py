@@ -52,13 +52,13 @@ def test_a_collapsed_trust_region_is_not_called_converged():
     # decrease (proportional to it) is below the tolerance, while the model still sees a
     # first-order decrease of |g|_1 per unit step
     res = _phase(_Linear, wall=True).run(np.zeros((1, _N)), "test", 200)
-    assert not res.converged
+    assert not res.converged and res.collapsed
     assert res.f == 1.0 and len(res.history) == 1     # nothing accepted, the start kept
 
 
 def test_a_stationary_model_is_converged():
     res = _phase(_Flat).run(np.zeros((1, _N)), "test", 200)
-    assert res.converged
+    assert res.converged and not res.collapsed
     assert res.iterations == 1
 
 
@@ -66,5 +66,5 @@ def test_a_descent_is_followed_and_not_called_converged():
     # a linear objective is unbounded below: the steps are accepted and grow; the budget
     # ends the phase
     res = _phase(_Linear).run(np.zeros((1, _N)), "test", 12)
-    assert not res.converged
+    assert not res.converged and not res.collapsed
     assert res.f < 1.0 - 1.0 and len(res.history) > 5
