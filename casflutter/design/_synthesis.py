@@ -451,14 +451,14 @@ class _Phase:
             gscale = float(np.max(gnorm[act]))
         return max(1e-8, 0.1 * gscale / delta0) * np.eye(self.prob.n)
 
-    def _stationary(self, H: np.ndarray, fv: np.ndarray, G: np.ndarray, con: list,
-                    delta: np.ndarray, tol: float) -> bool:
-        """Whether the local model predicts a decrease below ``tol`` within ``delta``."""
+    def _step(self, H: np.ndarray, fv: np.ndarray, G: np.ndarray, con: list,
+              delta: np.ndarray):
+        """The trust-region QP's step within the box ``delta`` (its status recorded)."""
         step = self.qp.solve(H, fv, G, np.minimum(np.array([c.value for c in con]), 0.0),
                              np.array([c.grad for c in con]).reshape(len(con), self.prob.n),
                              delta)
         self.statuses.append(step.status)
-        return -step.model <= tol
+        return step
 
     def _updated(self, H: np.ndarray, step, obj: list, con: list, Kn: np.ndarray
                  ) -> tuple[np.ndarray, bool]:
@@ -510,10 +510,7 @@ class _Phase:
             fv = np.array([c.value for c in obj]) - f
             if H is None:
                 H, fresh = self._curvature(fv, G, f, delta0), True
-            step = self.qp.solve(H, fv, G, np.minimum(np.array([c.value for c in con]), 0.0),
-                                 np.array([c.grad for c in con]).reshape(len(con), prob.n),
-                                 delta * free)
-            self.statuses.append(step.status)
+            step = self._step(H, fv, G, con, delta * free)
             pred = -step.model
             scale = max(abs(f), 1e-12) if self.kind == "hinf" else max(abs(f), self.margin)
             pred_rel = pred / scale
@@ -522,8 +519,8 @@ class _Phase:
                     # a radius that rejected trial points have shrunk far below the first
                     # one predicts little whether or not the model is stationary: converged
                     # only if the model sees no decrease at a tenth of the first radius
-                    converged = delta >= 0.1 * delta0 or self._stationary(
-                        H, fv, G, con, 0.1 * delta0 * free, opts.tol * scale)
+                    converged = delta >= 0.1 * delta0 or -self._step(
+                        H, fv, G, con, 0.1 * delta0 * free).model <= opts.tol * scale
                     collapsed = not converged
                     if collapsed:
                         log.debug("%s %s it %d: stopped, the trust region collapsed to %.3g "

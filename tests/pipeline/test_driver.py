@@ -237,7 +237,7 @@ def test_plant_and_controller_files_reproduce_the_verification(study, tmp_path, 
         assert got[key] == pytest.approx(list(getattr(ver, key)), rel=1e-6), key
 
 
-def test_the_controller_is_certified_on_the_truth_as_well(study):
+def test_the_controller_is_certified_on_the_truth_as_well(study, wing_sensor_plant):
     """The run's controller on the truth's own linearisation (flap behind the servo of
     controller.servo_omega): the certified interval against eigenvalues computed here
     from the truth's state space, its accelerometer rows and python-control's feedback."""
@@ -245,13 +245,9 @@ def test_the_controller_is_certified_on_the_truth_as_well(study):
     lower, upper = r.truth_stable_V
     assert lower < r.config.data.V0 < upper
     servo = r.config.controller.servo_omega
-    N = r.truth.n_modes
-    Hs = r.system.structure.Hs
 
     def worst(V):
-        P = r.truth.statespace(V, actuator_omega=servo)
-        A, B = np.asarray(P.A), np.asarray(P.B)[:, :1]
-        G = control.ss(A, B, Hs @ A[N:2 * N], Hs @ B[N:2 * N])     # zm = Hs ü
+        G = wing_sensor_plant(r, V)
         return float(np.max(control.feedback(G, r.controller, sign=1).poles().real))
 
     assert worst(0.5 * (max(lower, 0.05) + upper)) < 0
