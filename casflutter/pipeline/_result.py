@@ -592,7 +592,9 @@ class RunResult:
                 "V_flutter": stage.V_flutter, "flutter_of": stage.reference,
                 "flap_limit": cfg.flap_limit, "flap_rate_limit": cfg.flap_rate_limit,
                 "gust_intensity": cfg.gust_intensity, "gust_scale": cfg.gust_scale,
-                "noise": cfg.noise, "runs": [r.record() for r in stage.runs]}
+                "noise": cfg.noise,
+                "runs": [dict(r.record(), linear_loop_certified=ok)
+                         for r, ok in zip(stage.runs, stage.linear_loop_certified)]}
 
     def _rfa_summary(self) -> dict:
         """The RFA, its flutter in m/s and rad/s and the p–k check (GAF wing files)."""

@@ -322,9 +322,12 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
                                   flutters.truth, cfg.sensors.rows or None)
     if "suppression" in cfg.stages and "suppression" not in skipped:
         with progress.stage("suppression"):
+            truth_check = control_stage.checks.get("truth")
             sup = suppression_stage(cfg, truth, flutters, lco, control_stage.controller,
                                     mode=_mode(flutters.rom),
-                                    dt=model.identification.model.dt)
+                                    dt=model.identification.model.dt,
+                                    certified=None if truth_check is None
+                                    else truth_check.stable_interval)
     timings = dict(progress.timings, total=time.perf_counter() - progress.t0)
     result = RunResult(config=cfg, problem=problem, route=route.kind, model=model,
                        flutters=flutters, lco=lco, control=control_stage, closed_loop=closed,

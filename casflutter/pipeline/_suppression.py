@@ -6,6 +6,14 @@ controller's gain is ramped 0 -> 1, held and released, in the tunnel's turbulenc
 sensors and through the flap servo with its travel and rate limits
 (:func:`casflutter.truth.suppression_runs`).  The attenuation of each run is
 ``1 - rms(closed loop, hold) / rms(open-loop LCO)`` of the dominant sensor.
+
+An attenuation means a suppressed LCO only where the truth's linearised loop with the
+controller is stable at that speed.  Where it is not, the servo's limits bound an oscillation
+that the controller itself drives, and the sensors' rms can still fall below the open loop's
+LCO (on the seed wing, a controller whose linearised loop is unstable from V = 0.89 measured
+92 % at 1.2 Vf).  Each run therefore says whether its speed lies inside the interval the
+verification layer certifies on the truth (:attr:`SuppressionStage.certified`), and the stage
+warns where it does not.
 """
 
 from __future__ import annotations
@@ -38,6 +46,10 @@ class SuppressionStage:
         has no flutter in the search range).
     reference : str
         ``"truth"`` or ``"rom"``: whose flutter speed ``V_flutter`` is.
+    certified : tuple of float or None
+        ``(lo, hi)`` over which the verification layer certifies the truth's linearised loop
+        with the controller stable (the controller stage's ``"truth"`` check); ``None`` where
+        there is no such certificate.
     """
 
     __repr__ = result_repr
@@ -45,11 +57,22 @@ class SuppressionStage:
     runs: tuple
     V_flutter: float
     reference: str = "truth"
+    certified: tuple | None = None
 
     @property
     def attenuation_percent(self) -> tuple:
         """The attenuation of each run [%] (``None`` where the open loop was at rest)."""
         return tuple(r.attenuation_percent for r in self.runs)
+
+    @property
+    def linear_loop_certified(self) -> tuple:
+        """For each run, whether its speed lies inside :attr:`certified`: the truth's
+        linearised loop is certified stable there, so an attenuation is that of a suppressed
+        LCO (``None`` for every run without a certificate)."""
+        if self.certified is None:
+            return tuple(None for _ in self.runs)
+        lo, hi = self.certified
+        return tuple(bool(lo <= r.V <= hi) for r in self.runs)
 
     def at(self, speed_factor: float) -> SuppressionResult:
         """The run at ``speed_factor`` times :attr:`V_flutter`.
@@ -67,7 +90,8 @@ class SuppressionStage:
 
 
 def suppression_stage(cfg: RunConfig, truth, flutters: FlutterStage, lco,
-                      K: control.StateSpace, *, mode: int, dt: float) -> SuppressionStage:
+                      K: control.StateSpace, *, mode: int, dt: float,
+                      certified: tuple | None = None) -> SuppressionStage:
     """Stage ``suppression`` (module docstring).
 
     Where the LCO stage simulated the truth at one of the speeds, its converged run is the
@@ -91,6 +115,9 @@ def suppression_stage(cfg: RunConfig, truth, flutters: FlutterStage, lco,
         0-based flutter mode, deflected to start an LCO and tapped at the release.
     dt : float
         Sample time of the loop (the records').
+    certified : tuple of float, optional
+        ``(lo, hi)`` over which the verification layer certifies the truth's linearised loop
+        with ``K`` stable; a run outside it is warned about (module docstring).
 
     Returns
     -------
@@ -114,8 +141,19 @@ def suppression_stage(cfg: RunConfig, truth, flutters: FlutterStage, lco,
                  "rad, rate peak %.3g rad/s%s", r.speed_factor, r.V,
                  float("nan") if r.attenuation_percent is None else r.attenuation_percent,
                  r.flap_peak, r.flap_rate_peak, _saturation(r))
-    return SuppressionStage(runs=runs, V_flutter=V_ref,
-                            reference="truth" if has_truth_flutter else "rom")
+    stage = SuppressionStage(runs=runs, V_flutter=V_ref,
+                             reference="truth" if has_truth_flutter else "rom",
+                             certified=None if certified is None else
+                             tuple(float(v) for v in certified))
+    for r, ok in zip(runs, stage.linear_loop_certified):
+        if ok is False:
+            log.warning("suppression at %.4g x Vf (V = %.4f): the truth's linearised loop with "
+                        "this controller is certified stable only over [%.5g, %.5g], so the "
+                        "attenuation of %.1f %% is that of an oscillation the servo's limits "
+                        "bound, not of a suppressed LCO", r.speed_factor, r.V,
+                        *stage.certified, float("nan") if r.attenuation_percent is None
+                        else r.attenuation_percent)
+    return stage
 
 
 def _saturation(r: SuppressionResult) -> str:

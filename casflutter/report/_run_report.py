@@ -356,7 +356,12 @@ def figure_captions(result) -> dict:
             + (f" (at the rate limit {sup.flap_rate_saturated_percent:.0f} % of the hold)"
                if sup.flap_rate_saturated_percent else "")
             + ", the LCO returns on release: "
-            f"{'yes' if sup.lco_returns else 'no'}" for sup in result.suppression.runs)
+            f"{'yes' if sup.lco_returns else 'no'}"
+            + ("; the truth's linearised loop is not certified stable at this speed, so this "
+               "is an oscillation the servo's limits bound, not a suppressed LCO"
+               if certified is False else "")
+            for sup, certified in zip(result.suppression.runs,
+                                      result.suppression.linear_loop_certified))
         tunnel = (f"in a Dryden turbulence of intensity {100 * ss.gust_intensity:g} % and "
                   f"scale {ss.gust_scale:g} m" if ss.gust_intensity > 0 else "without turbulence")
         cap["fig11_gain_ramp"] = (

@@ -3,7 +3,7 @@ the seed wing and the flutter check on the typical section) run through it with 
 result per stage, and the configuration's tables are the stages' own settings classes."""
 
 import json
-from dataclasses import fields
+from dataclasses import fields, replace
 
 import control
 import numpy as np
@@ -73,6 +73,35 @@ def test_the_study_has_a_typed_field_per_stage(study):
     assert [s.speed_factor for s in r.suppression.runs] == [1.05, 1.2]
     assert r.suppression.at(1.2) is r.suppression.runs[1]
     assert r.controller.nstates == r.config.controller.order == 1
+
+
+def test_each_suppression_run_says_whether_the_truths_linear_loop_is_stable_there(
+        study, wing_sensor_plant):
+    """An attenuation is that of a suppressed LCO only where the truth's linearised loop with
+    the controller is stable; each run says whether its speed lies inside the truth's
+    certified interval, checked here against the loop's eigenvalues computed from the truth's
+    state space (python-control's feedback, not the verification layer)."""
+    r = study
+    stage = r.suppression
+    lower, upper = r.truth_stable_V
+    assert stage.certified == (lower, upper)
+
+    def worst(V):
+        G = wing_sensor_plant(r, V)
+        return float(np.max(control.feedback(G, r.controller, sign=1).poles().real))
+
+    for run, ok in zip(stage.runs, stage.linear_loop_certified):
+        assert ok == (lower <= run.V <= upper)
+        if ok:
+            assert worst(run.V) < 0
+        else:      # the loop loses stability between the certificate's end and the run
+            assert upper < run.V and worst(min(1.01 * upper, run.V)) > 0
+    runs = r.summary()["suppression"]["runs"]
+    assert [run["linear_loop_certified"] for run in runs] == list(stage.linear_loop_certified)
+    # the same runs against a certificate that ends between them, and without one
+    middle = 0.5 * (stage.runs[0].V + stage.runs[1].V)
+    assert replace(stage, certified=(0.0, middle)).linear_loop_certified == (True, False)
+    assert replace(stage, certified=None).linear_loop_certified == (None, None)
 
 
 def test_the_rom_lco_speed_is_above_its_loops_own_flutter_point(study):

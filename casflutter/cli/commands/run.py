@@ -138,7 +138,9 @@ def _main(args) -> int:
                          f"{sig(math.degrees(r['flap_rate_peak']), 3)} deg/s"
                          + (f" (at the rate limit {r['flap_rate_saturated_percent']:.0f} % of "
                             "the hold)" if r.get("flap_rate_saturated_percent") else "")
-                         + f", LCO returns on release: {r['lco_returns']}")
+                         + f", LCO returns on release: {r['lco_returns']}"
+                         + ("; the truth's linearised loop is not certified stable at this "
+                            "speed" if r.get("linear_loop_certified") is False else ""))
     if log_quiet:                    # otherwise the log said it once already
         lines += res.skipped_notes()
     if res.interval_ok is not None or res.closed_loop is not None:
