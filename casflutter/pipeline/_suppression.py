@@ -8,10 +8,10 @@ sensors and through the flap servo with its travel and rate limits
 ``1 - rms(closed loop, hold) / rms(open-loop LCO)`` of the dominant sensor.
 
 An attenuation means a suppressed LCO only where the truth's linearised loop with the
-controller is stable at that speed.  Where it is not, the servo's limits bound an oscillation
-that the controller itself drives, and the sensors' rms can still fall below the open loop's
-LCO (on the seed wing, a controller whose linearised loop is unstable from V = 0.89 measured
-92 % at 1.2 Vf).  Each run therefore says whether its speed lies inside the interval the
+controller is stable at that speed.  Where it is not, the wing cannot come to rest under the
+controller and only the loop's nonlinearities (the servo's limits) keep it bounded, yet the
+sensors' rms can still fall below the open loop's LCO during the hold (on the seed wing, a
+controller whose linearised loop is unstable from V = 0.89 measured 92 % at 1.2 Vf).  Each run therefore says whether its speed lies inside the interval the
 verification layer certifies on the truth (:attr:`SuppressionStage.certified`), and the stage
 warns where it does not.
 """
@@ -148,9 +148,9 @@ def suppression_stage(cfg: RunConfig, truth, flutters: FlutterStage, lco,
     for r, ok in zip(runs, stage.linear_loop_certified):
         if ok is False:
             log.warning("suppression at %.4g x Vf (V = %.4f): the truth's linearised loop with "
-                        "this controller is certified stable only over [%.5g, %.5g], so the "
-                        "attenuation of %.1f %% is that of an oscillation the servo's limits "
-                        "bound, not of a suppressed LCO", r.speed_factor, r.V,
+                        "this controller is certified stable only over [%.5g, %.5g]: the wing "
+                        "cannot come to rest there, and the attenuation of %.1f %% is not that "
+                        "of a suppressed LCO", r.speed_factor, r.V,
                         *stage.certified, float("nan") if r.attenuation_percent is None
                         else r.attenuation_percent)
     return stage

@@ -357,8 +357,8 @@ def figure_captions(result) -> dict:
                if sup.flap_rate_saturated_percent else "")
             + ", the LCO returns on release: "
             f"{'yes' if sup.lco_returns else 'no'}"
-            + ("; the truth's linearised loop is not certified stable at this speed, so this "
-               "is an oscillation the servo's limits bound, not a suppressed LCO"
+            + ("; the truth's linearised loop is not certified stable at this speed, so the "
+               "wing cannot come to rest there and this is not a suppressed LCO"
                if certified is False else "")
             for sup, certified in zip(result.suppression.runs,
                                       result.suppression.linear_loop_certified))
