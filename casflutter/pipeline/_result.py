@@ -591,6 +591,7 @@ class RunResult:
                 "started_from_lco": sup.started_from_lco,
                 "V_flutter": stage.V_flutter, "flutter_of": stage.reference,
                 "flap_limit": cfg.flap_limit, "flap_rate_limit": cfg.flap_rate_limit,
+                "command_limiter": cfg.command_limiter,
                 "gust_intensity": cfg.gust_intensity, "gust_scale": cfg.gust_scale,
                 "noise": cfg.noise,
                 "runs": [dict(r.record(), linear_loop_certified=ok)

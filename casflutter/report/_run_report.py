@@ -371,6 +371,9 @@ def figure_captions(result) -> dict:
             + f", with sensor noise of rms {ss.noise:g}, the flap behind a servo "
             + ("without a rate limit" if ss.flap_rate_limit is None
                else f"limited to {np.degrees(ss.flap_rate_limit):.3g} deg/s")
+            + {"none": "", "rate": ", its command rate-limited in software to the same rate",
+               "phase_compensated": ", its command through a phase-compensating rate limiter "
+               "at the same rate (the flap turns with the command)"}[ss.command_limiter]
             + ". Attenuation = 1 - RMS(last third of the full gain) / RMS(open-loop "
             f"LCO) of the dominant sensor. {each}.")
     cap.update(control)

@@ -108,7 +108,7 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
                       kick: tuple[float, int, float] | None = None,
                       sensor_rows=None, flap_limit: float | None = None,
                       flap_rate_limit: float | None = None, disturbance=None,
-                      sensor_noise=None,
+                      sensor_noise=None, command_limiter: str = "none",
                       stop: Callable[[int, np.ndarray], bool] | None = None
                       ) -> TruthLoopSimulation:
     """Sampled-data closed loop of the nonlinear truth with the controller ``K``.
@@ -129,7 +129,10 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     actuator's rate stops growing at ``±flap_rate_limit`` (its acceleration is cut while the
     rate is at the limit and pushing outwards, the flap moves at the clipped rate within a
     Runge--Kutta step, whose stages a sharp command would otherwise carry past the limit,
-    and the rate is clipped after every step).
+    and the rate is clipped after every step).  A flap at its rate limit lags its command,
+    by up to a quarter period deep in saturation; ``command_limiter`` puts a software rate
+    limiter between the controller and the servo (:class:`_CommandLimiter`), whose
+    phase-compensated form turns the flap with the command.
 
     A tunnel's turbulence enters as eq. 7's modal disturbance ``w`` (``disturbance``, held over
     each sample interval, through the truth's own disturbance input of
@@ -173,6 +176,9 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
         Eq. 7's modal disturbance ``w`` at the samples (zero when omitted).
     sensor_noise : array_like, shape (K, n_sensors), optional
         Added to the sensor readings (zero when omitted).
+    command_limiter : {"none", "rate", "phase_compensated"}
+        The software limiter of the flap command at the sample rate, at ``flap_rate_limit``
+        (:class:`_CommandLimiter`; ``"none"``: the command goes to the servo as it is).
     stop : callable, optional
         ``stop(k, zm) -> bool``, called once sample ``k`` is recorded, with the readings so
         far (``zm[:k + 1]`` are set): ``True`` ends the simulation there, and the record
@@ -187,7 +193,8 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     Raises
     ------
     ConfigError
-        An unknown ``sensor`` or a non-positive limit.
+        An unknown ``sensor`` or ``command_limiter``, a non-positive limit, or a command
+        limiter without ``flap_rate_limit``.
     DimensionError
         A disturbance or noise record of the wrong shape.
 
@@ -213,6 +220,7 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     servo = _FlapServo.of(actuator_omega, actuator_zeta, flap_limit, flap_rate_limit)
     t = np.asarray(timepts, dtype=float)
     dt = float(t[1] - t[0])
+    limiter = _CommandLimiter.of(command_limiter, flap_rate_limit, dt)
     nx = truth.state_matrix(V).shape[0]
     s = truth.layout.initial(x0, nx)  # the flow at rest
     Hs = _sensor_rows(truth, sensor_rows)
@@ -226,7 +234,7 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     G = np.zeros(t.size)
     n = _run_closed_loop(truth, truth.flap_dynamics(V), s, _sampled(K, dt), servo, Hs,
                          sensor == "acceleration", t, gain, kick, substeps, (ZM, Vf, Vr, G),
-                         forcing=forcing, noise=noise, stop=stop)
+                         forcing=forcing, noise=noise, stop=stop, limiter=limiter)
     return TruthLoopSimulation(t[:n], ZM[:n], Vf[:n], G[:n], Vr[:n])
 
 
@@ -239,13 +247,15 @@ def _sampled(K: control.StateSpace, dt: float):
 
 
 def _run_closed_loop(truth, f, s, controller, servo, Hs, acceleration: bool, t, gain, kick,
-                     substeps: int, records, *, forcing=None, noise=None, stop=None) -> int:
+                     substeps: int, records, *, forcing=None, noise=None, stop=None,
+                     limiter=None) -> int:
     """The sample loop of :func:`closed_loop_truth` from the truth state ``s``: read the
     sensors, update the controller (state ``(A, B, C, D, n)`` discretised), hold the command
     and integrate over the sample; fills ``records = (zm, v, v', g)`` up to a blow-up.
     ``forcing`` (samples, states): the disturbance's rate of the state, held over each
     sample; ``noise`` (samples, sensors): added to the readings; ``stop(k, zm)``: end after
-    sample ``k``.  Returns the number of samples the record keeps."""
+    sample ``k``; ``limiter``: a :class:`_CommandLimiter` the command passes through.
+    Returns the number of samples the record keeps."""
     Ak, Bk, Ck, Dk, nk = controller
     ZM, Vf, Vr, G = records
     N, n = truth.n_modes, t.size
@@ -273,6 +283,8 @@ def _run_closed_loop(truth, f, s, controller, servo, Hs, acceleration: bool, t, 
         if stop is not None and stop(k, ZM):
             return k + 1
         vc = G[k] * float((Ck @ xk + Dk @ zm)[0]) if nk else G[k] * float((Dk @ zm)[0])
+        if limiter is not None:
+            vc = limiter.step(vc)
         vc = float(np.clip(vc, -servo.pos_max, servo.pos_max))
         if nk and G[k] > 0:  # the controller runs from its engagement (state zero before)
             xk = Ak @ xk + Bk @ zm
@@ -337,6 +349,61 @@ class _FlapServo:
         return s, xa
 
 
+#: the command limiters of :func:`closed_loop_truth`
+COMMAND_LIMITERS = ("none", "rate", "phase_compensated")
+
+
+class _CommandLimiter:
+    """A software rate limiter of the flap command, run at the sample rate ``dt``.
+
+    Each sample the output moves towards the command by at most ``rate * dt``.  A plain
+    limiter (``"rate"``) always moves towards the command, so under a command faster than
+    the limit it peaks only when it meets the command again: a triangle wave that falls
+    behind the command by up to a quarter period the deeper the saturation, the lag that a rate-limited servo adds to a
+    loop (and that drives rate-limit-induced oscillations in flight control).
+
+    The phase-compensated limiter (``"phase_compensated"``) turns as soon as the command does:
+    while it is behind the command and the command's rate points back towards it, it moves
+    with the command's rate instead, so it peaks with the command (a triangle wave in phase
+    with it, whose fundamental, ``4 rate / (pi omega)`` at the frequency ``omega``, is the
+    largest any signal of that rate can have).  A turn that would carry it further from zero
+    is not taken (it then moves towards the command, as the plain limiter does), so the
+    triangle stays around the flap's neutral position instead of drifting to one side
+    (without that rule the seed wing's flap drifted onto its end stop).
+    This is the rule of the phase-compensating rate limiters of flight control (reverse the
+    output's rate when the command reverses while saturated, with a bias correction towards
+    neutral).  Below the limit both are the identity.
+    """
+
+    def __init__(self, kind: str, rate: float, dt: float):
+        self.kind, self.step_max = kind, float(rate) * float(dt)
+        self.y = self.u = 0.0
+
+    @classmethod
+    def of(cls, kind: str, rate: float | None, dt: float) -> "_CommandLimiter | None":
+        """The limiter of :func:`closed_loop_truth`'s arguments (``None`` for ``"none"``)."""
+        if kind not in COMMAND_LIMITERS:
+            raise ConfigError(f"command_limiter = {kind!r}: allowed {list(COMMAND_LIMITERS)}")
+        if kind == "none":
+            return None
+        if rate is None:
+            raise ConfigError(f"command_limiter = {kind!r} limits the command's rate to the "
+                              "servo's: give flap_rate_limit too")
+        return cls(kind, rate, dt)
+
+    def step(self, u: float) -> float:
+        """The output for the command ``u`` of this sample."""
+        e, du = u - self.y, u - self.u
+        self.u = u
+        if abs(e) <= self.step_max:
+            self.y = u
+        elif self.kind == "phase_compensated" and du * e < 0 and du * self.y < 0:
+            self.y += self.step_max * np.sign(du)       # turn with the command, towards 0
+        else:
+            self.y += self.step_max * np.sign(e)
+        return self.y
+
+
 def _nonnegative(name: str, value, *, positive: bool = False) -> None:
     """Refuse a setting that is not a finite number ``>= 0`` (``> 0`` when ``positive``)."""
     ok = (not isinstance(value, bool) and isinstance(value, (int, float))
@@ -378,6 +445,11 @@ class SuppressionSettings:
     noise: float = 0.0
     """Rms of each sensor's white noise, in the sensors' unit (m/s² for accelerometers); 0 for
     none."""
+    command_limiter: str = "none"
+    """A software limiter of the flap command before the servo, at ``flap_rate_limit``
+    (:func:`closed_loop_truth`): ``"none"``, ``"rate"`` (the flap then lags the command as a
+    rate-limited servo does) or ``"phase_compensated"`` (the flap turns with the command;
+    part of the controller's implementation, the identity below the limit)."""
 
     def __post_init__(self):
         factors = self.speed_factors
@@ -402,6 +474,7 @@ class SuppressionSettings:
                                       or not (np.isfinite(value) and value > 0)):
                 raise ConfigError(f"{name} = {value!r}: a positive number (or leave it out "
                                   "for no limit)")
+        _CommandLimiter.of(self.command_limiter, self.flap_rate_limit, 1.0)   # checked
 
 
 @dataclass(frozen=True)
@@ -579,6 +652,7 @@ def suppression_run(truth, K: control.StateSpace, V_flutter: float,
                             kick=(t_release, mode, deflection), sensor_rows=sensor_rows,
                             sensor=sensor, flap_limit=sp.flap_limit,
                             flap_rate_limit=sp.flap_rate_limit,
+                            command_limiter=sp.command_limiter,
                             disturbance=w if sp.gust_intensity > 0 else None,
                             sensor_noise=noise if sp.noise > 0 else None,
                             stop=_lco_returned(t, sp))

@@ -101,9 +101,8 @@ def test_the_established_lco_meets_the_tunnels_turbulence_through_the_servo(stud
 
 @pytest.mark.slow
 @pytest.mark.xfail(strict=True, reason="issue 32 item 4 at 1.2 Vf: through the 300 deg/s "
-                   "servo the flap sits at its rate limit about 98 % of the hold and the "
-                   "default order-3 design attenuates the established LCO by about 16 %; the "
-                   "same controller catches it with a 600 deg/s servo (95 %) but not with "
-                   "500 deg/s (62 %)")
+                   "servo the default order-3 design attenuates the established LCO by about "
+                   "16 % (about 30 % with command_limiter = 'phase_compensated'); a 600 deg/s "
+                   "servo catches it (95 %)")
 def test_the_established_lco_is_suppressed_at_1_2_times_the_flutter_speed(study):
     assert study.suppression.at(1.2).attenuation_percent >= 90.0
