@@ -22,7 +22,8 @@ own linear state space in the speed index ``V`` gives the true flutter speed.
 - :func:`truth_lco`, :func:`closed_loop_truth`, :func:`suppression_run`,
   :func:`suppression_runs`, :func:`truth_loop_sweep` -- the truth's own LCO, and the truth in
   closed loop with a controller (the wind tunnel, paper Fig. 11), in the tunnel's turbulence
-  with noisy sensors (:func:`tunnel_disturbances`).
+  with noisy sensors (:func:`tunnel_disturbances`); :func:`limit_command` -- the software
+  limiter of the flap command those runs can put before the servo.
 - :func:`frozen_aero_truth` -- the truth with its aerodynamics frozen at one speed: what a
   ROM with the V² scaling of eq. 8 represents.
 """
@@ -30,7 +31,8 @@ own linear state space in the speed index ``V`` gives the true flutter speed.
 from ._aero import JONES_A, JONES_B, jones_C, strip_coefficients, theodorsen_T
 from ._base import AeroelasticTruth, AeroMatrices, SimulationResult
 from ._closed_loop import (SuppressionResult, SuppressionSettings, TruthLoopSimulation,
-                           TruthLoopSweep, closed_loop_truth, gain_schedule, suppression_run,
+                           TruthLoopSweep, closed_loop_truth, gain_schedule, limit_command,
+                           suppression_run,
                            suppression_runs, truth_loop_matrix, truth_loop_sweep)
 from ._frozen import frozen_aero_truth
 from ._goland import GolandParams, GolandWing
@@ -56,7 +58,8 @@ __all__ = [
     "problem_definition", "problem_label", "parse_sets",
     "RecordSettings", "truth_records", "frozen_aero_truth",
     "TruthLco", "truth_lco",
-    "TruthLoopSimulation", "closed_loop_truth", "gain_schedule", "SuppressionSettings",
+    "TruthLoopSimulation", "closed_loop_truth", "gain_schedule", "limit_command",
+    "SuppressionSettings",
     "SuppressionResult", "suppression_run", "suppression_runs", "truth_loop_matrix",
     "TruthLoopSweep", "truth_loop_sweep", "dryden_gust", "gust_modal_forces",
     "tunnel_disturbances",

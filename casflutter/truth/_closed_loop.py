@@ -29,7 +29,8 @@ from ..errors import CasflutterError, ConfigError, DimensionError
 from ._lco import truth_lco
 from ._turbulence import tunnel_disturbances
 
-__all__ = ["TruthLoopSimulation", "closed_loop_truth", "gain_schedule", "SuppressionSettings",
+__all__ = ["TruthLoopSimulation", "closed_loop_truth", "gain_schedule", "limit_command",
+           "SuppressionSettings",
            "SuppressionResult", "suppression_run", "suppression_runs", "truth_loop_matrix",
            "TruthLoopSweep", "truth_loop_sweep"]
 
@@ -402,6 +403,51 @@ class _CommandLimiter:
         else:
             self.y += self.step_max * np.sign(e)
         return self.y
+
+
+def limit_command(command, rate: float, dt: float, kind: str = "phase_compensated"
+                  ) -> np.ndarray:
+    """A sampled flap command through the software limiter of :func:`closed_loop_truth`.
+
+    Parameters
+    ----------
+    command : array_like, shape (K,)
+        The command at the samples, from rest (the limiter starts at 0).
+    rate : float
+        The rate limit [flap unit per time unit] (> 0).
+    dt : float
+        Sample time (> 0).
+    kind : {"rate", "phase_compensated", "none"}
+        The limiter (:class:`_CommandLimiter`): the plain one falls behind a command faster
+        than ``rate`` by up to a quarter period, the phase-compensated one turns with it.
+
+    Returns
+    -------
+    ndarray, shape (K,)
+        What the servo is commanded.
+
+    Raises
+    ------
+    ConfigError
+        An unknown ``kind`` or a non-positive ``rate`` or ``dt``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0.0, 1.0, 0.002)
+    >>> u = np.sin(2 * np.pi * 10 * t)                # 63 rad/s of command rate at most
+    >>> y = limit_command(u, 5.0, 0.002)
+    >>> bool(np.max(np.abs(np.diff(y))) <= 5.0 * 0.002 + 1e-12)
+    True
+    """
+    for name, value in (("rate", rate), ("dt", dt)):
+        if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
+            raise ConfigError(f"{name} = {value!r}: a positive number")
+    u = np.asarray(command, dtype=float).ravel()
+    limiter = _CommandLimiter.of(kind, float(rate), float(dt))
+    if limiter is None:
+        return u.copy()
+    return np.array([limiter.step(float(x)) for x in u])
 
 
 def _nonnegative(name: str, value, *, positive: bool = False) -> None:

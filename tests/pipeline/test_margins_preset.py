@@ -63,20 +63,21 @@ def test_the_wing_keeps_6_db_and_45_degrees_past_its_flutter_speed(study,
 
 
 @pytest.mark.slow
-def test_the_command_limiter_catches_more_of_the_lco_at_1_2_times_the_flutter_speed(study):
+def test_the_lco_at_1_2_times_the_flutter_speed_dies_out_through_the_rate_limited_flap(study):
     """The preset's tunnel runs the flap command through the phase-compensating limiter
-    (``suppression.command_limiter``).  With the same controller, from the same established
-    LCO at 1.2 times the wing's flutter speed (a speed the wing's linear loop is certified
-    at), in the same turbulence: the limiter's flap never exceeds the servo's rate, and it
-    catches far more of the LCO than the bare servo, which pushes late (measured on seeds
-    0-4: 42-49 % against 8-12 %)."""
+    (``suppression.command_limiter``) and holds full gain for 40 s.  With the same controller,
+    from the same established LCO at 1.2 times the wing's flutter speed (a speed the wing's
+    linear loop is certified at), in the same turbulence: the flap never exceeds the servo's
+    rate, and with the limiter the LCO dies out (issue 32's target, at least 90 %; measured
+    95.0-95.2 % on seeds 0-4), while the bare servo, which pushes late, leaves it (seed 0:
+    7 %)."""
     from dataclasses import replace
 
     from casflutter.truth import suppression_run, truth_lco
 
     r, cfg = study, study.config
     ss = cfg.suppression
-    assert ss.command_limiter == "phase_compensated"
+    assert ss.command_limiter == "phase_compensated" and ss.hold >= 40.0
     V = 1.2 * r.Vf_truth
     lo, hi = r.truth_stable_V
     assert lo <= V <= hi
@@ -90,9 +91,8 @@ def test_the_command_limiter_catches_more_of_the_lco_at_1_2_times_the_flutter_sp
                                   speed_factor=1.2, seed=cfg.seed)
             for kind in ("none", "phase_compensated")}
     for sup in runs.values():
-        assert sup.started_from_lco
+        assert sup.started_from_lco and sup.lco_returns
         v = sup.simulation.v
         assert np.max(np.abs(np.diff(v))) / dt <= ss.flap_rate_limit * (1 + 1e-9)
-    with_limiter = runs["phase_compensated"].attenuation_percent
-    bare = runs["none"].attenuation_percent
-    assert with_limiter >= 30.0 and with_limiter >= bare + 20.0
+    assert runs["phase_compensated"].attenuation_percent >= 90.0
+    assert runs["none"].attenuation_percent < 50.0

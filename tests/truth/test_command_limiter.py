@@ -10,8 +10,7 @@ import numpy as np
 import pytest
 
 from casflutter.errors import ConfigError
-from casflutter.truth import SuppressionSettings, closed_loop_truth, load_problem
-from casflutter.truth._closed_loop import _CommandLimiter
+from casflutter.truth import SuppressionSettings, closed_loop_truth, limit_command, load_problem
 
 DT = 0.002                      # s, the seed wing's sample time
 RATE = np.radians(300.0)        # rad/s, the tunnel servo's rate limit
@@ -20,8 +19,7 @@ PERIOD = 2 * np.pi / W
 
 
 def _limited(kind: str, u: np.ndarray) -> np.ndarray:
-    lim = _CommandLimiter.of(kind, RATE, DT)
-    return np.array([lim.step(float(x)) for x in u])
+    return limit_command(u, RATE, DT, kind)
 
 
 def _fundamental(t: np.ndarray, y: np.ndarray) -> complex:
