@@ -11,9 +11,10 @@ An attenuation means a suppressed LCO only where the truth's linearised loop wit
 controller is stable at that speed.  Where it is not, the wing cannot come to rest under the
 controller and only the loop's nonlinearities (the servo's limits) keep it bounded, yet the
 sensors' rms can still fall below the open loop's LCO during the hold (on the seed wing, a
-controller whose linearised loop is unstable from V = 0.89 measured 92 % at 1.2 Vf).  Each run therefore says whether its speed lies inside the interval the
-verification layer certifies on the truth (:attr:`SuppressionStage.certified`), and the stage
-warns where it does not.
+controller whose linearised loop is unstable from V = 0.89 measured 92 % at 1.2 Vf).  Each
+run therefore says whether its speed lies inside the interval the verification layer
+certifies on the truth (:attr:`SuppressionStage.certified`), and the stage warns where it
+does not.
 """
 
 from __future__ import annotations

@@ -221,7 +221,7 @@ def closed_loop_truth(truth, K: control.StateSpace, V: float, timepts, x0, gain,
     servo = _FlapServo.of(actuator_omega, actuator_zeta, flap_limit, flap_rate_limit)
     t = np.asarray(timepts, dtype=float)
     dt = float(t[1] - t[0])
-    limiter = _CommandLimiter.of(command_limiter, flap_rate_limit, dt)
+    limiter = _CommandLimiter.of(command_limiter, flap_rate_limit, dt, flap_limit)
     nx = truth.state_matrix(V).shape[0]
     s = truth.layout.initial(x0, nx)  # the flow at rest
     Hs = _sensor_rows(truth, sensor_rows)
@@ -284,7 +284,7 @@ def _run_closed_loop(truth, f, s, controller, servo, Hs, acceleration: bool, t, 
         if stop is not None and stop(k, ZM):
             return k + 1
         vc = G[k] * float((Ck @ xk + Dk @ zm)[0]) if nk else G[k] * float((Dk @ zm)[0])
-        if limiter is not None:
+        if limiter is not None:     # on the controller's own command: where it turns
             vc = limiter.step(vc)
         vc = float(np.clip(vc, -servo.pos_max, servo.pos_max))
         if nk and G[k] > 0:  # the controller runs from its engagement (state zero before)
@@ -360,8 +360,9 @@ class _CommandLimiter:
     Each sample the output moves towards the command by at most ``rate * dt``.  A plain
     limiter (``"rate"``) always moves towards the command, so under a command faster than
     the limit it peaks only when it meets the command again: a triangle wave that falls
-    behind the command by up to a quarter period the deeper the saturation, the lag that a rate-limited servo adds to a
-    loop (and that drives rate-limit-induced oscillations in flight control).
+    behind the command by up to a quarter period the deeper the saturation, the lag that a
+    rate-limited servo adds to a loop (and that drives rate-limit-induced oscillations in
+    flight control).
 
     The phase-compensated limiter (``"phase_compensated"``) turns as soon as the command does:
     while it is behind the command and the command's rate points back towards it, it moves
@@ -374,15 +375,24 @@ class _CommandLimiter:
     This is the rule of the phase-compensating rate limiters of flight control (reverse the
     output's rate when the command reverses while saturated, with a bias correction towards
     neutral).  Below the limit both are the identity.
+
+    The limiter reads the controller's own command, not the command clipped to the flap's
+    travel: a clipped command stays flat at the end of the travel, and the limiter would turn
+    only when the command comes off it, as late as the plain one (on the seed wing at 1.2 Vf
+    that undid the whole gain).  Its output is kept inside the travel (``bound``), so it cannot
+    wind up beyond it.
     """
 
-    def __init__(self, kind: str, rate: float, dt: float):
+    def __init__(self, kind: str, rate: float, dt: float, bound: float | None = None):
         self.kind, self.step_max = kind, float(rate) * float(dt)
+        self.bound = np.inf if bound is None else float(bound)
         self.y = self.u = 0.0
 
     @classmethod
-    def of(cls, kind: str, rate: float | None, dt: float) -> "_CommandLimiter | None":
-        """The limiter of :func:`closed_loop_truth`'s arguments (``None`` for ``"none"``)."""
+    def of(cls, kind: str, rate: float | None, dt: float, bound: float | None = None
+           ) -> "_CommandLimiter | None":
+        """The limiter of :func:`closed_loop_truth`'s arguments (``None`` for ``"none"``;
+        ``bound``: the flap's travel, ``None`` for none)."""
         if kind not in COMMAND_LIMITERS:
             raise ConfigError(f"command_limiter = {kind!r}: allowed {list(COMMAND_LIMITERS)}")
         if kind == "none":
@@ -390,7 +400,7 @@ class _CommandLimiter:
         if rate is None:
             raise ConfigError(f"command_limiter = {kind!r} limits the command's rate to the "
                               "servo's: give flap_rate_limit too")
-        return cls(kind, rate, dt)
+        return cls(kind, rate, dt, bound)
 
     def step(self, u: float) -> float:
         """The output for the command ``u`` of this sample."""
@@ -402,11 +412,12 @@ class _CommandLimiter:
             self.y += self.step_max * np.sign(du)       # turn with the command, towards 0
         else:
             self.y += self.step_max * np.sign(e)
+        self.y = min(max(self.y, -self.bound), self.bound)
         return self.y
 
 
-def limit_command(command, rate: float, dt: float, kind: str = "phase_compensated"
-                  ) -> np.ndarray:
+def limit_command(command, rate: float, dt: float, kind: str = "phase_compensated", *,
+                  travel: float | None = None) -> np.ndarray:
     """A sampled flap command through the software limiter of :func:`closed_loop_truth`.
 
     Parameters
@@ -420,6 +431,8 @@ def limit_command(command, rate: float, dt: float, kind: str = "phase_compensate
     kind : {"rate", "phase_compensated", "none"}
         The limiter (:class:`_CommandLimiter`): the plain one falls behind a command faster
         than ``rate`` by up to a quarter period, the phase-compensated one turns with it.
+    travel : float, optional
+        The flap's travel: the output stays within ``±travel`` (no bound when omitted).
 
     Returns
     -------
@@ -444,9 +457,9 @@ def limit_command(command, rate: float, dt: float, kind: str = "phase_compensate
         if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
             raise ConfigError(f"{name} = {value!r}: a positive number")
     u = np.asarray(command, dtype=float).ravel()
-    limiter = _CommandLimiter.of(kind, float(rate), float(dt))
+    limiter = _CommandLimiter.of(kind, float(rate), float(dt), travel)
     if limiter is None:
-        return u.copy()
+        return u.copy() if travel is None else np.clip(u, -travel, travel)
     return np.array([limiter.step(float(x)) for x in u])
 
 

@@ -60,6 +60,21 @@ def test_deep_in_saturation_the_plain_limiter_lags_and_the_compensated_one_does_
     assert np.degrees(lag_plain) > 70
 
 
+@pytest.mark.parametrize("kind", ["rate", "phase_compensated"])
+def test_the_output_stays_inside_the_travel_and_does_not_wind_up(kind):
+    """A command held beyond the flap's travel, then dropped to zero: the output stops at the
+    travel and is back at zero after travel / rate (one sample more), not after the time it
+    would take from where the command was."""
+    travel, held = np.radians(15.0), np.radians(40.0)
+    t = np.arange(0.0, 1.0, DT)
+    u = np.where(t < 0.5, held, 0.0)
+    y = limit_command(u, RATE, DT, kind, travel=travel)
+    assert np.max(np.abs(y)) <= travel
+    back = t[(t >= 0.5) & (np.abs(y) <= 1e-12)][0] - 0.5
+    assert back <= travel / RATE + 2 * DT
+    assert back < held / RATE
+
+
 def test_a_limiter_needs_the_servos_rate_and_a_known_name():
     with pytest.raises(ConfigError, match="command_limiter = 'pcrl'"):
         SuppressionSettings(command_limiter="pcrl", flap_rate_limit=RATE)
@@ -67,6 +82,6 @@ def test_a_limiter_needs_the_servos_rate_and_a_known_name():
         SuppressionSettings(command_limiter="phase_compensated")
     truth = load_problem("typical_section")
     with pytest.raises(ConfigError, match="give flap_rate_limit too"):
-        closed_loop_truth(truth, control.ss([], [], [], [[0.0, 0.0]]), 1.0, np.arange(0.0, 1.0, 0.1),
-                          truth.displaced_state(0, 0.01), lambda t: 1.0,
-                          command_limiter="rate")
+        closed_loop_truth(truth, control.ss([], [], [], [[0.0, 0.0]]), 1.0,
+                          np.arange(0.0, 1.0, 0.1), truth.displaced_state(0, 0.01),
+                          lambda t: 1.0, command_limiter="rate")
