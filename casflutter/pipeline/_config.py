@@ -23,8 +23,11 @@ table          settings
 ``[solver]``   flat Ipopt options for every NLP
 ============== ==============================================================================
 
-The defaults of every key are the seed wing's study, ``problems/seed_wing/run.toml``: an
-empty configuration runs that study (a test keeps the two equal).
+The defaults of every key are the paper's study on the seed wing,
+``problems/seed_wing/run_paper.toml``: an empty configuration runs that study (a test keeps
+the two equal).  The default configuration, ``problems/seed_wing/run.toml``
+(:func:`default_config_path`), changes the controller (designed over speed on the ROM that
+follows the wing) and the tunnel of the suppression runs.
 
 ``stages`` lists the optional stages to run after the flutter search; the records, the ROM,
 Σf, ΣAE and the flutter speeds of the ROM and the truth always run.  Every value is checked
@@ -741,7 +744,8 @@ def flutter_config(problem: str, *, updates=None) -> RunConfig:
 
 
 def default_config_path() -> Path:
-    """The default configuration shipped with the package (the seed wing's study).
+    """The default configuration shipped with the package: the seed wing's study, with its
+    controller designed over speed (``problems/seed_wing/run.toml``).
 
     Returns
     -------

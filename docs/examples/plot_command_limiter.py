@@ -12,9 +12,9 @@ servo that turns the flap as soon as the command turns
 certificate changes.
 
 First the limiters on a command five times faster than the rate limit, then the controller of
-``problems/seed_wing/run_margins.toml`` against the wing's established LCO at 1.2 Vf, with the
-bare servo and with the limiter (same controller, same LCO, same turbulence, the preset's
-40 s of full gain).
+the default study (``problems/seed_wing/run.toml``) against the wing's established LCO at
+1.2 Vf, with the bare servo and with the limiter (same controller, same LCO, same turbulence,
+the default tunnel's 40 s of full gain).
 """
 
 from dataclasses import replace
@@ -23,7 +23,6 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import casflutter as cf
-from casflutter.pipeline import config_path
 from casflutter.truth import limit_command, suppression_run, truth_lco
 
 RATE, DT = np.radians(300.0), 0.002
@@ -47,9 +46,9 @@ fig.tight_layout()
 # %%
 # The wing at 1.2 Vf
 # ------------------
-# The controller stage of ``run_margins.toml`` (the multi-speed design of order 3), then the
+# The controller stage of the default study (the multi-speed design of order 3), then the
 # truth's LCO at 1.2 times its flutter speed, and two tunnel runs from it.
-config = cf.load_config(config_path("seed_wing", "run_margins"), updates={"stages": ["controller"]})
+config = cf.load_config(updates={"stages": ["controller"]})   # problems/seed_wing/run.toml
 r = cf.run(config, quiet=True, write=False)
 ss, dt = config.suppression, config.data.dt
 V = 1.2 * r.Vf_truth
@@ -91,6 +90,6 @@ fig.tight_layout()
 # %%
 # Through the bare servo the LCO stays.  In phase, the 6.6° of fundamental that 300 deg/s
 # allows at 9.26 Hz, :math:`4R/(\pi\omega)`, are enough for this controller, but slowly: the
-# LCO shrinks for 15-30 s of full gain (the preset holds it 40 s) before it dies out to what
-# the turbulence leaves.
+# LCO shrinks for 15-30 s of full gain (the default tunnel holds it 40 s) before it dies out
+# to what the turbulence leaves.
 plt.show()

@@ -2,12 +2,12 @@
 Reach or margins?  Two order-3 controllers on the wing
 ======================================================
 
-The default run designs the paper's way: one speed, γ of the LFT at the frozen ROM loop's Vf
-(eq. 14-16), and the stable interval measured afterwards.  On the wing's own linearisation
-(flap behind the 40 Hz servo) its controller is certified stable far past the wing's flutter
-speed (1.085), but its loop-at-a-time margins fall below 6 dB / 45° right at that speed.
-``problems/seed_wing/run_margins.toml`` designs on the ROM that follows the wing over speed
-instead, at several speeds: the loop decays over (0.05, 1.35), and among such controllers the
+``problems/seed_wing/run_paper.toml`` designs the paper's way: one speed, γ of the LFT at the
+frozen ROM loop's Vf (eq. 14-16), and the stable interval measured afterwards.  On the wing's
+own linearisation (flap behind the 40 Hz servo) its controller is certified stable far past
+the wing's flutter speed (1.085), but its loop-at-a-time margins fall below 6 dB / 45° right
+at that speed.  The default study, ``problems/seed_wing/run.toml``, designs on the ROM that
+follows the wing over speed instead, at several speeds: the loop decays over (0.05, 1.35), and among such controllers the
 worst output and input sensitivity over that interval is minimised, the flap rate weighed.
 
 This example runs the controller stage of both configurations (the ROM, its flutter search
@@ -23,8 +23,8 @@ import numpy as np
 import casflutter as cf
 from casflutter.pipeline import config_path
 
-CASES = {"the paper's design at Vf (run.toml)": "run",
-         "multi-speed, sensitivities (run_margins.toml)": "run_margins"}
+CASES = {"the paper's design at Vf (run_paper.toml)": "run_paper",
+         "multi-speed, sensitivities (run.toml)": "run"}
 runs = {}
 for label, name in CASES.items():
     config = cf.load_config(config_path("seed_wing", name), updates={"stages": ["controller"]})

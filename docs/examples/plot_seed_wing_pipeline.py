@@ -11,14 +11,15 @@ on the seed wing (the paper's wind-tunnel wing with tip store: five modes at 2.1
 3. Σf by ERA and Tustin with :math:`n_f = 15` (eq. 5); Σs (eq. 6–7, two tip accelerometers) and
    ΣAE (eq. 8–9, 25 states);
 4. the Hopf point :math:`V_f` and the nonlinear LCO of the ROM (Fig. 9);
-5. the LFT at :math:`V_f` (eq. 10–15) and a fixed-order robust controller (§III.C);
+5. the LFT at :math:`V_f` (eq. 10–15) and a fixed-order controller (§III.C), designed to
+   keep the ROM loop, made to follow the wing over speed, decaying over a speed interval;
 6. independent verification: γ, the small-gain interval of eq. 10/16 and the exact interval
-   of closed-loop stability;
+   of closed-loop stability, on the ROM loop and on the wing's own linearisation;
 7. the gain-ramp suppression of the truth's established LCO at 1.05 and 1.2 times its flutter
    speed, in a tunnel's turbulence with noisy sensors (Fig. 11).
 
 The example runs the default configuration ``problems/seed_wing/run.toml`` exactly as
-``make demo`` does (about 70 s, most of it the synthesis), also in the documentation build:
+``make demo`` does (about 50 s), also in the documentation build:
 a shorter run changes the identified ROM slightly, and the nonconvex synthesis can then end
 in another local optimum with another controller, so a reduced run would not show what the
 study does.  The numbers printed below are those of this run, of the version of casflutter

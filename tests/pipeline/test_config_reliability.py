@@ -3,6 +3,7 @@ well under a second and before any stage runs, by a ConfigError naming the key, 
 what is allowed."""
 
 import time
+from dataclasses import fields
 
 import pytest
 
@@ -95,13 +96,19 @@ def test_nf_bound_is_the_realisation_bound():
         load_config(updates={"stages": [], "rom.method": "common_denominator", "rom.nf": 31})
 
 
-def test_empty_config_is_the_seed_wing_study(tmp_path):
-    """The code defaults are problems/seed_wing/run.toml: an empty file runs that study."""
-    from casflutter.pipeline import RunConfig, default_config_path
+def test_empty_config_is_the_papers_study(tmp_path):
+    """The code defaults are problems/seed_wing/run_paper.toml: an empty file runs that
+    study.  The default configuration (run.toml) differs from it in the controller and the
+    suppression tunnel only."""
+    from casflutter.pipeline import RunConfig, config_path, default_config_path
 
-    shipped = load_config(default_config_path())
-    assert load_config(_write(tmp_path, "")) == shipped
-    assert RunConfig() == shipped
+    paper = load_config(config_path("seed_wing", "run_paper"))
+    assert load_config(_write(tmp_path, "")) == paper
+    assert RunConfig() == paper
+    default = load_config(default_config_path())
+    changed = {f.name for f in fields(RunConfig)
+               if getattr(default, f.name) != getattr(paper, f.name)}
+    assert changed == {"controller", "suppression"}
 
 
 @pytest.mark.parametrize("text,words", [

@@ -12,7 +12,7 @@ import pytest
 from casflutter._settings import field_names, settings_as
 from casflutter.aeroelastic import AeroelasticLFT, AeroelasticSystem, FlutterResult
 from casflutter.data import IOData
-from casflutter.design import SynthesisOptions, SynthesisResult
+from casflutter.design import MultiSpeedDesign, SynthesisOptions
 from casflutter.ident import (CommonDenominatorResult, IdentificationResult,
                               IdentificationSettings)
 from casflutter.pipeline import (ClosedLoopChecks, ControllerSettings, DataSection, LcoResult,
@@ -28,7 +28,7 @@ SUMMARY_KEYS = {"problem", "V0", "n_sensors", "orders", "n_params", "fit_error_p
                 "timings_s", "seed", "units", "flags", "casflutter_version", "threads", "route",
                 "flutter_convective", "control_reversal_V"}
 
-#: the seed wing's study, cut to a few seconds per stage (a poor controller, a whole run)
+#: the default study (run.toml), cut to a few seconds per stage (an order-1 controller, a whole run)
 STUDY_SMALL = {"data.duration": 4.0, "flutter.n_grid": 61, "lco.duration": 1.0,
                "controller.order": 1, "controller.max_outer": 1,
                "suppression": {"settle": 1.5, "ramp": 0.5, "hold": 1.5, "release": 1.0}}
@@ -56,7 +56,7 @@ def test_the_study_has_a_typed_field_per_stage(study):
     assert isinstance(r.realization, Realization) and isinstance(r.system, AeroelasticSystem)
     assert isinstance(r.flutter, FlutterResult) and isinstance(r.flutter_truth, FlutterResult)
     assert isinstance(r.lco, LcoResult) and isinstance(r.lft, AeroelasticLFT)
-    assert isinstance(r.synthesis, SynthesisResult)
+    assert isinstance(r.design, MultiSpeedDesign) and r.synthesis is None   # method multispeed
     assert isinstance(r.controller, control.StateSpace)
     assert isinstance(r.verification, VerificationReport)
     assert isinstance(r.suppression, SuppressionStage)
@@ -121,7 +121,12 @@ def test_the_rom_lco_speed_is_above_its_loops_own_flutter_point(study):
 
 def test_summary_keeps_the_keys_of_summary_json(study):
     s = study.summary()
-    assert set(s) == SUMMARY_KEYS
+    # the multi-speed design has a required interval (controller.interval): its check too
+    assert set(s) == SUMMARY_KEYS | {"verification"}
+    lo, hi = study.config.controller.interval
+    assert s["verification"]["required_V"] == [lo, hi]
+    assert s["verification"]["interval_ok"] == (s["controller"]["stable_interval"][0] <= lo
+                                                and s["controller"]["stable_interval"][1] >= hi)
     json.dumps(s, allow_nan=False)   # plain JSON values, no NaN
     assert s["flutter"]["V"] == study.flutter.Vf
     assert s["controller"]["lft_stable_V"] == list(study.verification.exact_V)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from casflutter.errors import ConfigError
-from casflutter.pipeline import load_config, run
+from casflutter.pipeline import config_path, load_config, run
 
 
 @pytest.fixture(scope="module")
@@ -37,7 +37,7 @@ def test_the_control_reversal_follows_the_wings(summary):
 
 def test_the_multispeed_design_is_made_on_the_loop_that_follows_the_wing(
         closed_loop_abscissa, caplog):
-    """``controller.method = "multispeed"`` on the default (HWL) run designs on the
+    """``controller.method = "multispeed"`` on the paper's (HWL) run designs on the
     speed-following ROM with the flap behind the servo, not on the frozen loop of eq. 8.
     Checked independently: python-control closes the controller on that loop (no code shared
     with the design) and finds it decaying at 15 speeds of the interval, which reaches 34 %
@@ -45,7 +45,7 @@ def test_the_multispeed_design_is_made_on_the_loop_that_follows_the_wing(
     itself (to 1 %, the ROM's flutter-speed error with room; measured 1.457 and 1.450).
     The run warns for each model exactly where the verification's robust flutter speed lies
     inside the interval held (measured 0.70 on both: the phase margin at the flap)."""
-    cfg = load_config(updates={
+    cfg = load_config(config_path("seed_wing", "run_paper"), updates={
         "stages": ["controller"], "controller.method": "multispeed", "controller.order": 3,
         "controller.interval": [0.05, 1.45], "controller.hinf_speeds": 0,
         "controller.random_starts": 0})

@@ -100,9 +100,33 @@ def test_the_established_lco_meets_the_tunnels_turbulence_through_the_servo(stud
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="issue 32 item 4 at 1.2 Vf: through the 300 deg/s "
-                   "servo the default order-3 design attenuates the established LCO by about "
-                   "16 % (about 30 % with command_limiter = 'phase_compensated'); a 600 deg/s "
-                   "servo catches it (95 %)")
-def test_the_established_lco_is_suppressed_at_1_2_times_the_flutter_speed(study):
-    assert study.suppression.at(1.2).attenuation_percent >= 90.0
+def test_the_lco_at_1_2_times_the_flutter_speed_dies_out_through_the_rate_limited_flap(study):
+    """At 1.2 Vf the 300 deg/s flap saturates.  The default tunnel runs the flap command
+    through the phase-compensating limiter (``suppression.command_limiter``) and holds full
+    gain for 40 s: the LCO dies out (measured 95.0-95.2 % on seeds 0-4).  The same
+    controller through the bare servo, from the same established LCO in the same turbulence,
+    pushes late and leaves it (seed 0: 7-8 %): the limiter, not the hold, does it."""
+    from dataclasses import replace
+
+    from casflutter.truth import suppression_run
+
+    r, cfg = study, study.config
+    ss = cfg.suppression
+    assert ss.command_limiter == "phase_compensated" and ss.hold >= 40.0
+    high = r.suppression.at(1.2)
+    lo, hi = r.truth_stable_V
+    assert lo <= high.V <= hi                   # a speed the wing's linear loop is certified at
+    assert high.attenuation_percent >= 90.0
+    # the run's own start (the truth's established LCO there) and turbulence (seed (seed, k))
+    mode, dt = int(r.flutter.flutter_mode), cfg.data.dt
+    lco = truth_lco(r.truth, high.V, cfg.lco.duration, mode, cfg.lco.initial_deflection, dt=dt)
+    bare = suppression_run(r.truth, r.controller, r.Vf_truth, replace(ss, command_limiter="none"),
+                           dt=dt, mode=mode, deflection=cfg.lco.initial_deflection,
+                           sensor_rows=cfg.sensors.rows or None, sensor=cfg.sensors.kind,
+                           x0=lco.final_state, speed_factor=1.2,
+                           seed=(cfg.seed, list(ss.speed_factors).index(1.2)))
+    np.testing.assert_allclose(bare.open_loop_rms, high.open_loop_rms, rtol=1e-9)
+    assert bare.started_from_lco and bare.lco_returns
+    assert np.max(np.abs(np.diff(bare.simulation.v))) / dt \
+        <= ss.flap_rate_limit * (1 + 1e-9)
+    assert bare.attenuation_percent < 50.0

@@ -1,5 +1,5 @@
 """``casflutter run``: a study run of a configuration (default: the paper's study on the seed
-wing, ``problems/seed_wing/run.toml``).
+wing with its controller designed over speed, ``problems/seed_wing/run.toml``).
 
 Exit status: 0 when the run finished and every check it made passed (the ``verify.required``
 interval, the closed-loop simulations), 3 when it finished and wrote its outputs but a check
