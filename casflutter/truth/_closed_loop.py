@@ -286,7 +286,7 @@ def _run_closed_loop(truth, f, s, controller, servo, Hs, acceleration: bool, t, 
         vc = G[k] * float((Ck @ xk + Dk @ zm)[0]) if nk else G[k] * float((Dk @ zm)[0])
         if limiter is not None:     # on the controller's own command: where it turns
             vc = limiter.step(vc)
-        vc = float(np.clip(vc, -servo.pos_max, servo.pos_max))
+        vc = min(max(vc, -servo.pos_max), servo.pos_max)
         if nk and G[k] > 0:  # the controller runs from its engagement (state zero before)
             xk = Ak @ xk + Bk @ zm
         if k == n - 1:
@@ -344,7 +344,7 @@ class _FlapServo:
             k4s, k4a = deriv(s + h * k3s, xa + h * k3a)
             s = s + h / 6 * (k1s + 2 * k2s + 2 * k3s + k4s)
             xa = xa + h / 6 * (k1a + 2 * k2a + 2 * k3a + k4a)
-            xa[1] = float(np.clip(xa[1], -self.rate_max, self.rate_max))
+            xa[1] = min(max(float(xa[1]), -self.rate_max), self.rate_max)
             if abs(xa[0]) > self.pos_max:  # the end stop
                 xa[0], xa[1] = float(np.sign(xa[0]) * self.pos_max), 0.0
         return s, xa

@@ -154,6 +154,29 @@ def test_flap_dynamics_linearises_to_the_state_matrix(wing):
     assert_allclose(ds_v, (np.asarray(ss.A) @ x)[:n], rtol=1e-10, atol=1e-14)
 
 
+
+@pytest.mark.parametrize("linear", [False, True])
+def test_flap_dynamics_gathers_the_strip_forces(wing, linear):
+    """The simulations' right-hand side (its operators gathered into a few matrices) is the
+    strip-by-strip assembly of the forces (:meth:`SeedWing._forces`, which the outputs of
+    simulate use) to rounding, deep in the saturation of the tip strips as well."""
+    rng = np.random.default_rng(7)
+    N = wing.n_modes
+    for V in (0.5, 1.3, 2.4):
+        n = wing.state_matrix(V).shape[0]
+        ng = (n - 2 * N) // 2
+        lam1, lam2 = wing.aero_matrices(V).lams
+        f, forces = wing.flap_dynamics(V, linear), wing._forces(V, linear)
+        for scale in (1e-4, 1e-2, 1.0):
+            s, v = scale * rng.standard_normal(n), scale * rng.standard_normal(3)
+            acc, g, _ = forces(s, *v)
+            ref = np.concatenate([s[N:2 * N], acc, -lam1 * s[2 * N:2 * N + ng] + g,
+                                  -lam2 * s[2 * N + ng:] + g])
+            ds, a = f(s, *v)
+            assert_allclose(ds, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+            assert_allclose(a, ds[N:2 * N], rtol=0, atol=0)
+
+
 # ---- forces ------------------------------------------------------------------------------
 def test_forces_close_the_linear_loop_at_small_amplitude(wing):
     """Motion from the linear state matrix, fed to the nonlinear aero_forces, satisfies eq. 6.
