@@ -63,6 +63,7 @@ class HWLModel:
     u_names: tuple[str, ...] = ()
     v_name: str = "v"
     _weights: Any = field(default=None, repr=False, compare=False)
+    _step_op: Any = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         theta = np.asarray(self.theta, dtype=float).ravel()
@@ -81,6 +82,7 @@ class HWLModel:
         if not self.u_names and self.structure.has_u:
             object.__setattr__(self, "u_names", tuple(f"u{i + 1}" for i in range(N)))
         object.__setattr__(self, "_weights", self.structure.weights(theta))
+        object.__setattr__(self, "_step_op", None)      # built by the first step()
 
     # -- construction ---------------------------------------------------------------
     @classmethod
@@ -335,16 +337,25 @@ class HWLModel:
         ndarray, shape (N,)
             ``y(k)``.
         """
-        L = self.max_lag
-        y_hist = np.asarray(y_hist, dtype=float).reshape(L + 1, self.n_modes)
-        # reversed histories are chronological: row L is time k
-        u = None if u_hist is None else np.asarray(u_hist, dtype=float).reshape(L + 1, -1)[::-1]
-        v = None if v_hist is None else np.asarray(v_hist, dtype=float).reshape(L + 1, 1)[::-1]
-        u, v, y, K = self._arrays(u, v, y_hist[::-1])
-        val = _input_part(self.structure, self._weights, u, v, K)
-        if self.orders.na:
-            val = val - _ar_part(self.structure, self._weights, y, K)
-        return np.asarray(val).ravel()
+        L, N = self.max_lag, self.n_modes
+        if u_hist is not None and v_hist is None and self.has_v and not self.has_u:
+            u_hist, v_hist = None, u_hist   # a flap-only model: the one input given is v
+        if self.has_u and u_hist is None:
+            raise DataError("this model has a modal-displacement input u: pass u_hist=")
+        if self.has_v and v_hist is None:
+            raise DataError("this model has a flap input v: pass v_hist=")
+        if self._step_op is None:
+            object.__setattr__(self, "_step_op", _StepOperator.of(self))
+        op = self._step_op
+        y_hist = np.asarray(y_hist, dtype=float).reshape(L + 1, N)
+        parts = [] if op.ar_lags is None else [y_hist[op.ar_lags] ** op.ar_powers]
+        if op.u_lags is not None:
+            u = np.asarray(u_hist, dtype=float).reshape(L + 1, N)
+            parts.append(u[op.u_lags] ** op.u_powers)
+        if op.v_lags is not None:
+            v = np.asarray(v_hist, dtype=float).reshape(L + 1)
+            parts.append(v[op.v_lags] ** op.v_powers)
+        return op.weights @ np.concatenate([x.ravel() for x in parts]) + op.constant
 
     # -- linear part ------------------------------------------------------------------
     def markov_parameters(self, n: int) -> np.ndarray:
@@ -591,3 +602,50 @@ class HWLModel:
         const = ", constant term" if s.constant else ""
         return (f"HWLModel(N={s.n_modes}, {s.orders}, inputs {'+'.join(ins)}{const}, "
                 f"{s.n_params} parameters, dt={self.dt:g} s)")
+
+
+@dataclass(frozen=True)
+class _StepOperator:
+    """Eq. 3 at one sample as one product: ``y(k) = weights @ phi + constant``, where
+    ``phi`` gathers the powers ``1..q`` of the lagged outputs and ``1..p`` of the lagged
+    inputs (each ``(powers, lags, channels)`` block flattened in that order) and
+    ``weights`` the matching columns of ``-A^(m) ∘ alpha^[l]``, ``[H,B]^(d) ∘ gamma^[l]``
+    and ``[h,b]^(d) ∘ beta^[l]`` (:meth:`HWLStructure.weights`).  Rows of the histories are
+    lags (row ``d`` at time ``k - d``)."""
+
+    weights: np.ndarray
+    constant: np.ndarray | float
+    ar_lags: np.ndarray | None
+    ar_powers: np.ndarray | None
+    u_lags: np.ndarray | None
+    u_powers: np.ndarray | None
+    v_lags: np.ndarray | None
+    v_powers: np.ndarray | None
+
+    @classmethod
+    def of(cls, model: HWLModel) -> "_StepOperator":
+        W, o, N = model._weights, model.orders, model.n_modes
+        blocks, fields_ = [], {}
+
+        def gather(name, lags, per_lag, sign, width):
+            """Columns ``[l, d, j]`` (power, lag, channel) of one block."""
+            p = len(per_lag[0])
+            cols = np.zeros((N, p, len(lags), width))
+            for d, ws in enumerate(per_lag):
+                for l, w in enumerate(ws):
+                    cols[:, l, d, :] = sign * np.asarray(w, dtype=float).reshape(N, width)
+            blocks.append(cols.reshape(N, -1))
+            shape = (-1, 1, 1) if width > 1 else (-1, 1)
+            fields_[f"{name}_lags"] = np.asarray(lags, dtype=np.intp)
+            fields_[f"{name}_powers"] = np.arange(1, p + 1, dtype=float).reshape(shape)
+
+        for name in ("ar", "u", "v"):
+            fields_[f"{name}_lags"] = fields_[f"{name}_powers"] = None
+        if o.na:
+            gather("ar", o.ar_lags(), W["ar"], -1.0, N)
+        if model.has_u:
+            gather("u", o.input_lags(), W["u"], 1.0, N)
+        if model.has_v:
+            gather("v", o.input_lags(), W["v"], 1.0, 1)
+        constant = np.asarray(W["c"], dtype=float).reshape(N) if "c" in W else 0.0
+        return cls(np.hstack(blocks), constant, **fields_)
