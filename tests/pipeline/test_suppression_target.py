@@ -82,12 +82,12 @@ def test_the_established_lco_meets_the_tunnels_turbulence_through_the_servo(stud
         assert np.max(np.abs(np.diff(sim.v))) / dt <= cfg.suppression.flap_rate_limit * (1 + 1e-9)
         assert sup.flap_rate_peak <= cfg.suppression.flap_rate_limit * (1 + 1e-12)
     # at 1.05 Vf the LCO is gone: what is left at full gain is the linear closed loop's
-    # response to the turbulence (measured 8.4 against 8.1 m/s^2 on Acc1; the window is the
+    # response to the turbulence (measured 8.6 against 7.9 m/s^2 on Acc1; the window is the
     # last 2 s of the hold), so the attenuation is set by the tunnel's turbulence
     low = r.suppression.at(1.05)
     # and it came back after the release: the run ended once its RMS over the open-loop
     # window was back above half the open loop's, well after the shortest release (the
-    # window) and before the longest (about 16 s after the release on the default run)
+    # window) and before the longest
     ss = cfg.suppression
     t_release = ss.settle + ss.ramp + ss.hold
     assert t_release + ss.settle / 3 + 2.0 < low.simulation.timepts[-1] < t_release + ss.release
@@ -103,9 +103,10 @@ def test_the_established_lco_meets_the_tunnels_turbulence_through_the_servo(stud
 def test_the_lco_at_1_2_times_the_flutter_speed_dies_out_through_the_rate_limited_flap(study):
     """At 1.2 Vf the 300 deg/s flap saturates.  The default tunnel runs the flap command
     through the phase-compensating limiter (``suppression.command_limiter``) and holds full
-    gain for 40 s: the LCO dies out (measured 95.0-95.2 % on seeds 0-4).  The same
-    controller through the bare servo, from the same established LCO in the same turbulence,
-    pushes late and leaves it (seed 0: 7-8 %): the limiter, not the hold, does it."""
+    gain for 40 s: the LCO dies out to the turbulence's floor (measured 95.0-95.2 % on seeds
+    0-4).  The same controller through the bare servo, from the same established LCO in the
+    same turbulence, pushes late and leaves it (seed 0: 7-8 %): the limiter, not the hold,
+    does it."""
     from dataclasses import replace
 
     from casflutter.truth import suppression_run
@@ -117,6 +118,11 @@ def test_the_lco_at_1_2_times_the_flutter_speed_dies_out_through_the_rate_limite
     lo, hi = r.truth_stable_V
     assert lo <= high.V <= hi                   # a speed the wing's linear loop is certified at
     assert high.attenuation_percent >= 90.0
+    # and it has died out: what is left is the linear closed loop's response to the
+    # turbulence, as at 1.05 Vf (measured 11.1 against 10.1 m/s^2 on Acc1)
+    dom = high.dominant_sensor
+    floor = _gust_floor(r.truth, r.controller, high.V, cfg)
+    assert high.closed_loop_rms[dom] == pytest.approx(floor[dom], rel=0.2)
     # the run's own start (the truth's established LCO there) and turbulence (seed (seed, k))
     mode, dt = int(r.flutter.flutter_mode), cfg.data.dt
     lco = truth_lco(r.truth, high.V, cfg.lco.duration, mode, cfg.lco.initial_deflection, dt=dt)
