@@ -281,7 +281,7 @@ def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int
     >>> round(result.flutter.Vf, 4)
     2.2589
 
-    The seed wing's default study (about 50 s): ``cf.run(cf.load_config())``.
+    The seed wing's default study (one to two minutes): ``cf.run(cf.load_config())``.
     """
     cfg = config if isinstance(config, RunConfig) else load_config(config)
     if seed is not None:

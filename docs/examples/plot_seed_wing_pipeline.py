@@ -19,7 +19,7 @@ on the seed wing (the paper's wind-tunnel wing with tip store: five modes at 2.1
    speed, in a tunnel's turbulence with noisy sensors (Fig. 11).
 
 The example runs the default configuration ``problems/seed_wing/run.toml`` exactly as
-``make demo`` does (about 50 s), also in the documentation build:
+``make demo`` does (one to two minutes), also in the documentation build:
 a shorter run changes the identified ROM slightly, and the nonconvex synthesis can then end
 in another local optimum with another controller, so a reduced run would not show what the
 study does.  The numbers printed below are those of this run, of the version of casflutter
