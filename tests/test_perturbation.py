@@ -80,12 +80,16 @@ def _conclusions(res) -> dict:
                 "same", c.rom.sensors.kind)
     if res.controller is not None:
         ver = res.verification
+        paper = res.synthesis is not None
+        design = res.synthesis if paper else res.design
         out.update({
             "controller order": ("same", res.controller.nstates),
             "nominal loop stable (verification)": ("same", bool(ver.stable)),
-            "verified gamma": ("rel 1e-2", res.gamma),
-            "design gamma (the synthesis' objective)": (
-                "rel 1e-2", getattr(res.synthesis, "gamma", None)),
+            # the paper's design minimises gamma of the LFT at Vf (eq. 16); the multi-speed
+            # design minimises its own objective (the loop's worst sensitivity), and the LFT's
+            # gamma of its controller is a by-product that no optimum pins: shown, not promised
+            "verified gamma (LFT at Vf)": ("rel 1e-2" if paper else "shown", res.gamma),
+            "design objective (worst H-inf norm of the design)": ("rel 1e-2", design.gamma),
             "certified ROM stable interval": ("ends 1e-3", _ends(res.rom_stable_V)),
             "certified truth stable interval": ("ends 1e-3", _ends(res.truth_stable_V)),
             "required interval held": ("same", res.interval_ok)})
@@ -96,6 +100,8 @@ def _conclusions(res) -> dict:
 
 
 def _agree(kind: str, a, b) -> bool:
+    if kind == "shown":          # in the table, not a conclusion
+        return True
     if kind == "same" or a is None or b is None:
         return a == b
     tol = float(kind.split()[1])

@@ -127,6 +127,11 @@ def test_summary_keeps_the_keys_of_summary_json(study):
     assert s["verification"]["required_V"] == [lo, hi]
     assert s["verification"]["interval_ok"] == (s["controller"]["stable_interval"][0] <= lo
                                                 and s["controller"]["stable_interval"][1] >= hi)
+    # one H∞ iteration (controller.max_outer = 1) cannot meet the stopping test: the run
+    # says the optimisation did not converge, in the summary and in the design's message
+    c = s["controller"]
+    assert c["hinf_converged"] is False and c["hinf_iterations"] == 1
+    assert "without converging" in c["design_message"]
     json.dumps(s, allow_nan=False)   # plain JSON values, no NaN
     assert s["flutter"]["V"] == study.flutter.Vf
     assert s["controller"]["lft_stable_V"] == list(study.verification.exact_V)

@@ -35,6 +35,11 @@ def _controller_lines(c: dict, res, unit: str) -> list[str]:
     if c["method"] == "multispeed":
         lines.append(f"  design over {sig(c['interval'])} {unit}: "
                      + ("held" if c["held"] else f"not held ({c['design_message']})"))
+    if c.get("hinf_converged") is False:
+        lines.append(f"  its H∞ optimisation stopped after {c['hinf_iterations']} iterations "
+                     f"(controller.max_outer = {res.config.controller.max_outer}) without "
+                     "converging: the controller is the best found; the certificates below "
+                     "are its own")
     if c.get("gamma") is not None:
         lines.append(f"  verified γ = {sig(c['gamma'])} (‖T_w̄z‖∞ of the LFT at Vf, eq. 16), "
                      f"small-gain V {sig(c['small_gain_V'])}, exact V {sig(c['lft_stable_V'])}")
