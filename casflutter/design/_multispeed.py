@@ -919,9 +919,8 @@ def _finish(eng: _Engine, fams, K: np.ndarray, order: int, interval: tuple, reac
         message = (f"{what} at the decay rate {s.decay:g}, not the requested "
                    f"[{interval[0]:.5g}, {interval[1]:.5g}]: the farthest any start reached")
     if syn is not None and not syn.converged:
-        best = next(r for r in syn.starts if r.start == syn.best_start)
-        message += (f"; its H∞ phase stopped after {best.outer_iterations} of "
-                    f"{s.synthesis.max_outer} iterations without converging ({best.reason}): "
+        message += (f"; its H∞ phase stopped after {syn.best.outer_iterations} of "
+                    f"{s.synthesis.max_outer} iterations without converging ({syn.best.reason}): "
                     "the objective is the best found, not a local minimum")
     log.info("multi-speed design: %s; worst H-infinity objective %.5g", message, gamma)
     sig = fams[0].signals          # K reads the measurements and drives the controls

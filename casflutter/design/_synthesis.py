@@ -281,6 +281,11 @@ class SynthesisResult:
     wall_time: float
     norm_method: str
 
+    @property
+    def best(self) -> StartRecord:
+        """The record of the start whose controller this is (``best_start``)."""
+        return next(r for r in self.starts if r.start == self.best_start)
+
 
 # ----------------------------------------------------------------------------- driver
 

@@ -678,8 +678,6 @@ class RunResult:
             out["synthesis_gamma"] = float(c.synthesis.gamma)
         syn = c.synthesis if c.design is None else c.design.synthesis
         # the H∞ optimisation met its stopping test, and its iterations (None: no H∞ phase)
-        best = None if syn is None else next(r for r in syn.starts
-                                             if r.start == syn.best_start)
         out["hinf_converged"] = None if syn is None else bool(syn.converged)
-        out["hinf_iterations"] = None if best is None else int(best.outer_iterations)
+        out["hinf_iterations"] = None if syn is None else int(syn.best.outer_iterations)
         return out

@@ -455,16 +455,18 @@ class SeedWing(AirspeedMixin, AeroelasticTruth):
         outside (a controller and actuator), e.g. closed-loop suppression simulations.
 
         ``s = [u, u', z1, z2]`` is the full state of :meth:`simulate`.  The right-hand side
-        of :meth:`_forces` with its linear operators gathered once: every term but the
-        saturated circulation is linear in ``s`` and the flap, so
+        of :meth:`_forces` written as the linear truth (:meth:`state_matrix` and its flap
+        columns) plus what the saturation changes:
 
-        ``ds/dt = L s + B [v, v', v''] + E g_sat + Q g_sat^2``,
-        ``g_sat = sat(G s + H [v, v'])``
+        ``ds/dt = A s + B [v, v', v''] + E (g_sat - g_eff) + Q g_sat^2``,
+        ``g_eff = G s + H [v, v']``, ``g_sat = sat(g_eff)``
 
         (``E`` the circulatory lift and moment, ``Q`` the leading-edge suction, both on the
-        modal accelerations only).  The same sums as :meth:`_forces`, in fewer array
-        operations: the simulations call it four times per Runge-Kutta step.
+        modal accelerations only): the same sums as :meth:`_forces` in one product, for the
+        simulations call it four times per Runge-Kutta step.
         """
+        if linear:
+            return super().flap_dynamics(V, linear=True)
         V = self._check_V(V)
         c = self._coupled(V)
         am, Minv, N, ng = c["am"], c["Minv"], c["N"], c["ng"]
@@ -473,54 +475,30 @@ class SeedWing(AirspeedMixin, AeroelasticTruth):
         A1, A2 = JONES_A
         a0 = 1.0 - sum(JONES_A)
         nx = 2 * N + 2 * ng
-        u_, ud_ = slice(0, N), slice(N, 2 * N)
-        z1_, z2_ = slice(2 * N, 2 * N + ng), slice(2 * N + ng, nx)
-        # the lagged downwash's input g = Gx u + Gx1 u' + Gv v + Gv1 v'
-        Gg = np.zeros((ng, nx))
-        Gg[:, u_], Gg[:, ud_] = am.Gx, am.Gx1
-        # the effective downwash geff = a0 g + A1 lam1 z1 + A2 lam2 z2
-        G = a0 * Gg
-        G[:, z1_], G[:, z2_] = A1 * lam1 * np.eye(ng), A2 * lam2 * np.eye(ng)
-        H = a0 * np.column_stack([am.Gv, am.Gv1])
-        L = np.zeros((nx, nx))
-        L[u_, ud_] = np.eye(N)
-        L[ud_, u_] = -Minv * self._omega ** 2
-        L[ud_, ud_] = Minv @ (am.Cx - np.diag(2 * self._zeta() * self._omega))
-        L[z1_], L[z2_] = Gg, Gg
-        L[z1_, z1_] -= lam1 * np.eye(ng)
-        L[z2_, z2_] -= lam2 * np.eye(ng)
-        B = np.zeros((nx, 3))
-        B[ud_] = Minv @ np.column_stack([am.Fv, am.Fv1, am.Fv2])
-        B[z1_, :2] = B[z2_, :2] = np.column_stack([am.Gv, am.Gv1])
-        E = np.zeros((nx, ng))
-        E[ud_] = Minv @ am.W
-        if linear:
-            def f(s, vv, vdv, vddv):
-                geff = G @ s + H @ (vv, vdv)
-                ds = L @ s + B @ (vv, vdv, vddv) + E @ geff
-                return ds, ds[ud_]
-
-            return f
+        ud_ = slice(N, 2 * N)
+        # the effective downwash geff = a0 (Gx u + Gx1 u' + Gv v + Gv1 v') + A1 lam1 z1
+        # + A2 lam2 z2, on [s; v; v']
+        GH = np.hstack([a0 * am.Gx, a0 * am.Gx1, A1 * lam1 * np.eye(ng),
+                        A2 * lam2 * np.eye(ng), a0 * np.column_stack([am.Gv, am.Gv1])])
         # the suction's generalised force per unit g_sat^2 of each strip
         # (:meth:`_nonlinear_circulation`: qx = -(X e^T) dy / m, X = k g_sat^2)
         k = p.suction * p.rho * p.b * p.lift_slope
-        Q = np.zeros((nx, ng))
+        E, Q = np.zeros((nx, ng)), np.zeros((nx, ng))
+        E[ud_] = Minv @ am.W
         Q[ud_] = Minv @ (-k * self._dy / p.modal_mass * self._e)
+        ABEQ = np.hstack([c["A"], c["Bflap"], E, Q])
         sat = self.airspeed(V) * p.alpha_sat
-        # one product each: geff = [G H] [s; v; v'], ds = [L B E Q] [s; v; v'; v''; gs; gs^2]
-        GH = np.hstack([G, H]) / sat
-        LBEQ = np.hstack([L, B, E, Q])
-        z = np.empty(nx + 3 + 2 * ng)
-        gs_, gs2_ = slice(nx + 3, nx + 3 + ng), slice(nx + 3 + ng, nx + 3 + 2 * ng)
+        z = np.empty(nx + 3 + 2 * ng)      # [s; v; v'; v''; g_sat - g_eff; g_sat^2]
+        dg_, gs2_ = slice(nx + 3, nx + 3 + ng), slice(nx + 3 + ng, nx + 3 + 2 * ng)
 
         def f(s, vv, vdv, vddv):
             z[:nx] = s
             z[nx], z[nx + 1], z[nx + 2] = vv, vdv, vddv
-            gs = z[gs_]
-            np.tanh(GH @ z[:nx + 2], out=gs)
-            gs *= sat
+            geff = GH @ z[:nx + 2]
+            gs = sat * np.tanh(geff / sat)
+            np.subtract(gs, geff, out=z[dg_])
             np.multiply(gs, gs, out=z[gs2_])
-            ds = LBEQ @ z
+            ds = ABEQ @ z
             return ds, ds[ud_]
 
         return f
