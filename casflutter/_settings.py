@@ -22,12 +22,15 @@ from __future__ import annotations
 
 import collections.abc
 import dataclasses
+import difflib
 import math
 import numbers
 import re
 import types
 import typing
 from typing import Any, Mapping
+
+import numpy as np
 
 from .errors import ConfigError
 
@@ -81,23 +84,25 @@ def _check_type(path: str, value, typ):
         return value
     base = origin or typ
     if dataclasses.is_dataclass(base):
+        if isinstance(value, base):        # already built (a Python caller's object)
+            return value
         if not isinstance(value, Mapping):
             raise ConfigError(f"[{path}] must be a table, got {value!r}")
         return build_settings(base, value, path)
-    if base is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
+    if base is float:         # numbers.Real: numpy's scalars from a parameter sweep too
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
             raise ConfigError(f"{path}: expected a number, got {_kind(value)}")
         if not math.isfinite(value):
             raise ConfigError(f"{path} = {value!r}: expected a finite number (no nan or inf)")
         return float(value)
     if base is int:
-        if isinstance(value, bool) or not isinstance(value, int):
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
             raise ConfigError(f"{path}: expected an integer, got {_kind(value)}")
-        return value
+        return int(value)
     if base is bool:
-        if not isinstance(value, bool):
+        if not isinstance(value, (bool, np.bool_)):
             raise ConfigError(f"{path}: expected true or false, got {_kind(value)}")
-        return value
+        return bool(value)
     if base is str:
         if not isinstance(value, str):
             raise ConfigError(f"{path}: expected a string, got {_kind(value)}")
@@ -139,10 +144,18 @@ def build_settings(cls, table: Mapping[str, Any], path: str = ""):
         raise ConfigError(f"[{path}] must be a table, got {table!r}")
     allowed = field_names(cls)
     unknown = [k for k in table if k not in allowed]
-    if unknown:
-        where = f"[{path}]" if path else "top level"
-        raise ConfigError(f"unknown key {unknown[0]!r} in {where}; allowed: {', '.join(allowed)}")
     hints = typing.get_type_hints(cls)
+    if unknown:
+        key = str(unknown[0])
+        where = f"[{path}]" if path else "top level"
+        # a key of a nested table given one level too high, else the nearest spelling
+        home = [name for name in allowed if dataclasses.is_dataclass(hints.get(name))
+                and key in field_names(hints[name])]
+        close = difflib.get_close_matches(key, allowed, n=1)
+        hint = (f" (it belongs in [{path + '.' if path else ''}{home[0]}])" if home
+                else f" (did you mean {close[0]!r}?)" if close else "")
+        raise ConfigError(f"unknown key {key!r} in {where}{hint}; allowed: "
+                          f"{', '.join(allowed)}")
     kwargs = {name: _check_type(f"{path}.{name}" if path else name, value, hints[name])
               for name, value in table.items()}
     try:

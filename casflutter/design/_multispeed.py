@@ -64,7 +64,7 @@ import control
 import numpy as np
 
 from .._format import result_repr
-from .._settings import finite_numbers
+from .._settings import build_settings, finite_numbers
 from .._threads import single_threaded
 from ..errors import ConfigError, DimensionError, SynthesisError
 from ._bfgs import nonsmooth_bfgs
@@ -142,7 +142,8 @@ class MultiSpeedSettings:
 
     def __post_init__(self):
         if isinstance(self.synthesis, Mapping):
-            object.__setattr__(self, "synthesis", SynthesisOptions(**self.synthesis))
+            object.__setattr__(self, "synthesis",
+                               build_settings(SynthesisOptions, self.synthesis, "synthesis"))
         checks = {"decay": self.decay is None or (isinstance(self.decay, (int, float))
                                                    and math.isfinite(self.decay)
                                                    and self.decay >= 0),
@@ -684,7 +685,7 @@ def design_over_speeds(family, interval, order: int = 3, *,
     fams = _families(family)
     lo, hi = _interval(interval, fams)
     if isinstance(settings, Mapping):
-        settings = MultiSpeedSettings(**settings)
+        settings = build_settings(MultiSpeedSettings, settings, "settings")
     s = settings or MultiSpeedSettings()
     if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order < 0:
         raise ConfigError(f"order = {order!r}: an integer >= 0")

@@ -57,6 +57,7 @@ import control
 import numpy as np
 
 from .._format import result_repr
+from .._settings import build_settings
 from .._threads import single_threaded
 from ..errors import CasflutterError, ConfigError, DataError, DimensionError, SynthesisError
 from ._fullorder import full_order_controller, reduced_controllers
@@ -668,7 +669,7 @@ def synthesize(plants, nmeas: int, ncon: int, order: int, *, starts: int = 3, se
     """
     t_start = time.perf_counter()
     if isinstance(options, Mapping):
-        options = SynthesisOptions(**options)
+        options = build_settings(SynthesisOptions, options, "options")
     opts = options or SynthesisOptions()
     if int(order) != order or order < 0:
         raise ConfigError(f"order must be an integer >= 0, got {order!r}")

@@ -27,7 +27,7 @@ from typing import Mapping
 import numpy as np
 
 from .._format import result_repr
-from .._settings import settings_as
+from .._settings import build_settings, settings_as
 from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, PKResult,
                            RFASystem, SpeedFollowingROM, TruthLoop, control_reversal,
                            family_flutter, find_flutter, load_family, pk_flutter,
@@ -372,7 +372,7 @@ def parametric_flutter(cfg: RunConfig, truth, structure) -> ParametricResult:
 def gaf_settings(cfg: RunConfig, gaf: GAFProblem) -> RFASettings:
     """The RFA settings of a GAF file, checked before any work."""
     try:
-        settings = RFASettings(**gaf.rfa)
+        settings = build_settings(RFASettings, gaf.rfa)
     except ConfigError as exc:
         raise ConfigError(f"[gaf] of the wing file {gaf.path}: {exc}") from None
     if "controller" in cfg.stages and settings.poly_order != 0:

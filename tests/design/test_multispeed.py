@@ -15,6 +15,7 @@ import control
 import numpy as np
 import pytest
 
+from casflutter._settings import build_settings
 from casflutter.aeroelastic import FamilySignals, PlantFamily, load_family
 from casflutter.design import MultiSpeedSettings, design_over_speeds
 from casflutter.errors import ConfigError, SynthesisError
@@ -145,6 +146,26 @@ def test_a_slow_mode_out_of_reach_sets_the_decay_rate_left_open(caplog):
 def test_bad_requests_are_refused_before_any_work(family, interval, order, match):
     with pytest.raises(ConfigError, match=match):
         design_over_speeds(family, interval, order, settings=FAST)
+
+
+@pytest.mark.parametrize("settings, match", [
+    ({"max_outer": 1}, r"unknown key 'max_outer' in \[settings\] \(it belongs in \[settings.synthesis\]\); "
+     "allowed: decay, "),
+    ({"synthesis": {"max_outr": 1}}, r"unknown key 'max_outr' in \[settings.synthesis\] \(did you mean 'max_outer'\?\)"),
+    ({"n_speeds": 2.5}, r"settings.n_speeds: expected an integer"),
+])
+def test_settings_given_as_a_table_name_the_bad_key(family, settings, match):
+    with pytest.raises(ConfigError, match=match):
+        design_over_speeds(family, (60.0, 150.0), 2, settings=settings)
+
+
+def test_settings_from_a_numpy_sweep_are_accepted():
+    """A study script's numbers are numpy scalars; the table takes them as Python's."""
+    s = build_settings(
+        MultiSpeedSettings, {"n_speeds": np.int64(8), "decay": np.float64(0.1),
+                             "full_order": np.bool_(False), "synthesis": {"max_outer": 3}})
+    assert (s.n_speeds, s.decay, s.full_order, s.synthesis.max_outer) == (8, 0.1, False, 3)
+    assert type(s.n_speeds) is int and type(s.full_order) is bool
 
 
 @pytest.mark.parametrize("side", ["output", "input"])

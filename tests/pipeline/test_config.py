@@ -19,8 +19,11 @@ def test_defaults_are_the_paper_choices():
 
 
 @pytest.mark.parametrize("text,match", [
-    ("[rom]\nordres = [3,1,1,1,2,2]\n", r"unknown key 'ordres' in \[rom\]; allowed: orders"),
+    ("[rom]\nordres = [3,1,1,1,2,2]\n", r"unknown key 'ordres' in \[rom\] \(did you mean 'orders'\?\); allowed: orders"),
     ("colour = 1\n", r"unknown key 'colour' in top level; allowed: problem"),
+    ("order = 4\n", r"unknown key 'order' in top level \(it belongs in \[controller\]\)"),
+    ("[controller]\nmax_outr = 4\n",
+     r"unknown key 'max_outr' in \[controller\] \(did you mean 'max_outer'\?\)"),
     ("[data]\ndt = 'fast'\n", r"data.dt: expected a number, got str"),
     ("[data]\ndt = -0.1\n", r"data.dt = -0.1: must be > 0"),
     ("[controller]\norder = 2.5\n", r"controller.order: expected an integer"),

@@ -31,7 +31,7 @@ def _write(tmp_path, text, name="run.toml"):
     ("[suppression]\nsettle = -inf\n", r"^suppression\.settle = -inf: expected a finite number"),
     # unknown keys and sections, wrong types
     ("[foo]\nx = 1\n", r"unknown key 'foo' in top level; allowed: problem, data, rom"),
-    ("[lco]\ndurration = 3.0\n", r"unknown key 'durration' in \[lco\]; allowed: duration"),
+    ("[lco]\ndurration = 3.0\n", r"unknown key 'durration' in \[lco\] \(did you mean 'duration'\?\); allowed: duration"),
     ("[lco]\nduration = \"long\"\n", r"^lco\.duration: expected a number, got str 'long'"),
     ("[flutter]\nn_grid = 10.5\n", r"^flutter\.n_grid: expected an integer, got float 10.5"),
     ("[controller]\nstrictly_proper = 1\n",

@@ -148,7 +148,7 @@ def test_truth_loop_matrix_without_controller_is_the_truth():
 
 
 def test_settings_validation():
-    with pytest.raises(ConfigError, match="unknown key 'V00' in \\[data\\]; allowed: V0"):
+    with pytest.raises(ConfigError, match="unknown key 'V00' in \\[data\\] \\(did you mean 'V0'\\?\\); allowed: V0"):
         flutter_check_settings(**{"data.V00": 2.0})
     with pytest.raises(ConfigError, match="containing 1.0"):
         flutter_check_settings(**{"controller.speeds": [0.5, 1.2]})

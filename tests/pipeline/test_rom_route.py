@@ -178,7 +178,7 @@ def test_mismatched_dimensions_name_both(ts_result):
 
 def test_unknown_rom_setting_lists_the_valid_ones():
     path = config_path("typical_section", "flutter")
-    with pytest.raises(ConfigError, match="unknown key 'V00' in \\[data\\]; allowed: .*V0"):
+    with pytest.raises(ConfigError, match="unknown key 'V00' in \\[data\\] \\(did you mean 'V0'\\?\\); allowed: .*V0"):
         load_config(path, updates={"data.V00": 1.0})
     with pytest.raises(ConfigError, match="Nyquist"):
         load_config(path, updates={"data.band": [0.0, 6.0]})
