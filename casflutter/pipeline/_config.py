@@ -45,11 +45,12 @@ from .._nlp import check_solver_options
 from .._resources import problems_dir, read_toml
 from .._settings import build_settings, finite_numbers, set_dotted
 from ..design import SynthesisOptions
-from ..errors import ConfigError
+from ..errors import CasflutterError, ConfigError
 from ..ident import HWLOrders, IdentificationSettings
 from ..structure import SENSOR_KINDS, check_sensor_rows
 from ..truth import (AeroelasticTruth, RecordSettings, SuppressionSettings, file_problem_names,
                      load_problem, problem_definition, problem_names)
+from ..verify import load_controller
 
 __all__ = ["RunConfig", "ProblemSection", "DataSection", "RomSection", "FlutterSection",
            "LcoSection", "ControllerSettings", "VerifySection", "ClosedLoopSection",
@@ -320,10 +321,24 @@ class ControllerSettings(SynthesisOptions):
     hold the established LCO."""
     flap_rate_bandwidth: float = 251.3
     """Bandwidth of the flap-rate filter [rad per time unit] (the seed wing's 40 Hz servo)."""
+    start: str = ""
+    """A controller file to start the design from (empty: none): a run's
+    ``controller.json``, or ``A, B, C, D`` in JSON with optional ``inputs``, ``outputs`` and
+    ``feedback`` (:func:`casflutter.verify.match_controller`), of order at most ``order``
+    (padded with decoupled stable states).  It is matched to the design family's
+    measurements and controls by name and turned into the family's convention; the
+    multi-speed design continues it first (its record says ``"given"``), the paper's
+    synthesis starts from it.  A relative path is looked up beside the configuration file
+    first.  What to start from when a model is updated: the controller of the last design."""
 
     def __post_init__(self):
         super().__post_init__()
         _integer("order", self.order, 0)
+        if not isinstance(self.start, str):
+            raise ConfigError(f"controller.start = {self.start!r}: the path of a controller "
+                              "file (a string), or \"\" for none")
+        if self.start:
+            _check_start(self.start, self.order)
         for key in ("flap_rate_weight", "flap_rate_bandwidth", "servo_omega"):
             value = getattr(self, key)
             if not (isinstance(value, (int, float)) and not isinstance(value, bool)
@@ -754,6 +769,34 @@ def default_config_path() -> Path:
     return config_path("seed_wing", "run")
 
 
+def _check_start(start: str, order: int) -> None:
+    """``controller.start``, read before any work: a controller file of order <= ``order``
+    (its names and convention are matched to the design family at the controller stage)."""
+    try:
+        K = load_controller(start)
+    except CasflutterError as exc:
+        raise ConfigError(f"controller.start = {start!r}: {exc}; give a controller file (a "
+                          "run's controller.json, or A, B, C, D in JSON), absolute or "
+                          "relative to the configuration file") from None
+    if K.nstates > order:
+        raise ConfigError(f"controller.start = {start!r} has order {K.nstates} > "
+                          f"controller.order = {order}: start from a controller of that "
+                          "order or lower, or raise the order")
+
+
+def _relative_path(table: dict, section: str, key: str, path: Path) -> None:
+    """``[section] key``, a file path relative to the configuration file's folder, becomes
+    that path (when it is not a file from the working folder)."""
+    sec = table.get(section)
+    name = sec.get(key) if isinstance(sec, dict) else None
+    if not isinstance(name, str) or not name or Path(name).is_absolute() \
+            or Path(name).exists():
+        return
+    near = path.parent / name
+    if near.is_file():
+        sec[key] = str(near)
+
+
 def _relative_problem(table: dict, path: Path) -> None:
     """A ``[problem] name`` that is a path relative to the configuration file's folder (a
     wing file beside its run configuration) becomes that path."""
@@ -809,6 +852,7 @@ def load_config(path=None, *, updates=None, **overrides) -> RunConfig:
                           f"this file (e.g. problems/example_wing/run.toml), or pass it as "
                           "problem.name")
     _relative_problem(table, path)
+    _relative_path(table, "controller", "start", path)
     table.update({k: v for k, v in overrides.items() if v is not None})
     for key, value in (updates or {}).items():
         set_dotted(table, RunConfig, key, value)

@@ -32,16 +32,17 @@ import numpy as np
 
 from .._format import result_repr
 from .._settings import settings_as
-from ..aeroelastic import AeroelasticLFT, build_lft
+from ..aeroelastic import FEEDBACK_SIGNS, AeroelasticLFT, build_lft
 from ..design import (MultiSpeedDesign, MultiSpeedSettings, SynthesisOptions,
                       SynthesisResult, default_objective, design_over_speeds, synthesize,
                       with_flap_rate)
 from ..errors import CasflutterError
 from ..verify import (FamilyVerification, ModelMismatch, SpeedSweep, VerificationReport,
-                      model_mismatch, speed_sweep, verify_controller, verify_family)
+                      match_controller, model_mismatch, speed_sweep, verify_controller,
+                      verify_family)
 from ._config import RunConfig
 
-__all__ = ["ControllerStage", "controller_stage", "multispeed_settings"]
+__all__ = ["ControllerStage", "controller_stage", "multispeed_settings", "start_controller"]
 
 log = logging.getLogger("casflutter.pipeline")
 
@@ -148,6 +149,56 @@ def multispeed_settings(cfg: RunConfig, objective: str) -> MultiSpeedSettings:
                                                                    **c.ipopt}))
 
 
+def start_controller(cfg: RunConfig, family, feedback: str | None = None
+                     ) -> control.StateSpace | None:
+    """``controller.start`` matched to a design family.
+
+    The file's controller is matched to the family's signals by name
+    (:func:`casflutter.verify.match_controller`: the file's ``inputs``/``outputs`` and
+    ``feedback``, or the family's order and convention), then written from all of the
+    family's measurements to all of its controls, a channel the file leaves out as a zero
+    row or column.
+
+    Parameters
+    ----------
+    cfg : RunConfig
+        The configuration (``controller.start``).
+    family : PlantFamily
+        The design family.
+    feedback : {"positive", "negative"}, optional
+        The convention of the controller returned (default the family's): ``u = +K y`` for
+        the paper's synthesis on the LFT (eq. 14).
+
+    Returns
+    -------
+    control.StateSpace or None
+        ``None`` without a start.
+
+    Raises
+    ------
+    ConfigError, DimensionError
+        A controller whose names or sizes do not match the family's (named).
+    """
+    if not cfg.controller.start:
+        return None
+    fc = match_controller(family, cfg.controller.start)
+    sig = family.signals
+    rows = [list(sig.controls).index(name) for name in fc.controls]
+    cols = [list(sig.measurements).index(name) for name in fc.measurements]
+    A, B, C, D = (np.atleast_2d(np.asarray(M, dtype=float))
+                  for M in (fc.K.A, fc.K.B, fc.K.C, fc.K.D))
+    n, nu, ny = A.shape[0], len(sig.controls), len(sig.measurements)
+    Bf, Cf, Df = np.zeros((n, ny)), np.zeros((nu, n)), np.zeros((nu, ny))
+    Bf[:, cols] = B.reshape(n, len(cols))
+    Cf[rows, :] = C.reshape(len(rows), n)
+    Df[np.ix_(rows, cols)] = D
+    sign = fc.sign * FEEDBACK_SIGNS[feedback or family.feedback]   # u = fc.sign K y
+    log.info("controller: starting from %s (order %d, %s feedback%s)", cfg.controller.start, n,
+             fc.feedback, "; " + "; ".join(fc.notes) if fc.notes else "")
+    return control.ss(A, Bf, sign * Cf, sign * Df, inputs=list(sig.measurements),
+                      outputs=list(sig.controls), name="K0")
+
+
 def _multispeed(cfg: RunConfig, family, lft_plants=None) -> MultiSpeedDesign:
     c = cfg.controller
     if c.hinf_objective == "lft" and lft_plants is None:
@@ -158,16 +209,18 @@ def _multispeed(cfg: RunConfig, family, lft_plants=None) -> MultiSpeedDesign:
     if objective == "auto":
         objective = "lft" if lft_plants is not None else default_objective(family)
     hinf = lft_plants if objective == "lft" and c.hinf_speeds else None
+    K0 = start_controller(cfg, family)
     return design_over_speeds(family, tuple(c.interval), c.order,
                               settings=multispeed_settings(cfg, objective), seed=cfg.seed,
-                              hinf_plants=hinf)
+                              initial=() if K0 is None else (K0,), hinf_plants=hinf)
 
 
-def _paper(cfg: RunConfig, P, lft) -> SynthesisResult:
+def _paper(cfg: RunConfig, family, P, lft) -> SynthesisResult:
     c = cfg.controller
     options = replace(settings_as(c, SynthesisOptions), ipopt={**cfg.solver.ipopt, **c.ipopt})
+    K0 = start_controller(cfg, family, "positive")       # the LFT's v = +K zm (eq. 14)
     return synthesize(P, lft.nmeas, lft.ncon, c.order, starts=c.starts, seed=cfg.seed,
-                      options=options)
+                      initial=K0, options=options)
 
 
 def _warn_without_margins(checks: Mapping, interval, unit: str, margins) -> None:
@@ -240,7 +293,7 @@ def controller_stage(cfg: RunConfig, family, *, system=None, Vf: float | None = 
             raise CasflutterError("controller.method = \"paper\" designs on the LFT at the ROM "
                                   "loop's flutter speed (eq. 14); this problem has no ROM loop "
                                   "with a flutter speed: use method = \"multispeed\"")
-        syn = _paper(cfg, P, lft)
+        syn = _paper(cfg, family, P, lft)
         sig = family.signals    # the LFT's K reads the measurements and drives the flap
         K = control.ss(syn.controller.A, syn.controller.B, syn.controller.C,
                        syn.controller.D, inputs=list(sig.measurements),

@@ -668,7 +668,10 @@ class RunResult:
         if c.design is not None:
             d = c.design
             out.update(interval=list(d.interval), held=bool(d.held), reach=d.reached[1],
-                       interval_decay=d.decay, design_gamma=d.gamma, design_message=d.message)
+                       interval_decay=d.decay, design_gamma=d.gamma, design_message=d.message,
+                       design_starts=[{"kind": h.kind, "order": h.order,
+                                       "reached": list(h.reached)} for h in d.starts],
+                       start=self.config.controller.start or None)
         if c.verification is not None:
             ver = c.verification
             out.update(gamma=ver.gamma, small_gain_V=_pair(ver.small_gain_V),
