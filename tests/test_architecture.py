@@ -19,7 +19,7 @@ LAYERS = ["structure", "data", "truth", "ident", "realize", "aeroelastic", "lco"
           "verify", "report", "pipeline", "study", "cli", "__main__"]
 #: helpers every stage may use
 INFRASTRUCTURE = {"errors", "_nlp", "_resources", "_settings", "_linalg", "_threads", "_logging",
-                  "_outputs", "_interrupt", "_format", "__init__"}
+                  "_outputs", "_interrupt", "_format", "_processes", "__init__"}
 #: known exceptions (none: design/ computes its own norms and never imports verify/, the
 #: layer that must share no code with the optimiser)
 KNOWN: set = set()

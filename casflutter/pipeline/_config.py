@@ -537,6 +537,14 @@ class SuppressionSection(SuppressionSettings):
     """Integral scale ``L_w`` of the turbulence [m]."""
     noise: float = 0.1
     """Rms of each sensor's noise [sensor unit: m/s² for the seed wing's accelerometers]."""
+    workers: int = 0
+    """Processes for the runs: 0, one per speed factor up to the machine's cores; 1, every
+    run in this process.  Each run is seeded on its own, so the numbers do not depend on
+    it."""
+
+    def __post_init__(self):
+        super().__post_init__()
+        _integer("suppression.workers", self.workers, 0)
 
 
 @dataclass(frozen=True)

@@ -133,7 +133,8 @@ def suppression_stage(cfg: RunConfig, truth, flutters: FlutterStage, lco,
     runs = suppression_runs(truth, K, V_ref, cfg.suppression, dt=dt, mode=mode,
                             deflection=cfg.lco.initial_deflection,
                             lco_duration=cfg.lco.duration, sensor_rows=cfg.sensors.rows or None,
-                            sensor=cfg.sensors.kind, seed=cfg.seed, lcos=known)
+                            sensor=cfg.sensors.kind, seed=cfg.seed, lcos=known,
+                            workers=cfg.suppression.workers)
     for r in runs:
         if not r.started_from_lco:
             log.info("the truth has no LCO at V = %.4f: the suppression run starts from a "

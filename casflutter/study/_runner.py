@@ -18,7 +18,6 @@ from __future__ import annotations
 import logging
 import numbers
 import os
-import signal
 import socket
 import sys
 import time
@@ -33,6 +32,7 @@ from typing import Any, Mapping
 from .._format import result_repr
 from .._interrupt import sigterm_raises
 from .._logging import PROGRESS, PROGRESS_END
+from .._processes import ignore_interrupts, stop_pool
 from ..errors import ConfigError
 from ._spec import Study
 from ._store import PointStore
@@ -124,29 +124,8 @@ def _warm(evaluator: str) -> None:
 def _worker_init(evaluator: str) -> None:
     """Initializer of a local worker process: Ctrl-C in the terminal reaches the whole
     process group, but only the driver acts on it (it stops the workers); then warm up."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    ignore_interrupts()
     _warm(evaluator)
-
-
-def _stop_pool(ex: ProcessPoolExecutor, timeout: float = 5.0) -> None:
-    """Cancel what is queued and stop the worker processes now (the points they are
-    computing are lost and will be computed by the next run); none is left running."""
-    procs = list((getattr(ex, "_processes", None) or {}).values())
-    ex.shutdown(wait=False, cancel_futures=True)
-    for proc in procs:
-        try:
-            proc.terminate()
-        except (OSError, ValueError, AttributeError):
-            pass
-    deadline = time.monotonic() + timeout
-    for proc in procs:
-        try:
-            proc.join(max(0.0, deadline - time.monotonic()))
-            if proc.is_alive():
-                proc.kill()
-                proc.join(timeout)
-        except (OSError, ValueError, AssertionError, AttributeError):
-            pass
 
 
 def _ready(_: int = 0) -> int:
@@ -348,13 +327,13 @@ def _run_local(study, todo, store, progress, workers, max_points, state) -> None
                     continue
                 remaining.pop(k)
                 if _finish(rec, store, progress, state, max_points):
-                    _stop_pool(ex)  # max_points reached: the running points are not waited for
+                    stop_pool(ex)  # max_points reached: the running points are not waited for
                     stopped = True
                     break
             state["wall"] += time.perf_counter() - t_work
         except KeyboardInterrupt:  # Ctrl-C or SIGTERM: no worker may outlive the driver
             state["interrupted"] = True
-            _stop_pool(ex)
+            stop_pool(ex)
             stopped = True
             raise
         finally:
@@ -393,7 +372,7 @@ def _run_one_by_one(study, remaining, store, progress, settings, ctx, max_points
     except KeyboardInterrupt:
         state["interrupted"] = True
         if ex is not None:
-            _stop_pool(ex)
+            stop_pool(ex)
             ex = None
         raise
     finally:

@@ -15,6 +15,7 @@ Controllers follow the convention of eq. 14: the flap command is ``v_c = +K zm``
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 from typing import Callable
 
@@ -24,7 +25,9 @@ from scipy.optimize import brentq
 
 from .._format import result_repr
 from .._linalg import spectral_abscissa
+from .._processes import map_in_processes
 from .._settings import finite_numbers
+from .._threads import single_threaded
 from ..errors import CasflutterError, ConfigError, DimensionError
 from ._lco import truth_lco
 from ._turbulence import tunnel_disturbances
@@ -803,7 +806,7 @@ def suppression_runs(truth, K: control.StateSpace, V_flutter: float,
                      settings: SuppressionSettings | None = None, *, dt: float, mode: int,
                      deflection: float, lco_duration: float, sensor_rows=None,
                      sensor: str = "acceleration", seed: int = 0,
-                     lcos=None) -> tuple[SuppressionResult, ...]:
+                     lcos=None, workers: int = 0) -> tuple[SuppressionResult, ...]:
     """One :func:`suppression_run` per speed factor of ``settings``, each from the truth's
     established LCO at that speed.
 
@@ -811,7 +814,7 @@ def suppression_runs(truth, K: control.StateSpace, V_flutter: float,
     a deflected mode and continued while it still grows) unless ``lcos`` holds that run;
     where the truth has no LCO the run starts from the deflected mode
     (``started_from_lco`` False).  Run ``k`` draws its turbulence and noise from the seed
-    ``(seed, k)``: one seed gives the same runs.
+    ``(seed, k)``: one seed gives the same runs, whichever process computes them.
 
     Parameters
     ----------
@@ -824,6 +827,9 @@ def suppression_runs(truth, K: control.StateSpace, V_flutter: float,
     lcos : mapping of float to TruthLco, optional
         The truth's runs of :func:`~casflutter.truth.truth_lco` by speed factor, where
         already computed (e.g. by an LCO study at the same speeds).
+    workers : int
+        Processes for the runs (:func:`casflutter._processes.map_in_processes`): 0, one per
+        speed up to the machine's cores; 1, every run in this process.
 
     Returns
     -------
@@ -831,19 +837,52 @@ def suppression_runs(truth, K: control.StateSpace, V_flutter: float,
         In the order of ``settings.speed_factors``.
     """
     sp = settings or SuppressionSettings()
+    if isinstance(workers, bool) or not isinstance(workers, numbers.Integral) or workers < 0:
+        raise ConfigError(f"workers = {workers!r}: an integer >= 0 (0: one process per speed "
+                          "up to the machine's cores, 1: this process)")
     known = {round(float(f), 9): lco for f, lco in (lcos or {}).items()}
-    out = []
-    for k, factor in enumerate(sp.speed_factors):
-        lco = known.get(round(factor, 9))
+    K_abcd = tuple(np.atleast_2d(np.asarray(M, dtype=float)) for M in (K.A, K.B, K.C, K.D))
+    jobs = [_SuppressionJob(truth, K_abcd, V_flutter, sp, dt, mode, deflection, lco_duration,
+                            sensor_rows, sensor, float(factor), (int(seed), k),
+                            known.get(round(factor, 9)))
+            for k, factor in enumerate(sp.speed_factors)]
+    return tuple(map_in_processes(_run_job, jobs, int(workers)))
+
+
+@dataclass(frozen=True)
+class _SuppressionJob:
+    """Everything one run of :func:`suppression_runs` depends on (picklable: the controller
+    as its ``(A, B, C, D)``)."""
+
+    truth: object
+    K: tuple
+    V_flutter: float
+    settings: SuppressionSettings
+    dt: float
+    mode: int
+    deflection: float
+    lco_duration: float
+    sensor_rows: object
+    sensor: str
+    speed_factor: float
+    seed: tuple
+    lco: object
+
+
+def _run_job(job: _SuppressionJob) -> SuppressionResult:
+    """One run: the truth's LCO at the speed (unless given), then the suppression run."""
+    with single_threaded():     # the same numbers in a worker as in the parent
+        lco = job.lco
         if lco is None:
-            lco = truth_lco(truth, V_flutter * factor, lco_duration, mode, deflection, dt=dt,
-                            sensor_rows=sensor_rows, sensor=sensor)
+            lco = truth_lco(job.truth, job.V_flutter * job.speed_factor, job.lco_duration,
+                            job.mode, job.deflection, dt=job.dt, sensor_rows=job.sensor_rows,
+                            sensor=job.sensor)
         x0 = lco.final_state if lco.kind == "lco" else None
-        out.append(suppression_run(truth, K, V_flutter, sp, dt=dt, mode=mode,
-                                   deflection=deflection, sensor_rows=sensor_rows,
-                                   sensor=sensor, x0=x0, speed_factor=factor,
-                                   seed=(int(seed), k)))
-    return tuple(out)
+        return suppression_run(job.truth, control.ss(*job.K), job.V_flutter, job.settings,
+                               dt=job.dt,
+                               mode=job.mode, deflection=job.deflection,
+                               sensor_rows=job.sensor_rows, sensor=job.sensor, x0=x0,
+                               speed_factor=job.speed_factor, seed=job.seed)
 
 
 def truth_loop_matrix(truth, K: control.StateSpace, V: float, *, actuator_omega: float,

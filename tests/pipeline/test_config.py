@@ -40,6 +40,7 @@ def test_defaults_are_the_paper_choices():
     ("[suppression]\nspeed_factors = 1.1\n", r"suppression.speed_factors: expected a list"),
     ("[suppression]\nspeed_factors = [1.05, 0.0]\n", r"speed_factors .*must be > 0"),
     ("[suppression]\ngust_intensity = -0.01\n", r"gust_intensity = -0.01: must be"),
+    ("[suppression]\nworkers = -1\n", r"suppression.workers = -1: must be an integer >= 0"),
     ("stages = ['lco', 'dance']\n", r"stages: unknown stage 'dance'"),
     ("stages = ['suppression']\n", r"'suppression' needs the 'controller' stage"),
     ("[controller]\nmethod = 'hifoo'\n", r"controller.method = 'hifoo': allowed 'auto'"),
