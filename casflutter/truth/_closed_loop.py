@@ -879,8 +879,7 @@ def _run_job(job: _SuppressionJob) -> SuppressionResult:
                             sensor=job.sensor)
         x0 = lco.final_state if lco.kind == "lco" else None
         return suppression_run(job.truth, control.ss(*job.K), job.V_flutter, job.settings,
-                               dt=job.dt,
-                               mode=job.mode, deflection=job.deflection,
+                               dt=job.dt, mode=job.mode, deflection=job.deflection,
                                sensor_rows=job.sensor_rows, sensor=job.sensor, x0=x0,
                                speed_factor=job.speed_factor, seed=job.seed)
 
