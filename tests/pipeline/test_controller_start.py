@@ -21,19 +21,10 @@ from casflutter.cli import main
 from casflutter.errors import ConfigError
 from casflutter.pipeline import load_config, start_controller
 
+from .test_family_run import RUN    # the goland_4flaps run whose controller starts the next
+
 WITNESS = Path(__file__).resolve().parents[1] / "witnesses" / \
     "truth_interval_controller_order4.json"
-
-RUN = """
-seed = 0
-stages = ["controller"]
-[problem]
-name = "goland_4flaps"
-[controller]
-order = 2
-interval = [60.0, 150.0]
-hinf_speeds = 0
-"""
 
 
 def test_a_missing_start_file_is_refused_before_any_work():
