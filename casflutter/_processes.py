@@ -1,4 +1,5 @@
-"""Worker processes for independent pieces of work (a study's points, a run's speeds).
+"""Worker processes for independent pieces of work (a study's points, a run's LCO
+simulations and tunnel runs).
 
 Ctrl-C reaches the whole process group, but only the parent acts on it
 (:func:`ignore_interrupts` in the workers, :func:`stop_pool` in the parent), so no worker is
@@ -66,7 +67,7 @@ def stop_pool(ex: ProcessPoolExecutor, timeout: float = 5.0) -> None:
 
 
 def map_in_processes(fn: Callable, jobs: Sequence, workers: int = 0) -> list:
-    """``[fn(job) for job in jobs]``, in up to ``workers`` spawned processes.
+    """``[fn(job) for job in jobs]``, in up to ``workers`` forked processes.
 
     Parameters
     ----------

@@ -227,6 +227,10 @@ class LcoSection:
     """Multiples of the truth's flutter speed at which the LCO of the ROM that follows the
     wing over speed (:func:`casflutter.lco.compare_lco`) is put beside the truth's, when the
     run has both; ``[]``: none."""
+    workers: int = 0
+    """Processes for the stage's independent computations (the truth's simulations and each
+    LCO branch): 0, up to the machine's cores; 1, all in this process.  The numbers do not
+    depend on it."""
 
     def __post_init__(self):
         for name in ("duration", "initial_deflection", "speed_factor"):
@@ -238,6 +242,7 @@ class LcoSection:
                               "must be > 0")
         object.__setattr__(self, "speed_following_factors", tuple(factors))
         _integer("branch_points", self.branch_points, 0)
+        _integer("lco.workers", self.workers, 0)
         if 0 < self.branch_points < 3:
             raise ConfigError(f"branch_points = {self.branch_points}: give 0 (no branches) or "
                               "at least 3")

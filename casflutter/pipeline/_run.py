@@ -50,7 +50,8 @@ import numpy as np
 
 from .._linalg import spectral_abscissa
 from .._outputs import provenance, utc_now
-from .._threads import deterministic
+from .._processes import map_in_processes
+from .._threads import deterministic, single_threaded
 from ..aeroelastic import AeroelasticSystem, FlutterResult, find_flutter, simulate_loop
 from ..data import envelope_growth_rate
 from ..errors import CasflutterError, ConfigError, ConvergenceError
@@ -401,54 +402,90 @@ def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth,
         # still growing: continue from where the structure ended (the ROM's past outputs
         # restart at zero, a small kick that the converging LCO forgets)
         xs0 = sim.xs[-1]
-    tr = None
-    if truth is not None:
-        V_truth = (float(flutter_truth.Vf) * lc.speed_factor
-                   if flutter_truth.flutter is not None else V_lco)
-        tr = truth_lco(truth, V_truth, lc.duration, crit, lc.initial_deflection, dt=model.dt,
-                       sensor_rows=structure.Hs, sensor=structure.sensor,
-                       max_extensions=_MAX_EXTENSIONS)
     loop = "" if V_loop is None else f"loop flutter {V_loop:.5g}, "
     log.info("ROM LCO at V = %.5g (%scontinuous exact-order Hopf %.5g): %s, %.4g Hz", V_lco,
              loop, V_hopf, sim.sensors.kind, sim.sensors.frequency_hz)
-    branches = _branches(cfg, truth, model, structure) if lc.branch_points else {}
-    following = ()
-    if (speed_following is not None and tr is not None and flutter_truth.flutter is not None
-            and lc.speed_following_factors):
-        following = compare_lco(speed_following, truth, float(flutter_truth.Vf),
-                                lc.speed_following_factors, duration=lc.duration, mode=crit,
-                                deflection=lc.initial_deflection, dt=model.dt,
-                                truth_lcos={lc.speed_factor: tr},
-                                max_extensions=_MAX_EXTENSIONS)
-        for c in following:
-            log.info("speed-following ROM's LCO at %.4g x truth Vf (V = %.5g): %s, amplitude "
-                     "%s of the truth's", c.speed_factor, c.V, c.rom.sensors.kind,
-                     ", ".join(f"{e:+.1f} %" for e in c.amplitude_error_percent))
+    # the truth's simulations and the two branches are independent: worker processes
+    jobs = []
+    if truth is not None:
+        V_truth = (float(flutter_truth.Vf) * lc.speed_factor
+                   if flutter_truth.flutter is not None else V_lco)
+        following = (speed_following if speed_following is not None
+                     and flutter_truth.flutter is not None and lc.speed_following_factors
+                     else None)
+        jobs.append((_truth_lcos, (truth, V_truth, following, crit, model.dt, structure, lc,
+                                   flutter_truth.Vf)))
+    if lc.branch_points:
+        jobs.extend(_branch_jobs(cfg, truth, model, structure))
+    done = map_in_processes(_piece, jobs, lc.workers)
+    tr, following = done.pop(0) if truth is not None else (None, ())
+    for c in following:
+        log.info("speed-following ROM's LCO at %.4g x truth Vf (V = %.5g): %s, amplitude "
+                 "%s of the truth's", c.speed_factor, c.V, c.rom.sensors.kind,
+                 ", ".join(f"{e:+.1f} %" for e in c.amplitude_error_percent))
+    branches = _branches(done)
     return LcoResult(rom=sim, truth=tr, V=V_lco, V_hopf_exact_order=V_hopf,
                      flutter_exact_order=fl_exact, V_hopf_loop=V_loop,
                      speed_following=following, **branches)
 
 
-def _branches(cfg: RunConfig, truth, model, structure) -> dict:
+def _piece(job):
+    """One independent piece of the LCO stage, ``(function, args)``, single-threaded (the
+    same numbers in a worker process as here)."""
+    fn, args = job
+    with single_threaded():
+        return fn(*args)
+
+
+def _truth_lcos(truth, V, speed_following, mode, dt, structure, lc, Vf):
+    """The truth's LCO at ``V`` and, given the ROM that follows the wing, that ROM's LCO
+    beside the truth's at ``lc.speed_following_factors`` times ``Vf``."""
+    tr = truth_lco(truth, V, lc.duration, mode, lc.initial_deflection, dt=dt,
+                   sensor_rows=structure.Hs, sensor=structure.sensor,
+                   max_extensions=_MAX_EXTENSIONS)
+    if speed_following is None:
+        return tr, ()
+    following = compare_lco(speed_following, truth, Vf, lc.speed_following_factors,
+                            duration=lc.duration, mode=mode, deflection=lc.initial_deflection,
+                            dt=dt, truth_lcos={lc.speed_factor: tr},
+                            max_extensions=_MAX_EXTENSIONS)
+    return tr, following
+
+
+def _branch(key, fn, args, kwargs):
+    """``(key, branch, None)``, or ``(key, None, reason)`` when it could not be started."""
+    try:
+        return key, fn(*args, **kwargs), None
+    except (ConfigError, ConvergenceError) as exc:
+        return key, None, str(exc)
+
+
+def _branch_jobs(cfg: RunConfig, truth, model, structure) -> list:
     """The LCO branches of the ROM loop and of the truth (``lco.branch_points`` points
-    each; no truth branch on a wing file), or the reason a branch could not be started."""
+    each; no truth branch on a wing file), as jobs of :func:`_piece`."""
     settings = LCOSettings(max_points=cfg.lco.branch_points, sensor_kind=structure.sensor)
     scale, unit = speed_convention(truth) if truth is not None else (1.0, "speed index")
     ms = truth.modal_structure() if truth is not None else structure
+    jobs = [] if truth is None else [
+        (_branch, ("truth_branch", lco_branch, (truth, cfg.flutter.V_range, settings),
+                   {"problem": "truth"}))]
+    jobs.append((_branch, ("rom_branch", rom_lco_branch,
+                           (model, structure, cfg.flutter.V_range, settings),
+                           {"mode_names": ms.mode_names, "sensor_names": structure.sensor_names,
+                            "problem": "ROM loop", "speed_scale": scale, "speed_unit": unit,
+                            "time_unit": ms.time_unit})))
+    return jobs
+
+
+def _branches(done) -> dict:
+    """The computed branches by key (the reason logged for one that could not be started);
+    the ROM loop's outputs in the truth's units."""
     out = {}
-    computations = [] if truth is None else [
-        ("truth_branch", lambda: lco_branch(truth, cfg.flutter.V_range, settings,
-                                            problem="truth"))]
-    for key, compute in (
-            *computations,
-            ("rom_branch", lambda: rom_lco_branch(
-                model, structure, cfg.flutter.V_range, settings, mode_names=ms.mode_names,
-                sensor_names=structure.sensor_names, problem="ROM loop", speed_scale=scale,
-                speed_unit=unit, time_unit=ms.time_unit))):
-        try:
-            out[key] = compute()
-        except (ConfigError, ConvergenceError) as exc:
-            log.info("no %s: %s", key.replace("_", " "), exc)
+    for key, branch, reason in done:
+        if branch is None:
+            log.info("no %s: %s", key.replace("_", " "), reason)
+        else:
+            out[key] = branch
     if "truth_branch" in out and "rom_branch" in out:
         # the ROM loop's outputs are the truth's quantities: give them the truth's units
         units = dict(zip(out["truth_branch"].outputs, out["truth_branch"].output_units))

@@ -41,6 +41,8 @@ def test_defaults_are_the_paper_choices():
     ("[suppression]\nspeed_factors = [1.05, 0.0]\n", r"speed_factors .*must be > 0"),
     ("[suppression]\ngust_intensity = -0.01\n", r"gust_intensity = -0.01: must be"),
     ("[suppression]\nworkers = -1\n", r"suppression.workers = -1: must be an integer >= 0"),
+    ("[lco]\nworkers = -2\n", r"lco.workers = -2: must be an integer >= 0"),
+    ("[lco]\nworkers = 1.5\n", r"lco.workers.*integer"),
     ("stages = ['lco', 'dance']\n", r"stages: unknown stage 'dance'"),
     ("stages = ['suppression']\n", r"'suppression' needs the 'controller' stage"),
     ("[controller]\nmethod = 'hifoo'\n", r"controller.method = 'hifoo': allowed 'auto'"),

@@ -125,15 +125,22 @@ def _assert_close(a, b, path=""):
 
 def test_same_seed_same_numbers(reduced, tmp_path):
     # a second run in a fresh process (another memory layout, another moment of machine
-    # load): the synthesis budget is counted in iterations, never in wall time
+    # load): the synthesis budget is counted in iterations, never in wall time; and with
+    # every computation in that process, where the first run gave the LCO stage's and the
+    # suppression's independent pieces to worker processes
     cfg_path, _, s = reduced
+    here = tmp_path / "run.toml"
+    here.write_text(REDUCED.replace("[lco]\n", "[lco]\nworkers = 1\n")
+                    .replace("[suppression]\n", "[suppression]\nworkers = 1\n"))
     out = tmp_path / "again"
     code = ("import sys; from casflutter.cli import main; "
-            f"sys.exit(main(['run', {str(cfg_path)!r}, '--out', {str(out)!r}, '--quiet']))")
+            f"sys.exit(main(['run', {str(here)!r}, '--out', {str(out)!r}, '--quiet']))")
     subprocess.run([sys.executable, "-c", code], check=True, timeout=600)
     again = json.loads((out / "summary.json").read_text())
+    config = json.loads((out / "config.json").read_text())
+    assert config["lco"]["workers"] == config["suppression"]["workers"] == 1
     for key in ("orders", "n_params", "fit_error_percent", "nf", "nae", "flutter",
-                "flutter_truth", "lco", "controller"):
+                "flutter_truth", "lco", "controller", "suppression"):
         _assert_close(s[key], again[key], key)
 
 
