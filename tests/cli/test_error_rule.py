@@ -57,6 +57,12 @@ def _bad_inputs(tmp):
         (["verify", str(tmp / "missing.json"), str(tmp / "K.json")],
          [str(tmp / "missing.json"), "file not found"]),
         (["problems", "no_such_problem"], ["'no_such_problem'", "available: typical_section"]),
+        (["run", "--set", "controller.ordr=3", "--out", str(tmp / "run")],
+         ["'ordr' in [controller]", "did you mean 'order'?"]),
+        (["run", "--set", "controller.interval=[0.05, 2.0", "--out", str(tmp / "run")],
+         ["--set controller.interval=[0.05, 2.0", "is not a value", "a list such as"]),
+        (["run", "--set", "seed", "--out", str(tmp / "run")],
+         ["--set item 'seed'", "name=value"]),
     ]
 
 

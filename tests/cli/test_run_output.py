@@ -51,3 +51,26 @@ def test_numbers_on_screen_have_a_few_digits_and_gamma_says_what_it_is(typical_s
     assert not LONG_NUMBER.search(std + err), LONG_NUMBER.findall(std + err)
     assert "verified γ = " in std and "of the LFT at Vf, eq. 16" in std
     assert "H-inf norm over the 4 design plant(s)" in err      # the synthesis's own γ
+
+
+def test_set_changes_keys_of_the_configuration(tmp_path):
+    """``--set KEY=VALUE`` is ``load_config(updates=...)``: values read as in the file (a
+    list, a number, a problem parameter), recorded in config.json, and the run the same as the
+    one configured from Python with those updates."""
+    import json
+
+    from casflutter.pipeline import load_config, run
+
+    cfg = config_path("typical_section", "flutter")
+    updates = {"stages": [], "flutter.n_grid": 61, "problem.set.mu": 25.0}
+    out = tmp_path / "o"
+    assert main(["run", str(cfg), "--set", "stages=[]", "--set", "flutter.n_grid=61",
+                 "--set", "problem.set.mu=25.0", "--out", str(out), "--quiet"]) == 0
+    written = json.loads((out / "config.json").read_text())
+    assert written["stages"] == [] and written["flutter"]["n_grid"] == 61
+    assert written["problem"]["set"] == {"mu": 25.0}
+    here = run(load_config(cfg, updates=updates), quiet=True)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["flutter"]["V"] == pytest.approx(here.flutter.Vf, rel=1e-9)
+    # and the change took: the heavier section flutters faster than the file's mu = 20
+    assert here.flutter.Vf > run(load_config(cfg, updates={"stages": []}), quiet=True).flutter.Vf

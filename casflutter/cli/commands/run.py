@@ -11,9 +11,11 @@ from __future__ import annotations
 import json
 import math
 import sys
+import tomllib
 
 from ..._format import sig
 from ..._outputs import check_output_path
+from ...errors import ConfigError
 
 
 def _speed(block) -> str:
@@ -86,10 +88,37 @@ def _model_lines(s: dict) -> list[str]:
     return lines
 
 
+#: characters that make a ``--set`` value TOML rather than a bare word
+_TOML_MARKS = set("[]{}\"'=,#")
+
+
+def _value(key: str, text: str):
+    """A ``--set`` value: a TOML value (``4``, ``0.03``, ``true``, ``[0.05, 2.4]``,
+    ``"text"``), or a bare word (``sensitivity``) as a string."""
+    try:
+        return tomllib.loads(f"value = {text}")["value"]
+    except tomllib.TOMLDecodeError:
+        if text and not _TOML_MARKS & set(text) and not text[0].isdigit():
+            return text
+        raise ConfigError(f"--set {key}={text}: {text!r} is not a value; give a number, true "
+                          "or false, a list such as [0.05, 2.4], or a word or \"quoted "
+                          "text\"") from None
+
+
+def config_updates(items) -> dict:
+    """``--set KEY=VALUE`` items as :func:`casflutter.pipeline.load_config` updates: the
+    key dotted (``controller.order``, ``problem.set.zeta``), the value read as in the
+    configuration file."""
+    from ...truth import parse_sets
+
+    return {key: _value(key, text) for key, text in parse_sets(items).items()}
+
+
 def _main(args) -> int:
     from ...pipeline import load_config, run
 
-    cfg = load_config(args.config)   # validated before any work starts
+    # validated before any work starts
+    cfg = load_config(args.config, updates=config_updates(args.sets))
     # a path that cannot be a folder is refused before the package's stages are even
     # imported; the driver then refuses a non-empty folder without --overwrite, before any
     # work, and writes the outputs atomically at the end
@@ -173,6 +202,10 @@ def register(subparsers) -> None:
                    help="replace an existing non-empty output folder (refused otherwise, "
                         "before any work)")
     p.add_argument("--seed", type=int, help="overrides the configuration's seed")
+    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                   help="change one key of the configuration (repeatable), dotted as "
+                        "TABLE.KEY and valued as in the file: --set controller.order=4 "
+                        "--set 'controller.interval=[0.05, 2.0]' --set problem.set.zeta=0.03")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument("--json", action="store_true", help="print summary.json")
     p.set_defaults(func=_main)
