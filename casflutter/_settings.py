@@ -137,8 +137,9 @@ def build_settings(cls, table: Mapping[str, Any], path: str = ""):
     Raises
     ------
     ConfigError
-        Unknown key (the message lists the allowed ones), a value of the wrong type, or a
-        value the class refuses; the message names the dotted key.
+        Unknown key (the message lists the allowed ones, and gives the class's
+        ``key_hints[key]``, the table the key belongs in or the nearest spelling), a value
+        of the wrong type, or a value the class refuses; the message names the dotted key.
     """
     if not isinstance(table, Mapping):
         raise ConfigError(f"[{path}] must be a table, got {table!r}")
@@ -152,7 +153,9 @@ def build_settings(cls, table: Mapping[str, Any], path: str = ""):
         home = [name for name in allowed if dataclasses.is_dataclass(hints.get(name))
                 and key in field_names(hints[name])]
         close = difflib.get_close_matches(key, allowed, n=1)
-        hint = (f" (it belongs in [{path + '.' if path else ''}{home[0]}])" if home
+        meant = getattr(cls, "key_hints", {}).get(key)
+        hint = (f" ({meant})" if meant
+                else f" (it belongs in [{path + '.' if path else ''}{home[0]}])" if home
                 else f" (did you mean {close[0]!r}?)" if close else "")
         raise ConfigError(f"unknown key {key!r} in {where}{hint}; allowed: "
                           f"{', '.join(allowed)}")

@@ -40,6 +40,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
+from typing import ClassVar
 
 from .._nlp import check_solver_options
 from .._resources import problems_dir, read_toml
@@ -87,6 +88,12 @@ class ProblemSection:
     beside the configuration file first."""
     set: dict = field(default_factory=dict)
     """Parameter changes ``{name = value}``, checked by the truth's parameter class."""
+
+    #: what a key that is not one of the table's was probably meant as
+    key_hints: ClassVar[dict] = dict.fromkeys(
+        ("file", "path", "problem", "family"),
+        'a problem file is named by name: name = "FILE.toml", looked up beside this '
+        "configuration")
 
     def __post_init__(self):
         try:

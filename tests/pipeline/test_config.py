@@ -51,6 +51,8 @@ def test_defaults_are_the_paper_choices():
      r"\[controller\] invalid SynthesisOptions.*max_stab_rounds"),
     ("[controller]\ninterval = [2.0, 1.0]\n", r"controller.interval"),
     ("[problem]\nname = 'concorde'\n", r"problem.name = 'concorde': allowed .*typical_section"),
+    ("[problem]\nfile = 'wing.toml'\n",
+     r"unknown key 'file' in \[problem\] \(a problem file is named by name: name = \"FILE.toml\""),
     ("[data\n", r"not valid TOML"),
     ("rom = 3\n", r"\[rom\] must be a table"),
 ])
