@@ -16,7 +16,8 @@ which the function is nonsmooth, and the iteration converges to the kink.  It is
 of HANSO and of HIFOO's stabilisation and H∞ phases.
 
 The function here stops when the objective reaches a target (the caller's requirement is
-met), when it has decreased by less than ``stall`` over ``window`` iterations (the usual
+met; a line search step that reaches it is taken at once, as HANSO does, rather than
+lengthened further), when it has decreased by less than ``stall`` over ``window`` iterations (the usual
 state at a nonsmooth minimiser, where the gradient never becomes small), when no step
 satisfies the conditions, or after ``max_iter`` iterations.  Every stop is deterministic: the
 same start gives the same iterates.
@@ -82,7 +83,8 @@ def nonsmooth_bfgs(fun: Callable, x0: np.ndarray, *, max_iter: int = 200,
     max_iter : int
         Iterations at most.
     target : float
-        Stop once ``f <= target``.
+        Stop once ``f <= target``; the first trial step of a line search that reaches it
+        (with sufficient decrease) is taken.
     stall : float
         Stop once ``f`` decreased by less than this over the last ``window`` iterations
         (0: never).
@@ -126,6 +128,11 @@ def nonsmooth_bfgs(fun: Callable, x0: np.ndarray, *, max_iter: int = 200,
             evaluations += 1
             if not np.isfinite(ft) or ft > f + c1 * t * slope:
                 hi = t              # not enough decrease: shorten
+            elif ft <= target:
+                # the caller's requirement is met: a longer step only goes further (along a
+                # direction in which f falls without bound, without end: HANSO's fvalquit)
+                gt, accepted = _gradient(gt), True
+                break
             elif float((gt := _gradient(gt)) @ d) < c2 * slope:
                 lo = t              # still steeply downhill: lengthen
             else:

@@ -27,6 +27,10 @@ __all__ = ["OutOfReach", "modes_out_of_reach"]
 #: (COMPleib's AC10, ‖A‖ = 1.6e7, whose flutter mode a controller does move)
 _RANK_TOL = 1e-12
 
+#: an eigenvalue this small [rad per time unit] is a pole at the origin to rounding (a time
+#: constant of decades in seconds)
+_ORIGIN = 1e-9
+
 
 @dataclass(frozen=True)
 class OutOfReach:
@@ -49,12 +53,15 @@ class OutOfReach:
     seen: bool
 
     def describe(self) -> str:
-        """``"the mode -0.0232+0.0925j (unseen by the measurements)"``."""
+        """``"the mode at λ = -0.0232+0.0925j (unseen by the measurements)"``; a pole at
+        the origin (to rounding) is named as such."""
         why = " and ".join(w for w, ok in (("unreached by the controls", self.reached),
                                           ("unseen by the measurements", self.seen)) if not ok)
         lam = complex(self.eigenvalue)
+        if abs(lam) < _ORIGIN:
+            return f"the mode at λ = 0 (a pole at the origin: a position or an integrator; {why})"
         text = f"{lam.real:.4g}{lam.imag:+.4g}j" if lam.imag else f"{lam.real:.4g}"
-        return f"the mode {text} ({why})"
+        return f"the mode at λ = {text} ({why})"
 
 
 def modes_out_of_reach(A, B, C, slower_than: float) -> list[OutOfReach]:

@@ -92,14 +92,31 @@ def check_output_folder(out_dir, *, overwrite: bool = False) -> Path:
 
 
 # ---------------------------------------------------------------------- controller poles
+#: a controller pole this many times faster than every pole of the plant it was designed on
+#: is flagged (:func:`controller_pole_check`)
+FASTER_THAN_PLANT = 100.0
+
+
+def plant_speed(family, lo: float, hi: float, n: int = 9) -> float:
+    """The fastest natural frequency ``max |λ|`` of the family's poles [rad per time unit]
+    over ``n`` speeds of ``[lo, hi]`` (and the grid speeds inside it)."""
+    grid = family.speed_grid(n, lo, hi) if hi > lo else [lo]
+    return float(max(np.max(np.abs(np.linalg.eigvals(family.state_matrix(V))), initial=0.0)
+                     for V in grid))
+
+
 def controller_pole_check(K, *, dt: float | None, actuator_omega: float | None = None,
-                          time_unit: str = "s") -> dict | None:
-    """Compare the controller's poles with the data's Nyquist frequency and the actuator.
+                          time_unit: str = "s", plant_omega: float | None = None
+                          ) -> dict | None:
+    """Compare the controller's poles with the data's Nyquist frequency, the actuator and the
+    plant.
 
     A continuous controller pole ``λ`` has the natural frequency ``|λ|`` [rad per time unit].
     Faster than ``π / dt`` (the Nyquist frequency of records sampled every ``dt``) it acts
     where the ROM was never identified; faster than the actuator's natural frequency the
-    flap cannot follow it.
+    flap cannot follow it; :data:`FASTER_THAN_PLANT` times faster than the plant's fastest
+    pole, the loop's speed is set where the plant's model says nothing (a design that raised
+    the gain without bound, on a plant whose abscissa keeps falling with it).
 
     Parameters
     ----------
@@ -111,6 +128,9 @@ def controller_pole_check(K, *, dt: float | None, actuator_omega: float | None =
         Natural frequency of the flap actuator [rad per time unit].
     time_unit : str
         The problem's time unit (``"s"``: frequencies in Hz).
+    plant_omega : float, optional
+        The fastest natural frequency of the plant's poles over the design's speeds
+        (:func:`plant_speed`) [rad per time unit].
 
     Returns
     -------
@@ -118,7 +138,8 @@ def controller_pole_check(K, *, dt: float | None, actuator_omega: float | None =
         ``None`` for a static gain; else ``poles`` (``[re, im]`` pairs),
         ``natural_frequencies_hz`` (cycles per time unit), ``nyquist_hz``,
         ``faster_than_nyquist`` (bool or ``None`` without ``dt``), ``actuator_bandwidth_hz``
-        and ``faster_than_actuator`` (``None`` without an actuator), and ``warnings`` (one
+        and ``faster_than_actuator`` (``None`` without an actuator), ``plant_fastest_hz``
+        and ``faster_than_plant`` (``None`` without ``plant_omega``), and ``warnings`` (one
         sentence per flag raised).
     """
     A = np.asarray(K.A, dtype=float)
@@ -131,7 +152,8 @@ def controller_pole_check(K, *, dt: float | None, actuator_omega: float | None =
     out = {"poles": [[float(p.real), float(p.imag)] for p in lam],
            "natural_frequencies_hz": [float(w / (2 * np.pi)) for w in wn],
            "nyquist_hz": None, "faster_than_nyquist": None, "actuator_bandwidth_hz": None,
-           "faster_than_actuator": None, "warnings": []}
+           "faster_than_actuator": None, "plant_fastest_hz": None, "faster_than_plant": None,
+           "warnings": []}
     if dt is not None and math.isfinite(dt) and dt > 0:
         nyq = np.pi / dt
         out["nyquist_hz"] = float(nyq / (2 * np.pi))
@@ -151,6 +173,18 @@ def controller_pole_check(K, *, dt: float | None, actuator_omega: float | None =
             out["warnings"].append(
                 f"controller poles at {above} {hz} are faster than the flap actuator "
                 f"({actuator_omega / (2 * np.pi):.4g} {hz}, closed_loop.actuator_omega)")
+    if plant_omega is not None and math.isfinite(plant_omega) and plant_omega > 0:
+        limit = FASTER_THAN_PLANT * plant_omega
+        out["plant_fastest_hz"] = float(plant_omega / (2 * np.pi))
+        out["faster_than_plant"] = bool(fast > limit)
+        if fast > limit:
+            above = ", ".join(f"{w / (2 * np.pi):.4g}" for w in sorted(wn[wn > limit])[::-1])
+            out["warnings"].append(
+                f"controller poles at {above} {hz} are more than {FASTER_THAN_PLANT:g} times "
+                f"faster than the plant's fastest pole ({plant_omega / (2 * np.pi):.4g} {hz} "
+                "over the design's speeds): the loop's speed is set where the plant's model "
+                "says nothing; give a controller of lower gain (a slower decay rate, "
+                "controller.interval_decay) or a model valid that fast")
     return out
 
 
@@ -162,8 +196,16 @@ def _pole_check(result) -> dict | None:
     dt = (model.dt if model is not None
           else (result.data.dt if result.data is not None else None))
     act = cfg.closed_loop.actuator_omega if "closed_loop" in cfg.stages else None
+    family = getattr(result, "controlled_rom", None)
+    plant = None
+    if family is not None:
+        lo, hi = (cfg.controller.interval if cfg.controller.interval is not None
+                  else family.speed_range)
+        lo, hi = max(lo, family.speed_range[0]), min(hi, family.speed_range[1])
+        if math.isfinite(hi) and hi >= lo:
+            plant = plant_speed(family, lo, hi)
     return controller_pole_check(result.controller, dt=dt, actuator_omega=act,
-                                 time_unit=_time_unit(result))
+                                 time_unit=_time_unit(result), plant_omega=plant)
 
 
 def log_flags(result) -> None:

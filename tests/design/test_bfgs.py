@@ -53,6 +53,19 @@ def test_target_and_stall_stop_early():
     assert flat.iterations <= 6
 
 
+def test_a_line_search_that_reaches_the_target_takes_that_step():
+    """Along a direction in which the function falls without bound (a gain that lowers the
+    closed-loop abscissa linearly), the weak Wolfe curvature test never passes and the step
+    would double to the end of the line search (2**40); the first step that reaches the
+    target is taken instead (HANSO's fvalquit)."""
+    res = nonsmooth_bfgs(lambda x: (1.0 - float(x[0]), np.array([-1.0])), np.zeros(1),
+                         target=-1.0)
+    assert res.reason == "target" and res.fun <= -1.0
+    assert res.x[0] <= 4.0                  # a step or two past x = 2, not 1e12
+    unbounded = nonsmooth_bfgs(lambda x: (1.0 - float(x[0]), np.array([-1.0])), np.zeros(1))
+    assert unbounded.reason == "line search" and unbounded.x[0] > 1e10
+
+
 def test_start_outside_the_domain_is_reported():
     res = nonsmooth_bfgs(lambda x: (np.inf, np.zeros_like(x)), np.ones(2))
     assert res.reason == "not finite" and res.iterations == 0

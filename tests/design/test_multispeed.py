@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from casflutter._settings import build_settings
-from casflutter.aeroelastic import FamilySignals, PlantFamily, load_family
+from casflutter.aeroelastic import FamilySignals, GriddedFamily, PlantFamily, load_family
 from casflutter.design import MultiSpeedSettings, design_over_speeds
 from casflutter.errors import ConfigError, SynthesisError
 from casflutter.verify import verify_family
@@ -75,7 +75,7 @@ def test_a_decay_a_mode_out_of_reach_forbids_is_refused_before_any_work(family, 
     bound, before any start is tried (none is logged)."""
     with caplog.at_level("DEBUG", logger="casflutter.design"), \
             pytest.raises(ConfigError,
-                          match=r"the mode -2\.986 .* ask for a decay rate below 2\.986"):
+                          match=r"the mode at λ = -2\.986 .* ask for a decay rate below 2\.986"):
         design_over_speeds(family, (60.0, 200.0), 1, seed=0, settings=MultiSpeedSettings(
             decay=5.0, hinf_speeds=0, random_starts=0, full_order=False, max_rounds=20))
     assert not [r for r in caplog.records if "continuation" in r.getMessage()
@@ -135,6 +135,10 @@ def test_a_slow_mode_out_of_reach_sets_the_decay_rate_left_open(caplog):
                            settings=replace(settings, decay=0.05))
     with pytest.raises(ConfigError, match="does not decay, and no controller moves it"):
         design_over_speeds(_with_hidden_mode(-0.01), (0.0, 1.0), 1, settings=settings)
+    # an unmeasured position: named as the pole at the origin it is, not as "the mode 0"
+    with pytest.raises(ConfigError, match=r"the mode at λ = 0 \(a pole at the origin: a "
+                       r"position or an integrator; unreached by the controls and unseen"):
+        design_over_speeds(_with_hidden_mode(0.0), (0.0, 1.0), 1, settings=settings)
 
 
 @pytest.mark.parametrize("interval, order, match", [
@@ -279,3 +283,22 @@ def test_a_mode_that_crosses_between_two_scan_speeds_is_not_called_held():
     assert d.reached[1] < fam.centre - fam.width
     loop = control.feedback(fam.plant(fam.centre), d.controller, sign=fam.feedback_sign)
     assert np.max(loop.poles().real) > 1.9
+
+
+def test_a_gain_that_helps_without_limit_is_raised_only_as_far_as_needed():
+    """A first-order divergence ``x' = 0.01 (V - 100) x + u``, ``y = x``: every added unit of
+    gain lowers the abscissa by one, without end.  The design asks for the decay rate and
+    gets it with a modest controller (once its line search doubled the step to 2**40:
+    gains of 1e11, poles at 1e12 rad/s, all certified).  Independent check: the loop closed
+    by python-control decays at the rate over the interval, with controller poles within a
+    hundred times the plant's."""
+    speeds = np.linspace(40.0, 200.0, 17)
+    fam = GriddedFamily(speeds, (0.01 * (speeds - 100.0))[:, None, None],
+                        np.ones((17, 1, 1)), np.ones((17, 1, 1)), np.zeros((17, 1, 1)))
+    settings = MultiSpeedSettings(hinf_speeds=0, random_starts=0, full_order=False)
+    d = design_over_speeds(fam, (60.0, 150.0), 2, settings=settings, seed=0)
+    assert d.held
+    assert np.max(np.abs(d.controller.poles())) < 100 * 0.5 + 0.05   # the plant's: 0.5 /s
+    for V in np.linspace(60.0, 150.0, 31):
+        loop = control.feedback(fam.plant(V), d.controller, sign=fam.feedback_sign)
+        assert np.max(loop.poles().real) <= -d.decay * (1 - 1e-6), V

@@ -48,6 +48,27 @@ def test_slow_poles_pass_and_the_actuator_bandwidth_is_checked():
     assert "cycles per 1/omega_theta" in text and "Hz" not in text
 
 
+def test_poles_far_faster_than_the_plant_are_flagged():
+    """A controller pole more than 100 times faster than every pole of the plant it was
+    designed on is flagged; the plant's speed is that of its fastest pole over the speeds."""
+    from casflutter.aeroelastic import GriddedFamily
+    from casflutter.pipeline._exports import plant_speed
+
+    speeds = np.array([1.0, 2.0, 3.0])
+    fam = GriddedFamily(speeds, [[[-2 * np.pi * 0.5 * v]] for v in speeds],
+                        np.ones((3, 1, 1)), np.ones((3, 1, 1)), np.zeros((3, 1, 1)))
+    omega = plant_speed(fam, 1.0, 2.5)
+    assert omega == pytest.approx(2 * np.pi * 1.25, rel=1e-12)   # the pole at V = 2.5
+    check = controller_pole_check(_controller(200.0, 100.0), dt=None, plant_omega=omega)
+    assert check["plant_fastest_hz"] == pytest.approx(1.25, rel=1e-12)
+    assert check["faster_than_plant"] is True
+    (text,) = check["warnings"]
+    assert text.startswith("controller poles at 200 Hz are more than 100 times faster than "
+                           "the plant's fastest pole (1.25 Hz")
+    slow = controller_pole_check(_controller(100.0), dt=None, plant_omega=omega)
+    assert slow["faster_than_plant"] is False and slow["warnings"] == []
+
+
 def test_the_run_logs_a_warning_for_fast_controller_poles(caplog):
     result = SimpleNamespace(
         controller=_controller(3978.0, 507.0),
