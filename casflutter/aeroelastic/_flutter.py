@@ -128,6 +128,30 @@ class FlutterResult:
         """True when a flutter speed was found in the range."""
         return self.Vf is not None
 
+    def onsets(self, speed_unit: str = "", time_unit: str = "s") -> str:
+        """The open-loop instabilities in one line, numbers to 5 digits: each destabilising
+        crossing (flutter with its frequency, divergence), and whether the system is
+        unstable already at the low end of the range.
+
+        Parameters
+        ----------
+        speed_unit, time_unit : str
+            Units for the words (the speeds' and the frequencies' rad per time unit).
+
+        Returns
+        -------
+        str
+        """
+        su = f" {speed_unit}" if speed_unit else ""
+        words = [f"{c.kind} at {c.V:.5g}{su}" + (
+            f" ({c.omega:.5g} rad/{time_unit})" if c.kind == "flutter" else "")
+            for c in self.crossings if c.direction == "destabilizing"]
+        text = "; ".join(words) or "no crossing into instability in the range"
+        if self.unstable_at_start:
+            text += (f"; unstable already at {self.tracking.V[0]:.5g}{su} (spectral "
+                     f"abscissa {self.spectral_abscissa_start:.3g} /{time_unit})")
+        return text
+
 
 def origin_modes(tracking: EigenTracking, *, mode_states=None, omega=None) -> np.ndarray:
     """Structural mode each branch comes from, judged at the lowest V.

@@ -380,9 +380,10 @@ class ControllerSettings(SynthesisOptions):
         if self.method not in ("auto", "multispeed", "paper"):
             raise ConfigError(f"controller.method = {self.method!r}: allowed 'auto', "
                               "'multispeed', 'paper'")
-        if self.method == "multispeed" and self.strictly_proper and self.order < 1:
-            raise ConfigError("controller.method = \"multispeed\" with strictly_proper = true "
-                              f"needs order >= 1 (got {self.order!r})")
+        if self.strictly_proper and self.order < 1:
+            raise ConfigError(f"controller.order = {self.order!r} with strictly_proper = true "
+                              "(the default) leaves no controller (D = 0 and no states): for "
+                              "a static gain set strictly_proper = false, or give order >= 1")
         ro = self.reduction_orders
         if isinstance(ro, (str, bytes)) or not all(
                 isinstance(o, int) and not isinstance(o, bool) and o >= 1 for o in ro):

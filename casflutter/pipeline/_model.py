@@ -480,10 +480,7 @@ def family_model(cfg: RunConfig, record, progress) -> tuple[ModelStage, FlutterS
     log.info("%s", family.describe())
     with progress.stage("flutter"):
         fl = family_flutter(family)
-    log.info("flutter: %s", "; ".join(f"{c.V:.5g} {family.speed_unit} at {c.omega:.5g} "
-                                      f"rad/{family.time_unit}" for c in fl.crossings
-                                      if c.kind == "flutter" and c.direction == "destabilizing")
-             or "no crossing in the range")
+    log.info("open loop: %s", fl.onsets(family.speed_unit, family.time_unit))
     return ModelStage(family=family), FlutterStage(rom=fl, Vf=fl.Vf)
 
 

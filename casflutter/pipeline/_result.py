@@ -564,13 +564,18 @@ class RunResult:
 
     def _family_summary(self) -> dict:
         """A family file's size, signals and every open-loop crossing (``flutter`` of
-        ``casflutter flutter FAMILY``)."""
+        ``casflutter flutter FAMILY``), with the status of the first destabilising one and
+        whether the family is unstable already at the low end of its range."""
         fam, fl = self.model.family, self.flutter
         sig = fam.signals
         return {"name": fam.name, "n_states": int(fam.n_states), "speed_unit": fam.speed_unit,
                 "time_unit": fam.time_unit, "speed_range": list(fam.speed_range),
                 "feedback": fam.feedback, "controls": list(sig.controls),
                 "measurements": list(sig.measurements),
+                "status": None if fl is None else fl.status,
+                "unstable_at_start": None if fl is None else bool(fl.unstable_at_start),
+                "spectral_abscissa_start": (None if fl is None
+                                            else float(fl.spectral_abscissa_start)),
                 "crossings": [] if fl is None else [
                     {"speed": c.V, "omega_rad_s": c.omega, "freq_hz": c.frequency_hz,
                      "branch": int(c.branch), "kind": c.kind, "direction": c.direction}

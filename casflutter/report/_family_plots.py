@@ -154,7 +154,8 @@ def plot_family_vg_vf(result, family, *, branches=None, hz: bool | None = None,
         lo, hi = float(np.nanmin(zs)), float(np.nanmax(zs))
         pad = 0.1 * max(hi - lo, 1e-3)
         ag.set_ylim(min(lo, 0.0) - pad, hi + pad)
-        af.set_ylim(0.0, 1.12 * float(np.nanmax(freq[:, bs])))
+        top = 1.12 * float(np.nanmax(freq[:, bs]))
+        af.set_ylim(0.0, top if top > 0 else 1.0)    # only real poles: a frequency axis still
     ag.set_ylabel("damping ratio ζ = −Re λ / |λ|")
     af.set_ylabel(flabel)
     af.set_xlabel(speed_label(family))

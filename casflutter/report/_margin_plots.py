@@ -151,7 +151,8 @@ def plot_closed_loop_damping(result, *, ax=None, n: int = _N_DAMPING) -> Figure:
     ax.set_xlabel(_speed_label(result))
     ax.set_ylabel("closed-loop damping ratio ζ")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize="x-small", loc="best")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize="x-small", loc="best")
     iv = result.interval
     if iv.lower is None:
         title = f"{result.family}: closed loop, not stable at the range's start"

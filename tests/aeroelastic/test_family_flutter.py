@@ -76,6 +76,22 @@ def test_a_hump_inside_one_interval_and_a_divergence_are_found_exactly():
         ["divergence"]
 
 
+def test_the_onsets_line_names_each_destabilising_crossing_and_an_unstable_start():
+    """What a run prints for the open loop: the hump's flutter onset (the stabilising
+    crossing left out) and the divergence; and a family already unstable at its first speed,
+    which crosses nowhere, says so instead of 'no crossing'."""
+    res = family_flutter(_Hump(), speeds=[0.0, 0.7, 1.4, 2.0])
+    assert res.onsets("m/s") == (f"flutter at {1 - EPS ** 0.5:.5g} m/s (3 rad/s); "
+                                 "divergence at 1.5 m/s")
+    V = np.array([0.0, 1.0, 2.0])
+    unstable = GriddedFamily(V, [[[0.2]]] * 3, np.ones((3, 1, 1)), np.ones((3, 1, 1)),
+                             np.zeros((3, 1, 1)))
+    res = family_flutter(unstable)
+    assert res.status == "no_crossing" and res.unstable_at_start
+    assert res.onsets("m/s") == ("no crossing into instability in the range; unstable already "
+                                 "at 0 m/s (spectral abscissa 0.2 /s)")
+
+
 def _pair_grid(re):
     """A gridded family at speeds 0, 1, 2 whose pair is ``re(V) ± 5i`` at the grid speeds."""
     V = np.array([0.0, 1.0, 2.0])

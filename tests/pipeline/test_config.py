@@ -46,6 +46,9 @@ def test_defaults_are_the_paper_choices():
     ("stages = ['lco', 'dance']\n", r"stages: unknown stage 'dance'"),
     ("stages = ['suppression']\n", r"'suppression' needs the 'controller' stage"),
     ("[controller]\nmethod = 'hifoo'\n", r"controller.method = 'hifoo': allowed 'auto'"),
+    ("[controller]\norder = 0\n",
+     r"controller.order = 0 with strictly_proper = true \(the default\) .* static gain set "
+     r"strictly_proper = false"),
     ("[controller]\nspeeds = [0.5, 1.2]\n", r"controller.speeds .*containing 1.0"),
     ("[controller]\nmax_stab_rounds = 0\n",
      r"\[controller\] invalid SynthesisOptions.*max_stab_rounds"),

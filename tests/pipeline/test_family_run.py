@@ -48,6 +48,9 @@ def test_the_design_holds_the_interval_and_is_certified(family_run):
     assert lo <= 60.0 and hi >= 150.0          # the verification layer's certificate
     # the open family flutters inside the interval: the controller is doing the work
     assert 60.0 < s["flutter"]["V"] < 150.0
+    fam = s["family"]
+    assert fam["status"] == "flutter" and fam["unstable_at_start"] is False
+    assert fam["spectral_abscissa_start"] < 0
 
 
 def test_the_closed_loop_is_stable_where_certified_by_an_independent_computation(family_run):

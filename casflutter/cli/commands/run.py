@@ -131,9 +131,7 @@ def _main(args) -> int:
     family = s.get("family")
     if family is not None:
         unit = family["speed_unit"]
-        lines.append("flutter: " + ("; ".join(
-            f"{sig(c['speed'])} {unit} at {sig(c['omega_rad_s'])} rad/{family['time_unit']}"
-            for c in family["crossings"] if c["kind"] == "flutter") or "none in the range"))
+        lines.append("open loop: " + res.flutter.onsets(unit, family["time_unit"]))
     else:
         unit = "(speed index)"
         lines.append(f"speeds: V is the {s['units']['V']}")
