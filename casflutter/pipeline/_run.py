@@ -52,7 +52,8 @@ from .._linalg import spectral_abscissa
 from .._outputs import provenance, utc_now
 from .._processes import map_in_processes
 from .._threads import deterministic, single_threaded
-from ..aeroelastic import AeroelasticSystem, FlutterResult, find_flutter, simulate_loop
+from ..aeroelastic import (AeroelasticSystem, FlutterResult, find_flutter, load_family,
+                          simulate_loop)
 from ..data import envelope_growth_rate
 from ..errors import CasflutterError, ConfigError, ConvergenceError
 from ..lco import (LCOSettings, compare_lco, lco_branch, rom_lco_branch, rom_loop_flutter,
@@ -60,7 +61,7 @@ from ..lco import (LCOSettings, compare_lco, lco_branch, rom_lco_branch, rom_loo
 from ..realize import realize
 from ..truth import closed_loop_truth, truth_lco, truth_loop_matrix, truth_loop_sweep
 from ._config import RunConfig, load_config
-from ._control import ControllerStage, controller_stage
+from ._control import ControllerStage, controller_stage, start_controller
 from ._exports import check_output_folder, log_flags, write_outputs
 from ._model import (ROUTES, FlutterStage, ModelStage, Route, controlled_family, family_model,
                      frozen_flutter, gaf_model, parametric_flutter, rom_model, route_of,
@@ -160,6 +161,15 @@ def _checked(cfg: RunConfig, route: Route, problem) -> RunConfig:
     if route.kind == "family" and set(cfg.stages) - {"controller"}:
         log.info("a plant family file has no records or simulator: only the 'controller' "
                  "stage runs")
+    if route.kind == "family" and "controller" in cfg.stages:
+        # what the design would refuse after the family's flutter analysis, refused now
+        family = load_family(problem)
+        (lo, hi), (a, b) = cfg.controller.interval, family.speed_range
+        if lo < a or hi > b:
+            raise ConfigError(f"controller.interval = [{lo:g}, {hi:g}] leaves the speed range "
+                              f"[{a:g}, {b:g}] {family.speed_unit} of {family.name}; give an "
+                              "interval inside it")
+        start_controller(cfg, family)       # names and sizes matched (None without a start)
     return cfg
 
 

@@ -19,7 +19,7 @@ import pytest
 from casflutter.aeroelastic import load_family
 from casflutter.cli import main
 from casflutter.errors import ConfigError
-from casflutter.pipeline import load_config, start_controller
+from casflutter.pipeline import load_config, run, start_controller
 
 from .test_family_run import RUN    # the goland_4flaps run whose controller starts the next
 
@@ -94,6 +94,31 @@ def test_names_that_match_nothing_are_named(tmp_path):
                                "controller.start": str(tmp_path / "K.json")})
     with pytest.raises(ConfigError, match="gyro_05"):
         start_controller(cfg, family)
+
+
+@pytest.mark.parametrize("what, match", [
+    ("start", r"inputs\[0\] \('gyro_05'\) matches no measurement"),
+    ("interval",
+     r"controller.interval = \[60, 400\] leaves the speed range \[.*\] m/s of goland_4flaps"),
+])
+def test_a_run_refuses_what_the_design_would_before_any_work(tmp_path, monkeypatch, what,
+                                                             match):
+    """A start whose names match no signal and an interval outside the family's speeds are
+    refused before the family's flutter analysis, not by the design after it."""
+    doc = {"A": [[-1.0]], "B": [[1.0]], "C": [[1.0]], "D": [[0.0]],
+           "inputs": ["gyro_05"], "outputs": ["flap_1"]}
+    (tmp_path / "K.json").write_text(json.dumps(doc))
+    (tmp_path / "run.toml").write_text(RUN)
+    updates = ({"controller.start": str(tmp_path / "K.json")} if what == "start"
+               else {"controller.interval": [60.0, 400.0]})
+    cfg = load_config(tmp_path / "run.toml", updates=updates)
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("the flutter analysis ran before the refusal")
+
+    monkeypatch.setattr("casflutter.pipeline._model.family_flutter", no_work)
+    with pytest.raises(ConfigError, match=match):
+        run(cfg, quiet=True)
 
 
 def test_a_run_continues_the_start_first(tmp_path):
