@@ -923,7 +923,10 @@ def _finish(eng: _Engine, fams, K: np.ndarray, order: int, interval: tuple, reac
         message += (f"; its H∞ phase stopped after {syn.best.outer_iterations} of "
                     f"{s.synthesis.max_outer} iterations without converging ({syn.best.reason}): "
                     "the objective is the best found, not a local minimum")
-    log.info("multi-speed design: %s; worst H-infinity objective %.5g", message, gamma)
+    if np.isfinite(gamma):
+        log.info("multi-speed design: %s; worst H-infinity objective %.5g", message, gamma)
+    else:
+        log.info("multi-speed design: %s; no H-infinity phase", message)
     sig = fams[0].signals          # K reads the measurements and drives the controls
     Kss = control.ss(Kss.A, Kss.B, Kss.C, Kss.D, inputs=list(sig.measurements),
                      outputs=list(sig.controls), name="K")
