@@ -80,8 +80,11 @@ def _inverse(R: np.ndarray) -> np.ndarray:
 
 
 def _derivative(W: np.ndarray, dA: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``λ_i' = w_i A' r_i`` and the condition numbers ``|w_i| |r_i|`` (``|r_i| = 1``)."""
-    return np.einsum("ij,ji->i", W, dA @ R), np.linalg.norm(W, axis=1)
+    """``λ_i' = w_i A' r_i`` and the condition numbers ``|w_i| |r_i|`` (``|r_i| = 1``); at
+    a defective eigenvalue (a double integrator's Jordan block) ``W`` is huge and both come
+    out infinite or NaN, which the callers take as a derivative not to trust."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return np.einsum("ij,ji->i", W, dA @ R), np.linalg.norm(W, axis=1)
 
 
 def _match(a: _Node, b: _Node) -> tuple[np.ndarray, np.ndarray]:
