@@ -32,7 +32,7 @@ import control
 import numpy as np
 
 from .._format import result_repr
-from ..data import check_grid_speeds, check_stack
+from ..data import check_grid_speeds, check_stack, check_state_stack
 from ..errors import ConfigError, DimensionError
 
 __all__ = ["FEEDBACK_SIGNS", "FamilySignals", "PlantFamily", "MatrixFamily", "GriddedFamily",
@@ -50,6 +50,11 @@ def _names(what: str, names) -> tuple[str, ...]:
                           "needs its own name")
     if any(not n.strip() for n in out):
         raise ConfigError(f"{what}: an empty name; every signal needs a name")
+    padded = [n for n in out if n != n.strip()]
+    if padded:
+        raise ConfigError(f"{what}: the names {padded} have blanks around them; names are "
+                          f"matched exactly, so give them without: {[n.strip() for n in padded]} "
+                          "(as a family file reads them)")
     return out
 
 
@@ -76,7 +81,8 @@ class FamilySignals:
     Parameters
     ----------
     inputs, outputs : sequence of str
-        Every input and output of the plant, in the plant's order (unique names).
+        Every input and output of the plant, in the plant's order (unique names, without
+        surrounding blanks).
     controls : sequence of str, optional
         The inputs a controller drives (control surfaces, or their servo commands); default
         all inputs.  The other inputs are disturbances.
@@ -88,8 +94,9 @@ class FamilySignals:
     Raises
     ------
     ConfigError
-        Repeated or empty names, roles naming signals the plant does not have, units of the
-        wrong length, or no control input or no measurement.
+        Repeated or empty names, names with blanks around them, roles naming signals the
+        plant does not have, units of the wrong length, or no control input or no
+        measurement.
     """
 
     inputs: tuple
@@ -423,7 +430,8 @@ class GriddedFamily(MatrixFamily):
     Raises
     ------
     DimensionError
-        Arrays that are ragged, not finite, or of inconsistent sizes (named).
+        Arrays that are ragged, not finite, or of inconsistent sizes (named); no states
+        (``n = 0``: a static plant has no flutter).
     ConfigError
         Speeds not strictly increasing or not finite, an unknown feedback convention, or
         signals that do not match the sizes.
@@ -436,10 +444,8 @@ class GriddedFamily(MatrixFamily):
                  name: str = "gridded plant family"):
         v = check_grid_speeds(speeds)
         k = v.size
-        A = check_stack("A", A, k, None, None)
+        A = check_state_stack(A, k)
         n = A.shape[1]
-        if A.shape[2] != n:
-            raise DimensionError(f"A has shape {A.shape}; each A must be square (n, n)")
         B = check_stack("B", B, k, n, None)
         C = check_stack("C", C, k, None, n)
         D = check_stack("D", D, k, C.shape[1], B.shape[2])

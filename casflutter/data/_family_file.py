@@ -15,6 +15,8 @@ Problem file (``kind = "plant_family"``)::
                                  #   "negative": u = -K y (MATLAB's feedback(P, K))
                                  #   "positive": u = +K y (the paper's v = K zm)
     interpolation = "linear"     # between grid speeds, elementwise (the only one)
+    layout = "pages"             # optional, .mat only: "pages" (A n x n x k) or
+                                 #   "speed_first" (A k x n x n); default: the one that fits
     controls = ["flap_1", ...]   # optional: the inputs a controller drives (default all)
     measurements = ["gyro", ...] # optional: the outputs a controller reads (default all)
     input_units = ["rad", ...]   # optional, one per input ("" where unknown)
@@ -38,14 +40,22 @@ Data file, MATLAB ``.mat`` (v5/v7; ``save(file, ..., '-v7')``)
     The same variables.  The arrays may be stacked as MATLAB stacks model arrays, one page
     per speed (``A(:, :, j)``, ``n x n x k``: what ``ssdata`` of an ss array gives), or with
     the speed first (``k x n x n``); the layout that fits all four arrays and ``speeds`` is
-    taken (the pages when both fit, i.e. when ``n = m = p = k``).  ``A`` may also be a cell
-    array ``{A1, ..., Ak}`` (so may ``B``, ``C``, ``D``).  Names are cell arrays of strings
-    or char matrices.  v7.3 (HDF5) files are refused with the fix.
+    taken.  When both fit (when ``n = m = p = k``) the pages are taken with a
+    :class:`~casflutter.errors.DataWarning`, since a file saved speed first is then read
+    wrong: ``layout = "pages"`` or ``"speed_first"`` in the problem file says which (the
+    writer of ``.mat`` files says ``"pages"``).  ``A`` may also be a cell array
+    ``{A1, ..., Ak}`` (so may ``B``, ``C``, ``D``).  Names are cell arrays of strings or
+    char matrices.  v7.3 (HDF5) files are refused with the fix.
+
+Signal names, in the data file and in ``controls`` / ``measurements``, are taken without
+surrounding blanks (a MATLAB char matrix pads its rows), so ``"q "`` and ``"q"`` are the
+same signal.
 
 Every inconsistency is an error before any work: a ragged or non-numeric array, a non-finite
 entry (named with its index), speeds not strictly increasing, a matrix size (the state
-dimension among them) that changes along the grid, names that do not match the sizes, an
-unknown key in the problem file (with the closest allowed one), a missing data file.
+dimension among them) that changes along the grid, no states (a static plant has no
+flutter), names that do not match the sizes, an unknown key in the problem file (with the
+closest allowed one), a missing data file.
 """
 
 from __future__ import annotations
@@ -64,7 +74,8 @@ from .._format import result_repr
 from .._outputs import atomic_file, check_output_path
 from .._resources import read_toml
 from ..errors import ConfigError, DataError, DimensionError
-from ._family_arrays import ARRAYS, check_grid_speeds, check_stack, read_family_arrays
+from ._family_arrays import (ARRAYS, check_grid_speeds, check_layout, check_stack,
+                             check_state_stack, read_family_arrays)
 
 __all__ = ["FAMILY_KIND", "INTERPOLATIONS", "FEEDBACK_CONVENTIONS", "FamilyFile",
            "read_family_file"]
@@ -77,7 +88,7 @@ INTERPOLATIONS = ("linear",)
 FEEDBACK_CONVENTIONS = ("negative", "positive")
 
 _TOP_KEYS = ("kind", "file", "speed_unit", "time_unit", "feedback", "interpolation",
-             "controls", "measurements", "input_units", "output_units", "problem",
+             "layout", "controls", "measurements", "input_units", "output_units", "problem",
              "reference")
 _PROBLEM_KEYS = ("name", "description", "source")
 
@@ -121,7 +132,8 @@ class FamilyFile:
     input_names, output_names : sequence of str, optional
         One per input / output (default ``u1..um``, ``y1..yp``).
     controls, measurements : sequence of str, optional
-        Roles by name (default all inputs, all outputs).
+        Roles by name (default all inputs, all outputs).  Every name (these,
+        ``input_names`` and ``output_names``) is taken without surrounding blanks.
     input_units, output_units : sequence of str, optional
         One per signal.
     reference : dict, optional
@@ -133,7 +145,8 @@ class FamilyFile:
     Raises
     ------
     DimensionError
-        Arrays ragged, non-finite or of inconsistent sizes; names that do not match them.
+        Arrays ragged, non-finite or of inconsistent sizes, no states (``n = 0``); names
+        that do not match them.
     ConfigError
         Speeds not strictly increasing, an unknown feedback convention or interpolation.
     """
@@ -165,10 +178,8 @@ class FamilyFile:
     def __post_init__(self):
         v = check_grid_speeds(self.speeds)
         k = v.size
-        A = check_stack("A", self.A, k, None, None)
+        A = check_state_stack(self.A, k)
         n = A.shape[1]
-        if A.shape[2] != n:
-            raise DimensionError(f"A has shape {A.shape}; each A must be square (n, n)")
         B = check_stack("B", self.B, k, n, None)
         C = check_stack("C", self.C, k, None, n)
         D = check_stack("D", self.D, k, C.shape[1], B.shape[2])
@@ -191,7 +202,7 @@ class FamilyFile:
                 "data_path": None if self.data_path is None else Path(self.data_path)}
         for key in ("controls", "measurements"):
             value = getattr(self, key)
-            sets[key] = None if value is None else tuple(str(s) for s in value)
+            sets[key] = None if value is None else tuple(str(s).strip() for s in value)
         for key in ("input_units", "output_units"):
             sets[key] = tuple(str(s) for s in getattr(self, key))
         for key, value in sets.items():
@@ -238,7 +249,8 @@ class FamilyFile:
             The problem file (``.toml``).
         format : {"npz", "mat"}
             Data-file format (the ``.mat`` file stacks the matrices as MATLAB pages,
-            ``n x n x k``, names as cell arrays).
+            ``n x n x k``, names as cell arrays; the problem file then says
+            ``layout = "pages"``).
         data_file : str, optional
             Name of the data file, beside the problem file (default its stem with the
             format's suffix).
@@ -271,7 +283,7 @@ class FamilyFile:
         with atomic_file(data) as tmp:
             (self._write_npz if format == "npz" else self._write_mat)(tmp)
         with atomic_file(path) as tmp:
-            tmp.write_text(self._toml(data_file), encoding="utf-8")
+            tmp.write_text(self._toml(data_file, format), encoding="utf-8")
         return path
 
     def _write_npz(self, path: Path) -> None:
@@ -290,7 +302,7 @@ class FamilyFile:
                        "input_names": cell(self.input_names),
                        "output_names": cell(self.output_names)}, do_compression=True)
 
-    def _toml(self, data_file: str) -> str:
+    def _toml(self, data_file: str, format: str) -> str:
         lines = [f"# A gridded plant family ({self.n_states} states, {self.n_inputs} inputs, "
                  f"{self.n_outputs} outputs, {self.speeds.size} speeds); layout: "
                  "casflutter/data/_family_file.py",
@@ -300,6 +312,8 @@ class FamilyFile:
                  f"time_unit = {_toml_value(self.time_unit)}",
                  f"feedback = {_toml_value(self.feedback)}",
                  f"interpolation = {_toml_value(self.interpolation)}"]
+        if format == "mat":
+            lines.append(f"layout = {_toml_value('pages')}")
         for key in ("controls", "measurements", "input_units", "output_units"):
             value = getattr(self, key)
             if value:
@@ -394,7 +408,7 @@ def read_family_file(path) -> FamilyFile:
     ------
     ConfigError
         A missing file, invalid TOML, a missing, unknown (with the closest allowed one) or
-        malformed key, an unknown feedback convention or interpolation.
+        malformed key, an unknown feedback convention, interpolation or layout.
     DataError
         A missing or unreadable data file, or arrays, speeds or names that do not fit
         (the message names the file and the array).
@@ -422,15 +436,19 @@ def read_family_file(path) -> FamilyFile:
         if meta[key] not in allowed:
             raise ConfigError(f"{source}: {key} = {meta[key]!r}; allowed: "
                               f"{', '.join(map(repr, allowed))}")
+    try:
+        layout = check_layout(data.get("layout"), Path(file).suffix)
+    except ConfigError as exc:
+        raise ConfigError(f"{source}: {exc}") from None
     roles = {key: _strings(data, key, source) for key in ("controls", "measurements")}
     units = {key: _strings(data, key, source) or () for key in ("input_units", "output_units")}
-    default = path.parent.name if path.name == "problem.toml" else path.stem
+    default = path.resolve().parent.name if path.name == "problem.toml" else path.stem
     info = {key: str(problem.get(key, "")) for key in ("description", "source")}
     data_path = path.parent / file
     if not data_path.is_file():
         raise DataError(f"{source}: file = {file!r}: {data_path} not found (a relative path "
                         "is taken from the problem file's folder)")
-    arrays = read_family_arrays(data_path)
+    arrays = read_family_arrays(data_path, layout=layout)
     try:
         return FamilyFile(**arrays, **meta, **roles, **units, **info,
                           name=str(problem.get("name", default)), reference=reference,

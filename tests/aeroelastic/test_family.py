@@ -56,6 +56,9 @@ def test_signals_roles_and_control_plant_by_name():
     (dict(measurements=["nz"]), "not among the outputs"),
     (dict(inputs=["a", "a"]), "more than once"),
     (dict(input_units=["rad"]), "one unit per signal"),
+    (dict(inputs=["elevator ", "gust"]), r"the names \['elevator '\] have blanks around them.*"
+                                        r"\['elevator'\]"),
+    (dict(measurements=[" q"]), r"measurements: the names \[' q'\] have blanks"),
 ])
 def test_signals_errors_name_the_problem(kw, match):
     args = dict(inputs=["elevator", "gust"], outputs=["q", "az"])
@@ -81,6 +84,15 @@ def test_gridded_family_refuses_bad_arrays_before_any_work():
     fam = GriddedFamily(speeds, A, B, C, D)
     with pytest.raises(ConfigError, match="outside the range"):
         fam.plant(41.0)
+
+
+def test_gridded_family_without_states_is_refused_with_the_fix():
+    # a static plant (D only) has no poles: no flutter to find, and the analyses need A
+    speeds, (_, _, _, D) = _grid()
+    k, p, m = D.shape
+    with pytest.raises(DimensionError, match=r"A has shape \(4, 0, 0\): the family has no "
+                                             r"states \(a static plant, D only\).*n >= 1"):
+        GriddedFamily(speeds, np.zeros((k, 0, 0)), np.zeros((k, 0, m)), np.zeros((k, p, 0)), D)
 
 
 def test_the_wing_loop_is_a_family_with_named_sensors_and_one_flap():

@@ -56,6 +56,21 @@ def test_role_names_are_checked_with_the_closest_signal(tmp_path):
         load_family(bad)
 
 
+def test_role_names_with_blanks_match_as_the_data_file_names_do(tmp_path):
+    # the data file's names are stripped (a MATLAB char matrix pads them): so are the roles
+    rng = np.random.default_rng(1)
+    np.savez(tmp_path / "g.npz", speeds=[10.0, 20.0], A=-np.ones((2, 1, 1)),
+             B=rng.standard_normal((2, 1, 2)), C=rng.standard_normal((2, 2, 1)),
+             D=np.zeros((2, 2, 2)), input_names=np.array(["flap ", "gust"]),
+             output_names=np.array(["gyro", "acc"]))
+    (tmp_path / "f.toml").write_text('kind = "plant_family"\nfile = "g.npz"\n'
+                                     'speed_unit = "m/s"\nfeedback = "negative"\n'
+                                     'controls = [" flap"]\nmeasurements = ["acc "]\n')
+    fam = load_family(tmp_path / "f.toml")
+    assert fam.signals.controls == ("flap",) and fam.signals.measurements == ("acc",)
+    assert fam.signals.disturbances == ("gust",)
+
+
 @pytest.mark.parametrize("name", ["goland_4flaps", "seed_wing_family"])
 def test_shipped_npz_and_mat_files_hold_the_same_family(name):
     a = load_family(problems_dir() / name)

@@ -1,6 +1,8 @@
 """Gridded plant-family files: the round trip through .npz and MATLAB .mat, the MATLAB
-layouts (pages, speed first, cell arrays, cellstr and char-matrix names), and every input
-error named before any work.
+layouts (pages, speed first, cell arrays, cellstr and char-matrix names; a warning and the
+``layout`` key when both fit), names stripped of blanks alike in the data file and the
+problem file, and every input error (a family without states among them) named before any
+work.
 
 Truth used: the arrays written are the arrays read back (bit for bit), and scipy's own
 ``savemat`` writes the MATLAB files the way MATLAB stores them.
@@ -8,13 +10,15 @@ Truth used: the arrays written are the arrays read back (bit for bit), and scipy
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from numpy.testing import assert_array_equal
 from scipy.io import savemat
 
 from casflutter.data import FamilyFile, read_family_arrays, read_family_file
-from casflutter.errors import ConfigError, DataError
+from casflutter.errors import ConfigError, DataError, DataWarning, DimensionError
 
 K, N, M, P = 5, 4, 2, 3
 
@@ -93,6 +97,15 @@ def test_default_names_and_time_unit(tmp_path):
     assert rec.input_names == ("u1",) and rec.output_names == ("y1",)
     assert rec.time_unit == "s" and rec.interpolation == "linear"
     assert rec.name == tmp_path.name                  # problem.toml: named by its folder
+
+
+def test_a_problem_toml_given_relative_to_its_folder_is_named_by_the_folder(tmp_path,
+                                                                              monkeypatch):
+    np.savez(tmp_path / "g.npz", speeds=[1.0, 2.0], A=-np.ones((2, 1, 1)), B=np.ones((2, 1, 1)),
+             C=np.ones((2, 1, 1)), D=np.zeros((2, 1, 1)))
+    _toml(tmp_path / "problem.toml", "g.npz")
+    monkeypatch.chdir(tmp_path)
+    assert read_family_file("problem.toml").name == tmp_path.name     # not ""
 
 
 def test_npz_names_stored_as_bytes_read_as_text(tmp_path):
@@ -192,3 +205,86 @@ def test_writer_refuses_bad_format_and_names(tmp_path):
     with pytest.raises(ConfigError, match="feedback = 'plus'"):
         _record(feedback="plus")
     assert not list(tmp_path.iterdir())                       # nothing written
+
+
+def test_a_family_without_states_is_refused_with_the_fix(tmp_path):
+    static = dict(A=np.zeros((K, 0, 0)), B=np.zeros((K, 0, M)), C=np.zeros((K, P, 0)))
+    match = r"A has shape \(5, 0, 0\): the family has no states.*static plant.*n >= 1"
+    with pytest.raises(DimensionError, match=match):
+        _record(**static)
+    with pytest.raises(DataError, match=r"g.npz: " + match):
+        read_family_file(_npz(tmp_path, **static))
+
+
+def _square(k=4, seed=3):
+    """n = m = p = k: arrays that fit both .mat layouts, saved speed first."""
+    rng = np.random.default_rng(seed)
+    return {"speeds": np.linspace(40.0, 200.0, k),
+            **{key: rng.standard_normal((k, k, k)) for key in ("A", "B", "C", "D")}}
+
+
+def test_mat_arrays_fitting_both_layouts_warn_and_the_layout_key_decides(tmp_path):
+    arrays = _square()
+    savemat(tmp_path / "g.mat", arrays)                       # speed first
+    with pytest.warns(DataWarning, match=r"g.mat: the arrays fit 4 speeds both as MATLAB pages "
+                                         r"and speed first.*read as pages.*"
+                                         r"layout = \"speed_first\""):
+        rec = read_family_file(_toml(tmp_path / "f.toml", "g.mat"))
+    assert_array_equal(rec.A, np.moveaxis(arrays["A"], -1, 0))     # the documented rule
+    for layout, want in (("speed_first", arrays), ("pages", {
+            key: np.moveaxis(arrays[key], -1, 0) for key in ("A", "B", "C", "D")})):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            rec = read_family_file(_toml(tmp_path / "f.toml", "g.mat", layout=f'"{layout}"'))
+        for key in ("A", "B", "C", "D"):
+            assert_array_equal(getattr(rec, key), want[key], err_msg=f"{layout}: {key}")
+
+
+def test_mat_arrays_fitting_one_layout_or_all_cells_do_not_warn(tmp_path):
+    rec = _record()                                           # k = 5, n = 4: unambiguous
+    cells = np.empty((1, 4), dtype=object)
+    arrays = _square()
+    for j in range(4):
+        cells[0, j] = arrays["A"][j]
+    cases = {"first": {key: getattr(rec, key) for key in ("speeds", "A", "B", "C", "D")},
+             "cells": {**arrays, **{key: cells for key in ("A", "B", "C", "D")}}}
+    for name, data in cases.items():
+        savemat(tmp_path / f"{name}.mat", data)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            read_family_arrays(tmp_path / f"{name}.mat")
+
+
+def test_mat_writer_says_pages_so_a_square_family_reads_back_without_warning(tmp_path):
+    arrays = _square()
+    rec = FamilyFile(**arrays, speed_unit="m/s", feedback="negative")
+    toml = rec.write(tmp_path / "sq.toml", format="mat")
+    assert 'layout = "pages"' in toml.read_text()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        back = read_family_file(toml)
+    for key in ("A", "B", "C", "D"):
+        assert_array_equal(getattr(back, key), arrays[key])
+    assert "layout =" not in rec.write(tmp_path / "sq2.toml", format="npz").read_text()
+
+
+def test_layout_errors_name_the_fix(tmp_path):
+    with pytest.raises(ConfigError, match="layout = 'cubes'; allowed: 'pages', 'speed_first'"):
+        read_family_file(_toml(tmp_path / "f.toml", "absent.mat", layout='"cubes"'))
+    with pytest.raises(ConfigError, match="an .npz data file is stored speed first"):
+        read_family_file(_toml(tmp_path / "f.toml", "absent.npz", layout='"pages"'))
+    rec = _record()
+    savemat(tmp_path / "g.mat", {key: getattr(rec, key) for key in ("speeds", "A", "B", "C",
+                                                                     "D")})
+    with pytest.raises(DataError, match="layout = 'pages', but the arrays do not fit 5 speeds "
+                                        "stacked as MATLAB pages.*they do fit 'speed_first'"):
+        read_family_file(_toml(tmp_path / "f.toml", "g.mat", layout='"pages"'))
+
+
+def test_names_with_blanks_are_stripped_in_the_data_file_and_the_problem_file(tmp_path):
+    path = _npz(tmp_path, input_names=np.array([" elevon ", "gust"]),
+                output_names=np.array(["q", "az ", "nz"]))
+    path.write_text(path.read_text() + 'controls = ["elevon "]\nmeasurements = [" q", "az"]\n')
+    rec = read_family_file(path)
+    assert rec.input_names == ("elevon", "gust") and rec.output_names == ("q", "az", "nz")
+    assert rec.controls == ("elevon",) and rec.measurements == ("q", "az")
