@@ -13,11 +13,15 @@ folder cannot be written, nor leave a folder that mixes two runs:
   killed outright leaves the ``.incomplete`` folder, never a half folder at the target).
   With ``overwrite`` the old folder is replaced as a whole (no stale file of the old run
   stays beside the new ones).
-- :func:`atomic_file` does the same for one file (write to a temporary name, then rename).
-  Both create their temporary folder or file with the ordinary modes (``0o777`` for a
-  folder, ``0o666`` for a file, less the umask: 0755 and 0644 under umask 022), not the
-  private 0700/0600 of :func:`tempfile.mkdtemp`/:func:`tempfile.mkstemp`, so the outputs
-  are readable by whoever may read the user's other files.
+- :func:`atomic_file` does the same for one file (write to a temporary name, then rename);
+  :func:`save_figure` writes a matplotlib figure through it (the commands' ``--figure``).
+  Like :func:`atomic_folder`, they create the missing parent folders of their target: a
+  path :func:`check_output_path` accepted (whose folder need not exist yet) is written.
+  :func:`atomic_folder` and :func:`atomic_file` create their temporary folder or file with
+  the ordinary modes (``0o777`` for a folder, ``0o666`` for a file, less the umask: 0755
+  and 0644 under umask 022), not the private 0700/0600 of
+  :func:`tempfile.mkdtemp`/:func:`tempfile.mkstemp`, so the outputs are readable by
+  whoever may read the user's other files.
 - :func:`provenance` and :func:`write_manifest` record what produced a folder: the package
   version, the configuration's hash, the seed, the thread settings (BLAS environment
   variables and the thread pools threadpoolctl sees), the completed stages, start and end
@@ -45,8 +49,8 @@ from . import __version__
 from .errors import OutputError
 
 __all__ = ["check_output_path", "check_figure_path", "atomic_folder", "atomic_file",
-           "check_output_folder", "provenance", "thread_settings", "config_hash", "write_manifest", "utc_now",
-           "plain_json",
+           "save_figure", "check_output_folder", "provenance", "thread_settings",
+           "config_hash", "write_manifest", "utc_now", "plain_json",
            "INCOMPLETE_TAG", "MANIFEST_NAME", "THREAD_ENV_VARS"]
 
 #: Part of the name of a folder being written (``NAME.incomplete-XXXXXX``, beside NAME).
@@ -95,7 +99,8 @@ def check_output_path(path: str | os.PathLike, *, what: str = "output",
     what : str
         How the message names the input (``"--out"``, ``"--figure"``, ``"output folder"``).
     kind : {"file", "dir"}
-        A file (its folder is created later by the writer) or a folder.
+        A file (its missing folders are created later by the writer, :func:`atomic_file`
+        or :func:`save_figure`) or a folder (:func:`atomic_folder`).
     suffixes : iterable of str, optional
         Allowed file suffixes (lower case, with the dot, e.g. ``(".png", ".pdf")``).
     overwrite : bool
@@ -300,13 +305,16 @@ def _move_into_place(tmp: Path, target: Path, *, overwrite: bool, what: str) -> 
 
 
 @contextmanager
-def atomic_file(target: str | os.PathLike) -> Iterator[Path]:
+def atomic_file(target: str | os.PathLike, *, what: str = "output file") -> Iterator[Path]:
     """Write one file under a temporary name beside ``target`` and rename it at the end.
 
     Parameters
     ----------
     target : str or path-like
-        The file; its folder must exist.
+        The file.  Its missing parent folders are created (as :func:`atomic_folder` does),
+        so a path that :func:`check_output_path` accepted can be written.
+    what : str
+        How a message names the file (``"--out"``).
 
     Yields
     ------
@@ -314,16 +322,63 @@ def atomic_file(target: str | os.PathLike) -> Iterator[Path]:
         The temporary path to write (``TARGET.incomplete-XXXXXX`` + the target's suffix, so
         that writers which choose the format by suffix still work).  Removed if the block
         raises.
+
+    Raises
+    ------
+    OutputError
+        The folder or the temporary file cannot be created (a parent is a file, no
+        permission); the message names ``what``, the path and the fix.
     """
-    target = Path(target)
-    tmp = _create_unique(target.parent, target.stem + INCOMPLETE_TAG, target.suffix,
-                         directory=False)
+    target = Path(os.fspath(target)).expanduser()
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        tmp = _create_unique(target.parent, target.stem + INCOMPLETE_TAG, target.suffix,
+                             directory=False)
+    except OSError as exc:
+        raise OutputError(f"{what} {target}: cannot create a file in {target.parent} "
+                          f"({exc.strerror or exc}); choose a writable location") from None
     try:
         yield tmp
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
     os.replace(tmp, target)
+
+
+def save_figure(fig, path: str | os.PathLike, *, what: str = "--figure",
+                **savefig_kw) -> Path:
+    """Save a matplotlib figure to ``path`` through :func:`atomic_file`.
+
+    The one writer of the commands' ``--figure PATH``: the missing parent folders are
+    created (the path was checked by :func:`check_figure_path` before the work, and its
+    folder need not exist yet), and the file appears only when it is complete.  The format
+    is chosen by the suffix, as :meth:`matplotlib.figure.Figure.savefig` does.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure (left open: the caller closes it).
+    path : str or path-like
+        The file to write.
+    what : str
+        How a message names the file.
+    **savefig_kw
+        Passed to :meth:`~matplotlib.figure.Figure.savefig` (``dpi``, ...).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path`` as a :class:`~pathlib.Path`.
+
+    Raises
+    ------
+    OutputError
+        As :func:`atomic_file`.
+    """
+    target = Path(os.fspath(path)).expanduser()
+    with atomic_file(target, what=what) as tmp:
+        fig.savefig(tmp, **savefig_kw)
+    return target
 
 
 # ---------------------------------------------------------------------- provenance

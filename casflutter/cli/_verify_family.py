@@ -14,11 +14,14 @@ finds: ``stable_interval`` (certified), ``absolute_flutter_speed``, ``robust_flu
 (``--margins GM_DB PM_DEG``, default 6 dB / 45°; ``--disk`` adds the multi-loop disk
 margins), the margins per loop and per speed at the plant inputs and outputs, and the
 closed-loop crossings, in the family's units.  ``--figure PATH`` saves the margins and the
-closed-loop damping against the speed.
+closed-loop damping against the speed (its missing folders are created).
 
 The verdict is the exit code: 1 when the closed loop is not stable just above the range's
-start, or when ``--require-v LO HI`` is not covered by the certified interval or the margins
-fail their thresholds inside it (the last line, ``verdict`` in the JSON, says which).
+start, or, with ``--require-v LO HI``, when the certified stable interval does not cover
+``[LO, HI]`` or a margin falls below its threshold (``--margins``, and with ``--disk`` the
+disk margins) at a speed below HI: the robust flutter speed, counted from the start of the
+verified range (``--range``, default the family's), must be above HI.  The last line
+(``verdict`` in the JSON) says which.
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from .._outputs import check_figure_path, print_json
+from .._outputs import check_figure_path, print_json, save_figure
 from ..errors import ConfigError
 
 __all__ = ["add_arguments", "is_family", "load_plant_family", "run", "verify_command",
@@ -119,7 +122,9 @@ def verdict(result, require_v=None) -> dict:
     ----------
     result : FamilyVerification
     require_v : (float, float), optional
-        Speeds the certified interval must cover and the margins must hold over.
+        Speeds ``(LO, HI)`` the certified interval must cover; the margins must hold their
+        thresholds from the verified range's start up to HI (the robust flutter speed above
+        HI, :meth:`~casflutter.verify.FamilyVerification.robust_over`).
 
     Returns
     -------
@@ -151,13 +156,61 @@ def verdict(result, require_v=None) -> dict:
         reason = (f"not covered: certified stable only on {where}{why}, which does not cover "
                   f"the required [{lo:.6g}, {hi:.6g}]")
     elif not out["robust"]:
-        reason = (f"not robust: margins below {result.gain_margin_db:g} dB / "
-                  f"{result.phase_margin_deg:g} deg from {result.robust_flutter_speed:.6g} "
-                  f"{u}, inside the required [{lo:.6g}, {hi:.6g}] ({result.robust_reason})")
+        rfs = result.robust_flutter_speed
+        below = (f"not robust: margins below {result.gain_margin_db:g} dB / "
+                 f"{result.phase_margin_deg:g} deg from {rfs:.6g} {u}")
+        if rfs >= lo:
+            reason = (f"{below}, inside the required [{lo:.6g}, {hi:.6g}] "
+                      f"({result.robust_reason})")
+        else:   # the margins are held from the verified range's start, not from LO
+            reason = (f"{below} ({result.robust_reason}), below the required [{lo:.6g}, "
+                      f"{hi:.6g}]: the margins must hold from the verified range's start, "
+                      f"{result.speed_range[0]:.6g} {u}, up to {hi:.6g}")
     else:
         reason = (f"certified stable and robust over [{lo:.6g}, {hi:.6g}] {u}")
     out.update(passed=bool(out["covered"] and out["robust"]), reason=reason)
     return out
+
+
+def _check_range(family, speed_range=None) -> tuple[float, float]:
+    """The speeds ``--range`` asks to verify, checked before any work.
+
+    The library's own checks (:func:`casflutter.verify.verify_family`) name its keyword
+    ``speed_range``; these name the option.
+
+    Parameters
+    ----------
+    family : casflutter.aeroelastic.PlantFamily
+        The family.
+    speed_range : (float, float), optional
+        ``--range LO HI`` (default: the family's own range).
+
+    Returns
+    -------
+    (float, float)
+        The range verified.
+
+    Raises
+    ------
+    ConfigError
+        ``--range`` is not two finite speeds ``LO < HI`` inside the family's range
+        (:meth:`~casflutter.aeroelastic.PlantFamily.check_speed`), or it is not given and
+        the family's range is unbounded (a loop family).
+    """
+    u = family.speed_unit
+    if speed_range is None:
+        lo, hi = (float(v) for v in family.speed_range)
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+            raise ConfigError(f"{family.name}: its speed range [{lo:g}, {hi:g}] {u} is not a "
+                              "finite interval; pass --range LO HI (the speeds to verify)")
+        return lo, hi
+    lo, hi = (float(v) for v in speed_range)
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        raise ConfigError(f"--range {lo:g} {hi:g}: give two finite speeds LO < HI ({u})")
+    if not lo < hi:
+        fix = f"--range {hi:g} {lo:g}" if hi < lo else "two different speeds"
+        raise ConfigError(f"--range {lo:g} {hi:g}: LO must be below HI; give {fix}")
+    return family.check_speed(lo, "--range LO"), family.check_speed(hi, "--range HI")
 
 
 def verify_command(family, controller, *, speed_range=None, require_v=None,
@@ -191,11 +244,11 @@ def verify_command(family, controller, *, speed_range=None, require_v=None,
 
     if figure is not None:
         check_figure_path(figure)
+    rng = _check_range(family, speed_range)
     if require_v is not None:
         lo, hi = require_v
         if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
             raise ConfigError(f"--require-v {lo!r} {hi!r}: give two finite speeds LO <= HI")
-        rng = speed_range if speed_range is not None else family.speed_range
         if lo < rng[0] or hi > rng[1]:
             raise ConfigError(f"--require-v [{lo:g}, {hi:g}] reaches outside the speeds "
                               f"verified [{rng[0]:g}, {rng[1]:g}] {family.speed_unit}; "
@@ -204,9 +257,13 @@ def verify_command(family, controller, *, speed_range=None, require_v=None,
                            disk=disk)
     v = verdict(result, require_v)
     if figure is not None:
+        import matplotlib.pyplot as plt
+
         from ..report import plot_family_verification
 
-        plot_family_verification(result).savefig(figure, dpi=120)
+        fig = plot_family_verification(result)
+        save_figure(fig, figure, dpi=120)
+        plt.close(fig)
     if json_out:
         print_json({**result.to_dict(), "verdict": v})
     else:

@@ -56,6 +56,8 @@ def _bad_inputs(tmp):
         (["demo", "--noise", "nan"], ["--noise nan", "in [0, 1)"]),
         (["verify", str(tmp / "missing.json"), str(tmp / "K.json")],
          [str(tmp / "missing.json"), "file not found"]),
+        (["verify", "goland_4flaps", str(tmp / "K.json"), "--range", "150", "60"],
+         ["--range 150 60", "LO must be below HI", "give --range 60 150"]),
         (["problems", "no_such_problem"], ["'no_such_problem'", "available: typical_section"]),
         (["run", "--set", "controller.ordr=3", "--out", str(tmp / "run")],
          ["'ordr' in [controller]", "did you mean 'order'?"]),

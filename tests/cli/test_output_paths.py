@@ -1,10 +1,13 @@
-"""Output paths are checked before any work (``check_output_path``), and ``casflutter
-flutter`` writes a figure only where asked."""
+"""Output paths are checked before any work (``check_output_path``), their missing folders
+are created by the writers (``atomic_file``, ``save_figure``), and ``casflutter flutter``
+writes a figure only where asked."""
 
 from __future__ import annotations
 
 import json
+import os
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -98,3 +101,69 @@ def test_flutter_writes_no_figure_unless_asked(tmp_path, monkeypatch, capsys):
     doc = json.loads(capsys.readouterr().out)
     assert doc["figure"] is None and doc["truth"]["V_flutter"] > 0
     assert list(tmp_path.iterdir()) == []  # nothing dropped into the current folder
+
+
+def test_atomic_file_and_save_figure_create_the_missing_folders(tmp_path):
+    """``check_output_path`` accepts a file whose folder does not exist yet ("created later by
+    the writer"): the writers create it, and leave no temporary file beside the target."""
+    import matplotlib.pyplot as plt
+
+    from casflutter._outputs import atomic_file, save_figure
+
+    target = tmp_path / "new" / "sub" / "x.json"
+    with atomic_file(target) as tmp:
+        tmp.write_text("{}")
+    assert target.read_text() == "{}" and os.listdir(target.parent) == ["x.json"]
+    fig = plt.figure(figsize=(1, 1))
+    try:
+        path = save_figure(fig, tmp_path / "figs" / "a" / "f.png", dpi=20)
+    finally:
+        plt.close(fig)
+    assert path == tmp_path / "figs" / "a" / "f.png"
+    assert path.read_bytes()[:4] == b"\x89PNG" and os.listdir(path.parent) == ["f.png"]
+
+
+def test_atomic_file_that_cannot_create_its_folder_is_an_output_error(tmp_path):
+    from casflutter._outputs import atomic_file
+    from casflutter.errors import OutputError
+
+    (tmp_path / "afile").write_text("")
+    with pytest.raises(OutputError, match=r"^--out .*afile.*choose a writable location"):
+        with atomic_file(tmp_path / "afile" / "x.json", what="--out"):
+            raise AssertionError("the block ran without a file to write")
+
+
+def test_bench_design_out_in_a_missing_folder_is_written(tmp_path):
+    """R2: the folder of ``--out`` is created (it was an internal FileNotFoundError after the
+    whole design)."""
+    from casflutter.aeroelastic import write_family
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "verify"))
+    from family_helpers import random_family
+
+    fam = random_family(4, n_modes=2)
+    write_family(fam, tmp_path / "fam.toml", fam.speeds)
+    out = tmp_path / "new" / "sub" / "bench.json"
+    assert main(["-q", "bench", "design", "--problem", str(tmp_path / "fam.toml"),
+                 "--interval", "0.1", "0.5", "--orders", "0", "--seeds", "0",
+                 "--out", str(out)]) == 0
+    (rec,) = json.loads(out.read_text())["records"]
+    assert rec["held"] is True and sorted(p.name for p in out.parent.iterdir()) == ["bench.json"]
+
+
+@pytest.mark.parametrize("figure, words", [
+    ("afile/sub.png", "afile is a file, not a folder"),
+    ("f.xyz", "unsupported file type '.xyz'"),
+])
+def test_lco_figure_path_is_checked_before_any_work(tmp_path, monkeypatch, capsys, figure,
+                                                     words):
+    import casflutter.truth
+
+    def no_work(*a, **k):
+        raise AssertionError("the work started before the figure path was checked")
+
+    monkeypatch.setattr(casflutter.truth, "load_problem", no_work)
+    (tmp_path / "afile").write_text("")
+    assert main(["lco", "typical_section", "--figure", str(tmp_path / figure)]) == 1
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and err.startswith("casflutter: error: --figure ") and words in err

@@ -99,3 +99,67 @@ def test_a_family_file(tmp_path):
     rc, text = _run(main, ["verify", str(tmp_path / "fam.toml"), str(tmp_path / "K.json"),
                            "--require-v", "0.1", "0.8", "--json"])
     assert rc == 0 and KEYS <= set(json.loads(text))
+
+
+def test_the_figure_goes_into_a_folder_that_does_not_exist_yet(family_and_file, tmp_path):
+    """R3: ``--figure DIR/fig.png`` with DIR missing is written (as ``flutter --figure``),
+    not an internal error after the certificate."""
+    fam, path = family_and_file
+    figure = tmp_path / "new" / "sub" / "margins.png"
+    rc, text = _run(verify_command, fam, path, figure=figure)
+    assert rc == 0 and "PASSED" in text
+    assert figure.stat().st_size > 10_000
+    assert sorted(p.name for p in figure.parent.iterdir()) == ["margins.png"]
+
+
+@pytest.mark.parametrize("speed_range, words", [
+    ((0.8, 0.2), "--range 0.8 0.2: LO must be below HI; give --range 0.2 0.8"),
+    ((0.5, 0.5), "--range 0.5 0.5: LO must be below HI; give two different speeds"),
+    ((0.2, float("inf")), "--range 0.2 inf: give two finite speeds LO < HI (q)"),
+    ((0.01, 0.8), "--range LO = 0.01 q is outside the range [0.1, 1.5]"),
+])
+def test_a_bad_range_names_the_option_not_the_python_keyword(family_and_file, speed_range,
+                                                             words):
+    fam, path = family_and_file
+    with pytest.raises(ConfigError) as err:
+        verify_command(fam, path, speed_range=speed_range)
+    assert words in str(err.value) and "speed_range" not in str(err.value)
+
+
+def test_a_loop_family_without_range_is_told_to_pass_it(capsys):
+    rc = main(["verify", str(ROM_LOOP), str(WITNESSES / "rom_order4_low_controller.json"),
+               "--servo", "251.3"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 1 and "\n" not in err and err.startswith("casflutter: error: ")
+    assert "pass --range LO HI" in err and "speed_range" not in err
+
+
+def test_require_v_help_says_what_each_route_requires(capsys):
+    with pytest.raises(SystemExit):
+        main(["verify", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    start = text.index("--require-v LO HI ")
+    help_ = text[start:text.index("--json", start)]
+    # the LFT route: the exact interval, stability only; the family route: the margins too
+    assert "exact interval, eq. 10-15" in help_ and "no margins" in help_
+    assert "certified stable interval must cover [LO, HI]" in help_
+    assert "--margins thresholds" in help_ and "--disk" in help_
+    assert "from the start of the verified range" in help_
+
+
+def test_margins_failing_below_the_required_range_are_said_so(family_and_file):
+    """The margins are held from the verified range's start, not from LO: a failure below LO
+    fails the verdict, and the reason says where (not "inside the required" range)."""
+    from casflutter.cli._verify_family import verdict
+    from casflutter.verify import verify_family
+
+    fam, path = family_and_file
+    result = verify_family(fam, str(path))
+    rfs = result.robust_flutter_speed
+    assert 0.8 < rfs < 0.84
+    v = verdict(result, (0.84, 0.85))
+    assert v["covered"] is True and v["passed"] is False
+    assert "inside" not in v["reason"]
+    assert (f"below the required [0.84, 0.85]: the margins must hold from the verified "
+            f"range's start, 0.1 q, up to 0.85") in v["reason"]
+    assert "inside the required [0.1, 0.85]" in verdict(result, (0.1, 0.85))["reason"]

@@ -9,7 +9,8 @@ held: ``--decay``, or the one the design chose), ``worst_abscissa``,
 the same controller on the family (``certified_interval``: the stable interval containing
 the range's start, :func:`casflutter.verify.verify_family`), and a ``summary`` with the
 medians per order.  The file is rewritten after every record, so a run that is stopped keeps
-what it finished; ``--out`` is checked before any work.
+what it finished; ``--out`` is checked before any work (its missing folders are created
+with the first record).
 
 ``--problem`` names a plant family (a ``kind = "plant_family"`` file or a folder of
 ``problems/`` holding one) or a run configuration (a ``problems/`` name with a ``run.toml``,
@@ -171,7 +172,7 @@ def summarize(records: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def _write(out: Path, records: list, meta: dict) -> None:
-    with atomic_file(out) as tmp:
+    with atomic_file(out, what="--out") as tmp:
         tmp.write_text(json.dumps({"records": records, "summary": summarize(records),
                                    **meta}, indent=1))
 

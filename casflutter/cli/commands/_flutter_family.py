@@ -12,9 +12,8 @@ from __future__ import annotations
 
 import math
 import time
-from pathlib import Path
 
-from ..._outputs import print_json
+from ..._outputs import print_json, save_figure
 
 __all__ = ["print_notes", "run_family", "summarize_family"]
 
@@ -121,9 +120,8 @@ def run_family(args, record, label: str, fig_path) -> int:
 
         from ...report import plot_family_vg_vf
 
-        Path(fig_path).parent.mkdir(parents=True, exist_ok=True)
         fig = plot_family_vg_vf(result, family)
-        fig.savefig(fig_path, dpi=110)
+        save_figure(fig, fig_path, dpi=110)
         plt.close(fig)
     if args.json:
         print_json(doc)

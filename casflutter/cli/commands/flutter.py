@@ -20,9 +20,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from pathlib import Path
 
-from ..._outputs import check_figure_path, print_json
+from ..._outputs import check_figure_path, print_json, save_figure
 from ._flutter_family import print_notes
 
 __all__ = ["register", "run", "summarize"]
@@ -187,7 +186,7 @@ def _figure(result, path: str, omega_max: float) -> None:
     fig.legend(list(legend.values()), list(legend), loc="lower center", ncol=min(len(legend), 4),
                fontsize="small", frameon=False)
     fig.tight_layout(rect=(0, 0.03 * (1 + (len(legend) - 1) // 4), 1, 1))
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -247,7 +246,6 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
 
         from ...report import plot_vg_vf, speed_axes
 
-        Path(fig_path).parent.mkdir(parents=True, exist_ok=True)
         pk, fl = result.pk, result.rfa_flutter
         # the oscillatory branches of the modes p-k follows (not the real aerodynamic roots)
         lam = fl.tracking.eigenvalues
@@ -264,7 +262,7 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
         ag.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0),
                   borderaxespad=0.0)
         fig.tight_layout()
-        fig.savefig(fig_path, dpi=110)
+        save_figure(fig, fig_path, dpi=110)
     if args.json:
         print_json(doc)
         return 0
@@ -330,7 +328,6 @@ def run(args) -> int:
     doc = summarize(result, label)
     doc["figure"] = fig_path
     if fig_path is not None:
-        Path(fig_path).parent.mkdir(parents=True, exist_ok=True)
         _figure(result, fig_path, float(truth.modal_structure().omega.max()))
     if args.json:
         print_json(doc)

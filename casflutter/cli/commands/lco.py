@@ -5,12 +5,12 @@ of the sampled-data loop of a saved HWL ROM with the problem's structure), conti
 the speed, and prints (or writes as JSON) the Hopf point, its criticality, the branch with
 its stability and the folds.  Speeds in the problem's unit (m/s for the wings and rig
 sections, the speed index for the typical section).  No figure is written unless
-``--figure PATH`` is given.
+``--figure PATH`` is given (checked before the work; its missing folders are created).
 """
 
 from __future__ import annotations
 
-from ..._outputs import print_json
+from ..._outputs import check_figure_path, print_json, save_figure
 
 __all__ = ["register", "run"]
 
@@ -41,7 +41,8 @@ def register(subparsers) -> None:
                    help="read the sensors as displacements (Hs u) or accelerations (Hs u'')")
     p.add_argument("--max-points", type=int, default=None, help="most branch points")
     p.add_argument("--figure", default=None, metavar="PATH",
-                   help="write the bifurcation diagram to PATH ('none' or omitted: no figure)")
+                   help="write the bifurcation diagram to PATH (.png, .pdf, .svg ...; checked "
+                        "before the work; 'none' or omitted: no figure)")
     p.add_argument("--json", action="store_true", help="write the result as JSON to stdout")
     p.set_defaults(func=run)
 
@@ -71,6 +72,9 @@ def run(args) -> int:
     from ...truth import load_problem, problem_label
     from ...errors import ConfigError
 
+    fig_path = None                  # figures only where asked, checked before the work
+    if args.figure and args.figure.lower() != "none":
+        fig_path = str(check_figure_path(args.figure, what="--figure"))
     truth = load_problem(args.problem, args.sets)
     label = problem_label(args.problem)
     scale, unit = speed_convention(truth)
@@ -101,13 +105,12 @@ def run(args) -> int:
                 raise
             raise ConfigError(f"{exc}{_nonlinearity_hint(truth, args.problem)}") from None
     doc = branch.to_dict()
-    fig_path = args.figure if args.figure and args.figure.lower() != "none" else None
     if fig_path:
         from ...report import plot_bifurcation
         import matplotlib.pyplot as plt
 
         fig = plot_bifurcation(branch)
-        fig.savefig(fig_path, dpi=110)
+        save_figure(fig, fig_path, dpi=110)
         plt.close(fig)
     doc["figure"] = fig_path
     if args.json:

@@ -7,7 +7,10 @@ speed-index intervals (Lum et al. 2016, eq. 10-16).
 
 The verdict is the exit code: 0 when the nominal closed loop is stable and, with
 ``--require-v LO HI``, stays stable over that whole speed-index range (the exact interval
-covers it); 1 otherwise, the last line (``verdict`` in the JSON) saying which check failed.
+covers it; no margin is required on this route); 1 otherwise, the last line (``verdict`` in
+the JSON) saying which check failed.  A plant family (the first file not a ``.json``) is
+verified by :mod:`casflutter.cli._verify_family`, whose ``--require-v`` also requires the
+``--margins`` thresholds.
 The JSON is strict: a non-finite number (the γ of an unstable loop, an unbounded interval
 end) is ``null``.
 """
@@ -47,8 +50,13 @@ def register(subparsers) -> None:
                    help="H-inf norm implementation (default: slycot if installed)")
     p.add_argument("--require-v", nargs=2, type=float, default=None, metavar=("LO", "HI"),
                    dest="require_v",
-                   help="speed-index range over which the loop must stay stable (exact "
-                        "interval, eq. 10-15); not covered -> exit code 1")
+                   help="speed range to require; not met -> exit code 1.  A .json plant "
+                        "(LFT): the loop must stay stable over the speed indices [LO, HI] "
+                        "(the exact interval, eq. 10-15, covers them; stability only, no "
+                        "margins).  A plant family, in its speed unit: the certified stable "
+                        "interval must cover [LO, HI], and the --margins thresholds (with "
+                        "--disk the disk margins too) must hold from the start of the "
+                        "verified range (--range, default the family's) up to HI")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     _verify_family.add_arguments(p)
     p.set_defaults(func=run)
