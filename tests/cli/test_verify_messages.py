@@ -57,3 +57,16 @@ def test_verify_controller_takes_the_loaded_plant_file(files):
     assert verify_controller(data, K, Vf=None, n_delta=None).Vf == 1.0   # the file's channel
     with pytest.raises(ConfigError, match="number of measurements and controls"):
         verify_controller(P, K)
+
+
+@pytest.mark.parametrize("extra, named", [
+    (["--range", "0.5", "1.5"], "--range"), (["--disk"], "--disk"),
+    (["--servo", "250"], "--servo"), (["--margins", "3", "30"], "--margins"),
+])
+def test_family_options_on_a_single_plant_are_refused_not_ignored(files, capsys, extra, named):
+    """The family route's options mean nothing to a single LFT plant: refused by name, where
+    they were silently ignored."""
+    assert main(["verify", *files, *extra]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"casflutter: error: {named} belong to a plant family") and \
+        "drop them" in err

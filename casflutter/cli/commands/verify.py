@@ -163,6 +163,15 @@ def run(args) -> int:
     stable or not robust over ``--require-v``."""
     if _verify_family.is_family(args.plant):
         return _verify_family.run(args)
+    given = [option for option, used in (
+        ("--range", args.speed_range is not None), ("--disk", args.disk),
+        ("--servo", args.servo is not None), ("--figure", args.figure is not None),
+        ("--margins", tuple(args.margins) != (6.0, 45.0))) if used]
+    if given:
+        raise ConfigError(f"{', '.join(given)} belong to a plant family (FAMILY.toml, a "
+                          f"family folder or problem name, a ROM loop .npz); {args.plant} is "
+                          "a single LFT plant, verified at its nominal speed with the exact "
+                          "speed interval of eq. 10-15: drop them")
     from ...verify import load_controller, load_plant, verify_controller
 
     pdoc = _peek(args.plant)
