@@ -162,8 +162,10 @@ class FamilyVerification:
         return self.interval.covers(lo, hi)
 
     def robust_over(self, lo: float, hi: float) -> bool:
-        """True when every margin holds its threshold on ``[lo, hi]`` (at the margin speeds,
-        with the first violation located between them).
+        """True when the certified interval covers ``[lo, hi]`` and every margin holds its
+        threshold from the start of the verified range up to ``hi`` (the robust flutter
+        speed, the first violation located between the margin speeds, lies above ``hi``):
+        a loop without margins just below ``lo`` is not called robust.
 
         Parameters
         ----------
