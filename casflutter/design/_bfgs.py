@@ -16,8 +16,9 @@ which the function is nonsmooth, and the iteration converges to the kink.  It is
 of HANSO and of HIFOO's stabilisation and H∞ phases.
 
 The function here stops when the objective reaches a target (the caller's requirement is
-met; a line search step that reaches it is taken at once, as HANSO does, rather than
-lengthened further), when it has decreased by less than ``stall`` over ``window`` iterations (the usual
+met; where a line search finds no step that meets the curvature condition, along a ray on
+which the function falls without bound, it takes the first step that reached the target
+rather than the longest one tried), when it has decreased by less than ``stall`` over ``window`` iterations (the usual
 state at a nonsmooth minimiser, where the gradient never becomes small), when no step
 satisfies the conditions, or after ``max_iter`` iterations.  Every stop is deterministic: the
 same start gives the same iterates.
@@ -83,8 +84,9 @@ def nonsmooth_bfgs(fun: Callable, x0: np.ndarray, *, max_iter: int = 200,
     max_iter : int
         Iterations at most.
     target : float
-        Stop once ``f <= target``; the first trial step of a line search that reaches it
-        (with sufficient decrease) is taken.
+        Stop once ``f <= target``.  A line search that ends without a weak Wolfe step (the
+        function falling without bound along the direction) takes its first trial step that
+        reached the target, if one did.
     stall : float
         Stop once ``f`` decreased by less than this over the last ``window`` iterations
         (0: never).
@@ -120,7 +122,7 @@ def nonsmooth_bfgs(fun: Callable, x0: np.ndarray, *, max_iter: int = 200,
             if not slope < 0:
                 reason = "stationary"
                 break
-        lo, hi, t, accepted = 0.0, np.inf, 1.0, False
+        lo, hi, t, accepted, reached = 0.0, np.inf, 1.0, False, None
         for _ in range(max_line_search):
             xt = x + t * d
             ft, gt = fun(xt)
@@ -128,21 +130,24 @@ def nonsmooth_bfgs(fun: Callable, x0: np.ndarray, *, max_iter: int = 200,
             evaluations += 1
             if not np.isfinite(ft) or ft > f + c1 * t * slope:
                 hi = t              # not enough decrease: shorten
-            elif ft <= target:
-                # the caller's requirement is met: a longer step only goes further (along a
-                # direction in which f falls without bound, without end: HANSO's fvalquit)
-                gt, accepted = _gradient(gt), True
-                break
             elif float((gt := _gradient(gt)) @ d) < c2 * slope:
                 lo = t              # still steeply downhill: lengthen
+                if reached is None and ft <= target:
+                    reached = (xt, ft, gt)
             else:
                 accepted = True
                 break
             t = 0.5 * (lo + hi) if np.isfinite(hi) else 2.0 * t
         if not accepted:
-            if np.isfinite(ft) and ft < f:
-                x, f, g = xt, ft, _gradient(gt)
-            reason = "line search"
+            if reached is not None and not np.isfinite(hi):
+                # f fell along the whole ray (without bound, as a gain that lowers an
+                # abscissa linearly): the first step that met the target, not the longest
+                x, f, g = reached
+                reason = "target"
+            else:
+                if np.isfinite(ft) and ft < f:
+                    x, f, g = xt, ft, _gradient(gt)
+                reason = "line search"
             break
         s, y = xt - x, gt - g
         x, f, g = xt, ft, gt

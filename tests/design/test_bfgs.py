@@ -56,8 +56,8 @@ def test_target_and_stall_stop_early():
 def test_a_line_search_that_reaches_the_target_takes_that_step():
     """Along a direction in which the function falls without bound (a gain that lowers the
     closed-loop abscissa linearly), the weak Wolfe curvature test never passes and the step
-    would double to the end of the line search (2**40); the first step that reaches the
-    target is taken instead (HANSO's fvalquit)."""
+    would double to the end of the line search (2**40); the first step that reached the
+    target is taken instead."""
     res = nonsmooth_bfgs(lambda x: (1.0 - float(x[0]), np.array([-1.0])), np.zeros(1),
                          target=-1.0)
     assert res.reason == "target" and res.fun <= -1.0
