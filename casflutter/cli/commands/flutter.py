@@ -242,6 +242,7 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
     doc = summarize_gaf(result, label)
     doc["figure"] = fig_path
     if fig_path is not None:
+        import matplotlib.pyplot as plt
         import numpy as np
 
         from ...report import plot_vg_vf, speed_axes
@@ -263,6 +264,7 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
                   borderaxespad=0.0)
         fig.tight_layout()
         save_figure(fig, fig_path, dpi=110)
+        plt.close(fig)
     if args.json:
         print_json(doc)
         return 0
