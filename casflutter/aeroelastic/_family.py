@@ -405,6 +405,35 @@ class RealisationGap:
     pole_distance: float
 
 
+def _read_only(M: np.ndarray) -> np.ndarray:
+    M.setflags(write=False)
+    return M
+
+
+def _tolerance(tol) -> float:
+    try:
+        t = float(tol)
+    except (TypeError, ValueError):
+        t = math.nan
+    if not (math.isfinite(t) and t >= 0):
+        raise ConfigError(f"tol = {tol!r}: give a finite relative tolerance >= 0 (e.g. 1e-10)")
+    return t
+
+
+def _state_indices(indices, n: int) -> list[int]:
+    """Sorted unique state indices, each an integer in ``[0, n)``."""
+    out = set()
+    for i in indices:
+        if isinstance(i, (bool, np.bool_)) or not isinstance(i, (int, np.integer)):
+            raise ConfigError(f"state index {i!r} is not an integer; give 0-based indices "
+                              f"of the {n} states")
+        if not 0 <= int(i) < n:
+            raise ConfigError(f"state index {int(i)} is out of range; the family has {n} "
+                              f"states, indexed 0 to {n - 1}")
+        out.add(int(i))
+    return sorted(out)
+
+
 class GriddedFamily(MatrixFamily):
     """A plant family given at a grid of speeds, linearly interpolated between them.
 
@@ -426,6 +455,19 @@ class GriddedFamily(MatrixFamily):
         ``y1..yp``, all measurements).
     speed_unit, time_unit, feedback, name : str
         As :class:`PlantFamily`.
+
+    Attributes
+    ----------
+    left_out_states : tuple of int
+        The states of the family this one was made from that :meth:`without_states` left
+        out (0-based indices into the original family's states, sorted; ``()`` for a family
+        built from its arrays).  :func:`~casflutter.aeroelastic.load_family` leaves out a
+        family file's rigid-body positions (:meth:`detached_states`).
+    left_out_eigenvalues : ndarray, shape (k, len(left_out_states))
+        The eigenvalues of the left-out block of the state matrix at each grid speed (row
+        ``j``: ``speeds[j]``), sorted by real part and then imaginary part within a row;
+        every closed loop of the original family has them besides the eigenvalues of this
+        family's loop.  Read-only; no columns when nothing was left out.
 
     Raises
     ------
@@ -465,6 +507,8 @@ class GriddedFamily(MatrixFamily):
         self.feedback, self.name = feedback, str(name)
         self.speed_range = (float(v[0]), float(v[-1]))
         self.breakpoints = tuple(float(x) for x in v[1:-1])
+        self.left_out_states: tuple[int, ...] = ()
+        self.left_out_eigenvalues = _read_only(np.empty((k, 0), dtype=complex))
 
     @property
     def signals(self) -> FamilySignals:
@@ -501,6 +545,126 @@ class GriddedFamily(MatrixFamily):
     def n_states(self) -> int:
         """Number of states."""
         return int(self._mats[0].shape[1])
+
+    def detached_states(self, tol: float = 1e-10) -> tuple[int, ...]:
+        """The states that feed neither an output nor any state outside them, at every speed.
+
+        An aircraft's rigid-body positions (plunge and lateral displacement, yaw angle,
+        altitude) are such states: translation does not change the aerodynamics and no
+        accelerometer or gyro measures position, so the state's column of ``C`` and its
+        column of ``A`` outside the set are zero, and its eigenvalue is 0.  With ``R`` these
+        states and ``K`` the others, ``A[K, R] = 0`` and ``C[:, R] = 0``: every transfer
+        function from the inputs to the outputs is that of ``(A[K, K], B[K], C[:, K], D)``,
+        and a closed loop's state matrix is block triangular, so its eigenvalues are those of
+        the loop closed on the kept states and those of ``A[R, R]``, which no controller
+        changes (:meth:`without_states` leaves them out).
+
+        The set is the largest one, found as a fixed point: start from the states whose
+        column of ``C`` is zero at every grid speed and remove, until none is left to
+        remove, every state that feeds a state outside the set at some grid speed.  A state
+        that feeds only detached states (a yaw angle that feeds only the lateral
+        displacement) is detached too.
+
+        Parameters
+        ----------
+        tol : float
+            Relative tolerance: an entry counts as zero when ``|A[i, j]| <= tol · max |A|``
+            and ``|C[i, j]| <= tol · max |C|``, each maximum taken over every entry at every
+            grid speed (so a model's units of the states and outputs enter only through
+            these two scales).
+
+        Returns
+        -------
+        tuple of int
+            0-based state indices (into ``A``'s rows and columns), sorted; ``()`` when
+            every state feeds an output, directly or through other states.
+
+        Raises
+        ------
+        ConfigError
+            ``tol`` not a finite number >= 0.
+        """
+        tol = _tolerance(tol)
+        A, _, C, _ = self._mats
+        absA, absC = np.abs(A), np.abs(C)
+        feeds = absA.max(axis=0) > tol * float(absA.max())      # [i, j]: x_j feeds x_i
+        detached = ~(absC.max(axis=(0, 1)) > tol * float(absC.max()))
+        while True:
+            bad = detached & feeds[~detached].any(axis=0)
+            if not bad.any():
+                return tuple(int(j) for j in np.flatnonzero(detached))
+            detached &= ~bad
+
+    def without_states(self, indices, *, tol: float = 1e-10) -> GriddedFamily:
+        """The same family with states that feed no output and no kept state left out.
+
+        ``A`` loses their rows and columns, ``B`` their rows and ``C`` their columns; the
+        signals, units, feedback convention, name and speeds stay.  Since the states left
+        out feed no output and no kept state, every transfer function from the inputs to
+        the outputs is unchanged, and every closed loop of this family has the eigenvalues
+        of the new family's loop and those of the left-out block, which no controller moves
+        (recorded in :attr:`left_out_eigenvalues`).
+
+        Parameters
+        ----------
+        indices : sequence of int
+            0-based indices of this family's states, e.g. :meth:`detached_states`.
+        tol : float
+            Relative tolerance of "feeds", as in :meth:`detached_states`.
+
+        Returns
+        -------
+        GriddedFamily
+            The family without these states (``self`` when ``indices`` is empty);
+            :attr:`left_out_states` names them by their indices in the family this one
+            was made from (those of the file, for a family of
+            :func:`~casflutter.aeroelastic.load_family`).
+
+        Raises
+        ------
+        ConfigError
+            An index that is not an integer or out of range, every state asked for, or a
+            state that feeds an output or a kept state (named, with the fix): leaving it
+            out would change the plant.
+        """
+        tol = _tolerance(tol)
+        n = self.n_states
+        idx = _state_indices(indices, n)
+        if not idx:
+            return self
+        if len(idx) == n:
+            raise ConfigError(f"{self.name}: leaving out all {n} states leaves no plant; "
+                              "name only the states that feed no output")
+        gone = set(idx)
+        keep = [j for j in range(n) if j not in gone]
+        A, B, C, D = self._mats
+        absA, absC = np.abs(A), np.abs(C)
+        outputs = list(range(C.shape[1]))
+        for M, key, rows in ((absA, "A", keep), (absC, "C", outputs)):
+            sub = M[:, rows][:, :, idx]
+            hit = np.argwhere(sub > tol * float(M.max()))
+            if hit.size:
+                s, r, c = (int(x) for x in hit[0])
+                i, j = rows[r], idx[c]
+                what = (f"state {i}, which is kept" if key == "A"
+                        else f"the output {self.signals.outputs[i]!r}")
+                raise ConfigError(
+                    f"{self.name}: state {j} (0-based) feeds {what} (|{key}[{i}, {j}]| = "
+                    f"{M[s, i, j]:.3g} at V = {self.speeds[s]:g} {self.speed_unit}); leaving "
+                    "it out would change the plant.  Only states that feed no output and no "
+                    "kept state can be left out: those of detached_states()")
+        fam = GriddedFamily(self.speeds, A[:, keep][:, :, keep], B[:, keep], C[:, :, keep], D,
+                            self.signals, speed_unit=self.speed_unit,
+                            time_unit=self.time_unit, feedback=self.feedback, name=self.name)
+        before = set(self.left_out_states)
+        original = [i for i in range(n + len(before)) if i not in before]
+        fam.left_out_states = tuple(sorted(before | {original[j] for j in idx}))
+        block = A[:, idx][:, :, idx].copy()
+        block[np.abs(block) <= tol * float(absA.max())] = 0.0      # rounding: exactly zero
+        lam = np.linalg.eigvals(block).astype(complex)
+        fam.left_out_eigenvalues = _read_only(       # lexicographic: real part, then imaginary
+            np.sort(np.concatenate([self.left_out_eigenvalues, lam], axis=1), axis=1))
+        return fam
 
     def realisation_gaps(self, *, ends_tol: float = 0.1, middle_tol: float = 0.3
                          ) -> tuple[RealisationGap, ...]:

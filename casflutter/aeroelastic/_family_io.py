@@ -41,7 +41,14 @@ def load_family(source) -> GriddedFamily:
     GriddedFamily
         Signals named, roles and units as the file says; interpolated linearly between
         the grid speeds.  A warning is logged where the states seem to change meaning
-        between grid speeds (:meth:`GriddedFamily.realisation_gaps`).
+        between grid speeds (:meth:`GriddedFamily.realisation_gaps`).  The file's
+        rigid-body positions are left out: when the states that feed no output and no
+        other state (:meth:`GriddedFamily.detached_states`) have, at every grid speed, a
+        pole at the origin and no pole that grows, the family is returned without them
+        (:meth:`GriddedFamily.without_states`; the input-output behaviour is unchanged and
+        no controller moves them), says so at INFO level and names them in
+        ``left_out_states`` (0-based indices of the file's states).  Detached states with a
+        pole that grows are kept, for the design to refuse by name.
 
     Raises
     ------
@@ -89,7 +96,53 @@ def load_family(source) -> GriddedFamily:
             "in one realisation (the same modal basis, normalisation and lag states at every "
             "speed)", where, len(gaps), family.speeds.size - 1, g.lo, g.hi, family.speed_unit,
             100 * g.pole_distance)
-    return family
+    return _leave_out_positions(family, where)
+
+
+#: an eigenvalue of the detached block within this much of the imaginary axis or the origin,
+#: relative to the family's scale (max |A| over the grid), is on it to rounding.  Rounding of
+#: A's entries (eps · max |A|) moves a double pole at the origin (a yaw angle feeding a lateral
+#: displacement, a Jordan block) by about sqrt(eps) · max |A| = 1.5e-8 · max |A|; an entry of
+#: the block at the level of the detached-state tolerance is set to zero first.
+_ORIGIN_REL = 1e-7
+
+#: (file, states) whose leaving out was already said in this process
+_ANNOUNCED: set = set()
+
+
+def _leave_out_positions(family: GriddedFamily, where) -> GriddedFamily:
+    """``family`` without its detached states when they are positions: every pole of
+    their block at the origin or decaying at every grid speed, one at the origin at least."""
+    detached = family.detached_states()
+    if not detached or len(detached) == family.n_states:
+        return family
+    reduced = family.without_states(detached)
+    lam = reduced.left_out_eigenvalues
+    scale = float(np.max(np.abs(family.arrays[0])))
+    tiny = _ORIGIN_REL * scale
+    at_origin = np.abs(lam) <= tiny
+    if np.max(lam.real) > tiny or not np.all(at_origin.any(axis=1)):
+        log.debug("%s: states %s (0-based) feed no output and no other state, but their "
+                  "poles are not at the origin (or one grows); they are kept", where,
+                  list(detached))
+        return family
+    # said once per file and process (a run loads its family to check the configuration,
+    # then for its stages)
+    key = (str(where), tuple(detached))
+    level = logging.DEBUG if key in _ANNOUNCED else logging.INFO
+    _ANNOUNCED.add(key)
+    log.log(
+        level,
+        "%s: %d of its %d states left out (0-based indices %s): poles at the origin that feed "
+        "no output and no other state: rigid-body positions or integrators that no sensor "
+        "sees; the loop's input-output behaviour does not depend on them (every closed loop "
+        "keeps these %d poles, whatever the controller: %d at the origin, %s)", where,
+        len(detached), family.n_states, list(detached), len(detached),
+        int(np.min(at_origin.sum(axis=1))),
+        "none other" if bool(np.all(at_origin)) else
+        f"the others decaying, the slowest at Re λ = {np.max(lam[~at_origin].real):.4g} "
+        f"per {family.time_unit}")
+    return reduced
 
 
 def family_record(family: PlantFamily, speeds, *, name: str | None = None,

@@ -772,7 +772,10 @@ def _reachable_decay(models: _Models, s: MultiSpeedSettings, lo: float, hi: floa
             f"{where}: {mode.describe()} does not decay, and no controller moves it, so none "
             "can stabilise the family; give the family a control that reaches it and a "
             "measurement that sees it, or leave the mode out (e.g. rigid-body positions "
-            "that the sensors do not measure)")
+            "that the sensors do not measure: a family file's states with poles at the "
+            "origin that feed no output and no other state are left out when it loads, and "
+            "from Python family.without_states(family.detached_states()) leaves them out of "
+            "a GriddedFamily)")
     what = (f"{where}: {mode.describe()} decays at only {rate:.4g} per {fam.time_unit} and "
             f"no controller moves it, so no loop decays at the rate {asked:g}")
     if s.decay is not None:

@@ -565,10 +565,16 @@ class RunResult:
     def _family_summary(self) -> dict:
         """A family file's size, signals and every open-loop crossing (``flutter`` of
         ``casflutter flutter FAMILY``), with the status of the first destabilising one and
-        whether the family is unstable already at the low end of its range."""
+        whether the family is unstable already at the low end of its range.  ``n_states``
+        is the number of states analysed, ``n_states_file`` the number in the file, and
+        ``left_out_states`` the file's states (0-based) that were left out as rigid-body
+        positions (:func:`casflutter.aeroelastic.load_family`)."""
         fam, fl = self.model.family, self.flutter
         sig = fam.signals
-        return {"name": fam.name, "n_states": int(fam.n_states), "speed_unit": fam.speed_unit,
+        left_out = [int(i) for i in getattr(fam, "left_out_states", ())]
+        return {"name": fam.name, "n_states": int(fam.n_states),
+                "n_states_file": int(fam.n_states) + len(left_out),
+                "left_out_states": left_out, "speed_unit": fam.speed_unit,
                 "time_unit": fam.time_unit, "speed_range": list(fam.speed_range),
                 "feedback": fam.feedback, "controls": list(sig.controls),
                 "measurements": list(sig.measurements),
