@@ -144,32 +144,34 @@ class MultiSpeedSettings:
         if isinstance(self.synthesis, Mapping):
             object.__setattr__(self, "synthesis",
                                build_settings(SynthesisOptions, self.synthesis, "synthesis"))
-        checks = {"decay": self.decay is None or (isinstance(self.decay, (int, float))
-                                                   and math.isfinite(self.decay)
-                                                   and self.decay >= 0),
-                  "n_speeds": int(self.n_speeds) == self.n_speeds and self.n_speeds >= 2,
-                  "hinf_speeds": int(self.hinf_speeds) == self.hinf_speeds
-                  and self.hinf_speeds >= 0,
-                  "rate_weight": math.isfinite(self.rate_weight) and self.rate_weight >= 0,
-                  "rate_bandwidth": math.isfinite(self.rate_bandwidth)
-                  and self.rate_bandwidth > 0,
-                  "random_starts": int(self.random_starts) == self.random_starts
-                  and self.random_starts >= 0,
-                  "reduction_orders": all(int(o) == o and o >= 1
-                                          for o in self.reduction_orders),
-                  "max_iter": int(self.max_iter) == self.max_iter and self.max_iter >= 1,
-                  "max_rounds": int(self.max_rounds) == self.max_rounds
-                  and self.max_rounds >= 1,
-                  "first_step": 0 < self.first_step <= 1,
-                  "min_step": 0 < self.min_step <= self.first_step}
-        bad = [k for k, ok in checks.items() if not ok]
+        checks = {"decay": (self.decay is None or (isinstance(self.decay, (int, float))
+                                                    and math.isfinite(self.decay)
+                                                    and self.decay >= 0),
+                            "a number >= 0, or None to have it chosen"),
+                  "n_speeds": (int(self.n_speeds) == self.n_speeds and self.n_speeds >= 2,
+                               "an integer >= 2"),
+                  "hinf_speeds": (int(self.hinf_speeds) == self.hinf_speeds
+                                  and self.hinf_speeds >= 0, "an integer >= 0"),
+                  "rate_weight": (math.isfinite(self.rate_weight) and self.rate_weight >= 0,
+                                  "a number >= 0"),
+                  "rate_bandwidth": (math.isfinite(self.rate_bandwidth)
+                                     and self.rate_bandwidth > 0, "a number > 0"),
+                  "random_starts": (int(self.random_starts) == self.random_starts
+                                    and self.random_starts >= 0, "an integer >= 0"),
+                  "reduction_orders": (all(int(o) == o and o >= 1
+                                           for o in self.reduction_orders),
+                                       "integers >= 1"),
+                  "max_iter": (int(self.max_iter) == self.max_iter and self.max_iter >= 1,
+                               "an integer >= 1"),
+                  "max_rounds": (int(self.max_rounds) == self.max_rounds
+                                 and self.max_rounds >= 1, "an integer >= 1"),
+                  "first_step": (0 < self.first_step <= 1, "a number in (0, 1]"),
+                  "min_step": (0 < self.min_step <= self.first_step,
+                               "a number in (0, first_step]")}
+        bad = [f"{k} = {getattr(self, k)!r}: give {need}"
+               for k, (ok, need) in checks.items() if not ok]
         if bad:
-            raise ConfigError(f"invalid MultiSpeedSettings field(s) {bad}: need decay >= 0 "
-                              "(or None), "
-                              "n_speeds >= 2, hinf_speeds >= 0, rate_weight >= 0, "
-                              "rate_bandwidth > 0, random_starts >= 0, reduction orders "
-                              ">= 1, max_iter >= 1, max_rounds >= 1, 0 < min_step <= "
-                              "first_step <= 1")
+            raise ConfigError(f"invalid MultiSpeedSettings: {'; '.join(bad)}")
 
 
 @dataclass(frozen=True)
