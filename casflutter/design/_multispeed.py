@@ -171,7 +171,7 @@ class MultiSpeedSettings:
         bad = [f"{k} = {getattr(self, k)!r}: give {need}"
                for k, (ok, need) in checks.items() if not ok]
         if bad:
-            raise ConfigError(f"invalid MultiSpeedSettings: {'; '.join(bad)}")
+            raise ConfigError(f"{'; '.join(bad)} (MultiSpeedSettings)")
 
 
 @dataclass(frozen=True)

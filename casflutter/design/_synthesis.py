@@ -140,24 +140,29 @@ class SynthesisOptions:
     """Extra flat Ipopt options of the QP subproblems."""
 
     def __post_init__(self):
-        checks = {"max_outer": self.max_outer >= 1, "max_stab_rounds": self.max_stab_rounds >= 1,
-                  "max_iter": self.max_iter >= 1, "tol": 0 < self.tol < 1,
-                  "stability_margin": self.stability_margin > 0, "decay": self.decay >= 0,
-                  "min_det": 0 < self.min_det < 1, "trust_region": self.trust_region > 0,
-                  "max_trust_region": self.max_trust_region >= self.trust_region,
-                  "active_ratio": 0 < self.active_ratio < 1,
-                  "abandon_after": self.abandon_after >= 1,
-                  "stall_window": self.stall_window >= 2, "stall_tol": 0 <= self.stall_tol < 1, "abandon_ratio": self.abandon_ratio > 1,
-                  "time_limit": self.time_limit is None or self.time_limit > 0,
-                  "full_order_gamma_factor": self.full_order_gamma_factor > 1}
-        bad = [k for k, ok in checks.items() if not ok]
+        checks = {"max_outer": (self.max_outer >= 1, "an integer >= 1"),
+                  "max_stab_rounds": (self.max_stab_rounds >= 1, "an integer >= 1"),
+                  "max_iter": (self.max_iter >= 1, "an integer >= 1"),
+                  "tol": (0 < self.tol < 1, "a number in (0, 1)"),
+                  "stability_margin": (self.stability_margin > 0, "a number > 0"),
+                  "decay": (self.decay >= 0, "a number >= 0"),
+                  "min_det": (0 < self.min_det < 1, "a number in (0, 1)"),
+                  "trust_region": (self.trust_region > 0, "a number > 0"),
+                  "max_trust_region": (self.max_trust_region >= self.trust_region,
+                                       "a number >= trust_region"),
+                  "active_ratio": (0 < self.active_ratio < 1, "a number in (0, 1)"),
+                  "abandon_after": (self.abandon_after >= 1, "an integer >= 1"),
+                  "stall_window": (self.stall_window >= 2, "an integer >= 2"),
+                  "stall_tol": (0 <= self.stall_tol < 1, "a number in [0, 1)"),
+                  "abandon_ratio": (self.abandon_ratio > 1, "a number > 1"),
+                  "time_limit": (self.time_limit is None or self.time_limit > 0,
+                                 "None or a number > 0"),
+                  "full_order_gamma_factor": (self.full_order_gamma_factor > 1,
+                                              "a number > 1")}
+        bad = [f"{k} = {getattr(self, k)!r}: give {need}"
+               for k, (ok, need) in checks.items() if not ok]
         if bad:
-            raise ConfigError(f"invalid SynthesisOptions field(s) {bad}: need max_outer>=1, "
-                              "max_stab_rounds>=1, max_iter>=1, 0<tol<1, stability_margin>0, "
-                              "decay>=0, 0<min_det<1, trust_region>0, max_trust_region>="
-                              "trust_region, 0<active_ratio<1, abandon_after>=1, abandon_ratio>1, "
-                              "stall_window>=2, 0<=stall_tol<1, "
-                              "time_limit None or >0, full_order_gamma_factor>1")
+            raise ConfigError(f"{'; '.join(bad)} (SynthesisOptions)")
 
 
 @dataclass(frozen=True)

@@ -159,8 +159,8 @@ def test_bad_requests_are_refused_before_any_work(family, interval, order, match
     ({"n_speeds": 2.5}, r"settings.n_speeds: expected an integer"),
     # only the values that are wrong, each with what to give
     ({"decay": -1.0, "n_speeds": 1},
-     r"invalid MultiSpeedSettings: decay = -1.0: give a number >= 0, or None to have it "
-     r"chosen; n_speeds = 1: give an integer >= 2$"),
+     r"settings.decay = -1.0: give a number >= 0, or None to have it chosen; n_speeds = 1: "
+     r"give an integer >= 2 \(MultiSpeedSettings\)$"),
 ])
 def test_settings_given_as_a_table_name_the_bad_key(family, settings, match):
     with pytest.raises(ConfigError, match=match):

@@ -51,7 +51,7 @@ def test_defaults_are_the_paper_choices():
      r"strictly_proper = false"),
     ("[controller]\nspeeds = [0.5, 1.2]\n", r"controller.speeds .*containing 1.0"),
     ("[controller]\nmax_stab_rounds = 0\n",
-     r"\[controller\] invalid SynthesisOptions.*max_stab_rounds"),
+     r"controller.max_stab_rounds = 0: give an integer >= 1 \(SynthesisOptions\)$"),
     ("[controller]\ninterval = [2.0, 1.0]\n", r"controller.interval"),
     ("[problem]\nname = 'concorde'\n", r"problem.name = 'concorde': allowed .*typical_section"),
     ("[problem]\nfile = 'wing.toml'\n",
