@@ -349,7 +349,10 @@ class PlantFamily(abc.ABC):
         str
         """
         s, (lo, hi) = self.signals, self.speed_range
-        return (f"{self.name}: {self.n_states} states, speeds [{lo:g}, {hi:g}] "
+        gone = getattr(self, "left_out_states", ())
+        states = (f"{self.n_states} states ({len(gone)} more left out, which feed no output: "
+                  f"states {list(gone)})" if gone else f"{self.n_states} states")
+        return (f"{self.name}: {states}, speeds [{lo:g}, {hi:g}] "
                 f"{self.speed_unit}, time in {self.time_unit}, {self.feedback} feedback; "
                 f"controls {list(s.controls)}, measurements {list(s.measurements)}"
                 + (f", disturbances {list(s.disturbances)}" if s.disturbances else ""))

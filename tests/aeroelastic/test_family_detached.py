@@ -121,6 +121,7 @@ def test_a_family_file_loads_without_its_positions_and_says_so(tmp_path, caplog)
     assert np.all(fam.left_out_eigenvalues == 0)
     assert "2 of its 6 states left out (0-based indices [4, 5])" in caplog.text
     assert "poles at the origin that feed no output and no other state" in caplog.text
+    assert "4 states (2 more left out, which feed no output: states [4, 5])" in fam.describe()
     A, B, C, D = fam.arrays
     np.testing.assert_array_equal(A, rec.A[:, :4, :4])
     np.testing.assert_array_equal(B, rec.B[:, :4])
