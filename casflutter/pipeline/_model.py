@@ -21,6 +21,7 @@ on) and a :class:`FlutterStage` (every flutter search of the route).
 from __future__ import annotations
 
 import logging
+import warnings
 from dataclasses import dataclass, field, replace
 from typing import Mapping
 
@@ -33,7 +34,7 @@ from ..aeroelastic import (AeroelasticSystem, FlutterResult, ParametricSystem, P
                            family_flutter, find_flutter, load_family, pk_flutter,
                            speed_following_rom)
 from ..data import IOData
-from ..errors import CasflutterError, ConfigError
+from ..errors import CasflutterError, ConfigError, ConvergenceError, DataError
 from ..ident import (CommonDenominatorResult, FitReport, HWLModel, IdentificationResult,
                      IdentificationSettings, fit_report, identify, identify_common_denominator)
 from ..realize import (ParametricROM, RationalApproximation, Realization, RFASettings, fit_rfa,
@@ -140,7 +141,9 @@ class FlutterStage:
         The p–k solution on the same ``Q(ik)``.
     Vf : float or None
         The speed the LFT is built at: the ROM loop's flutter speed (a GAF file's ``Uf /
-        U_ref``, where Σf is frozen).
+        U_ref``, where Σf is frozen); ``None`` without a flutter crossing, or when the ROM
+        loop is unstable already at the start of ``flutter.V_range`` (its crossings are then
+        no flutter onsets: ``rom.unstable_at_start``).
     convective : FlutterResult or None
         Of the speed-following ROM (:attr:`ModelStage.speed_following`).
     reversals : mapping of str to ControlReversal or None
@@ -239,6 +242,40 @@ def _flutter_kw(cfg: RunConfig) -> dict:
     return dict(n_grid=cfg.flutter.n_grid, max_refine=cfg.flutter.max_refine)
 
 
+def _rom_flutter(system, V_range, kw: dict) -> FlutterResult:
+    """:func:`find_flutter` on the ROM loop, its warning about a loop unstable at the range's
+    start held back (:func:`rom_model` says it in its own words, with the fix)."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=".*unstable already at", category=RuntimeWarning)
+        return find_flutter(system, V_range, **kw)
+
+
+def _unstable_note(flutter: FlutterResult, system: AeroelasticSystem) -> str:
+    """Why a ROM loop unstable already at the low end of ``flutter.V_range`` has no flutter
+    speed, and the fix."""
+    V_lo = float(flutter.tracking.V[0])
+    text = (f"the ROM loop ΣAE(V) is unstable already at V = {V_lo:g}, the start of "
+            f"flutter.V_range (spectral abscissa {flutter.spectral_abscissa_start:.3g})")
+    if not system.rom_stable:
+        text += ": Σf, the identified ROM, is unstable on its own"
+    text += ("; its crossing at V = {:.5g} is no flutter onset".format(flutter.Vf)
+             if flutter.Vf is not None else "") + ", so the ROM has no flutter speed"
+    if not system.rom_stable:
+        return text + ("; identify a ROM that is stable on its own (see its fit error; other "
+                       "rom.orders, rom.na / rom.nb or rom.method)")
+    return text + (f"; the loop flutters below V = {V_lo:g} or the ROM is poor there: lower "
+                   "the start of flutter.V_range")
+
+
+def _needing(cfg: RunConfig) -> str:
+    """What of the configuration needs the ROM's flutter speed, in words."""
+    stages = [repr(s) for s in cfg.stages if s in ("lco", "controller")]
+    if stages:
+        return f"stage{'s' if len(stages) > 1 else ''} {' and '.join(stages)} need" + (
+            "s" if len(stages) == 1 else "")
+    return f"rom.v0_iterations = {cfg.rom.v0_iterations} needs"
+
+
 def rom_model(cfg: RunConfig, problem, structure, progress, *, needs_vf: bool
               ) -> tuple[ModelStage, FlutterStage]:
     """Stages 1-5 on a truth or a wing file: records, ROM, Σf, ΣAE(V), flutter; repeated at
@@ -261,12 +298,16 @@ def rom_model(cfg: RunConfig, problem, structure, progress, *, needs_vf: bool
     -------
     (ModelStage, FlutterStage)
         The records, the ROM, its fit, Σf and ΣAE(V); the flutter of the ROM loop, of the
-        truth and (``rom.method = "hwl"``) of the speed-following ROM.
+        truth and (``rom.method = "hwl"``) of the speed-following ROM.  A ROM loop unstable
+        already at the low end of ``flutter.V_range`` (``FlutterResult.unstable_at_start``,
+        e.g. an unstable Σf) has no flutter speed: ``FlutterStage.Vf`` is ``None`` and a
+        warning says why, while ``FlutterStage.rom`` keeps the search with its crossings.
 
     Raises
     ------
     CasflutterError
-        No ROM flutter in ``flutter.V_range`` when ``needs_vf``.
+        No ROM flutter in ``flutter.V_range``, or a ROM loop unstable already at its low
+        end, when ``needs_vf``.
     """
     truth = problem if isinstance(problem, AeroelasticTruth) else None
     records = settings_as(cfg.data, RecordSettings)
@@ -283,16 +324,23 @@ def rom_model(cfg: RunConfig, problem, structure, progress, *, needs_vf: bool
             system = AeroelasticSystem.from_parts(
                 real.sigma_f, structure, warn_unstable=False,
                 convective_V0=V0 if cfg.rom.convective else None)
-            if not system.rom_stable:
-                log.warning("Σf is unstable on its own (ΣAE unstable at V = 0)")
         with progress.stage("flutter"):
-            flutter = find_flutter(system, vr, **kw)
-            Vf = flutter.Vf
+            flutter = _rom_flutter(system, vr, kw)
+            if not system.rom_stable and not flutter.unstable_at_start:
+                log.warning("Σf is unstable on its own (ΣAE unstable at V = 0), though its "
+                            "loop is stable at V = %g", vr[0])
+            # a loop unstable already at the range's start has no flutter onset in it
+            Vf = None if flutter.unstable_at_start else flutter.Vf
             last = (it == cfg.rom.v0_iterations - 1 or Vf is None
                     or abs(Vf - V0) <= cfg.rom.v0_rtol * Vf)
             if last and truth is not None:
                 flutter_truth = find_flutter(truth, vr, **kw)
-            if Vf is None and needs_vf:
+            if flutter.unstable_at_start:
+                why = _unstable_note(flutter, system)
+                if needs_vf:
+                    raise CasflutterError(f"{why}; {_needing(cfg)} the ROM's flutter speed")
+                log.warning("%s", why)
+            elif Vf is None and needs_vf:
                 raise CasflutterError(f"the ROM identified at V0 = {V0:.4g} has no flutter "
                                       f"crossing in V ∈ {vr}: {flutter.message}; widen "
                                       "flutter.V_range")
@@ -304,7 +352,10 @@ def rom_model(cfg: RunConfig, problem, structure, progress, *, needs_vf: bool
     fit = (ident.fit if isinstance(ident, IdentificationResult)
            else fit_report(model, data, "simulation"))
     log.info("%s; fit error %% %s", model, ", ".join(f"{e:.4g}" for e in fit.error_percent))
-    note = f"ROM Vf = {Vf:.5g}" if Vf is not None else "ROM: no flutter in flutter.V_range"
+    note = (f"ROM Vf = {Vf:.5g}" if Vf is not None
+            else "ROM: no flutter speed (its loop is unstable already at V = "
+                 f"{vr[0]:g})" if flutter.unstable_at_start
+            else "ROM: no flutter in flutter.V_range")
     if flutter_truth is not None:
         note += (f"; truth Vf = {flutter_truth.Vf:.5g}" if flutter_truth.flutter is not None
                  else "; truth: no flutter in flutter.V_range")
@@ -386,12 +437,144 @@ def gaf_settings(cfg: RunConfig, gaf: GAFProblem) -> RFASettings:
     return settings
 
 
-def _pk_modes(gaf: GAFProblem, U_lo: float) -> tuple[int, ...]:
-    """The modes p–k can follow from ``U_lo``: in-vacuo reduced frequency ``omega b / U_lo``
-    within 0.8 of the table's largest ``k`` (the iteration must stay inside the table)."""
-    k_vac = gaf.structure.omega * gaf.table.b / U_lo
-    modes = tuple(int(i) for i in np.flatnonzero(k_vac <= 0.8 * gaf.table.k[-1]))
-    return modes or (0,)
+#: airspeeds of the p–k cross-check over ``gaf.U_range``
+_PK_SPEEDS = 29
+
+
+def _pk_span(table, structure, U: np.ndarray, m: int, start: int):
+    """p–k on mode ``m`` over ``U[start:end]``, ``end`` as large as the table allows from
+    ``start``: ``(PKResult, end)``, or ``(None, start)`` when the iteration leaves the table
+    already between ``U[start]`` and ``U[start + 1]``."""
+    def solve(end):
+        try:
+            return pk_flutter(table, structure, U[start:end], modes=(m,))
+        except DataError:          # the iteration needs k beyond the table
+            return None
+
+    res = solve(U.size)
+    if res is not None:
+        return res, U.size
+    good, bad, best = start + 2, U.size, solve(start + 2)
+    if best is None:
+        return None, start
+    while bad - good > 1:          # the largest end the table holds
+        mid = (good + bad) // 2
+        trial = solve(mid)
+        if trial is None:
+            bad = mid
+        else:
+            good, best = mid, trial
+    return best, good
+
+
+def _pk_mode(gaf: GAFProblem, structure, U: np.ndarray, m: int):
+    """p–k on mode ``m`` over the speeds ``U`` where the table holds it: from the first speed
+    whose in-vacuo reduced frequency ``omega b / U`` lies inside the table (later while the
+    iteration still leaves the table there), up to where it leaves the table.
+
+    Returns
+    -------
+    (PKResult or None, int, int, str)
+        The solution on ``U[start:end]`` (``None``: the mode cannot be followed anywhere in
+        ``U``), ``start``, ``end``, and why it is followed over a part of ``U`` or not at all
+        (``""`` over the whole of ``U``).
+    """
+    table = gaf.table
+    k_max = float(table.k[-1])
+    beyond = f"p–k needs k beyond the table's k <= {k_max:g}"
+    inside = np.flatnonzero(float(structure.omega[m]) * table.b <= k_max * U)
+    if inside.size == 0:
+        return None, 0, 0, (f"the in-vacuo k = omega b / U lies beyond the table's k <= "
+                            f"{k_max:g} up to U = {U[-1]:g} m/s")
+    try:
+        for start in range(int(inside[0]), U.size - 1):
+            res, end = _pk_span(table, structure, U, m, start)
+            if res is not None:
+                break
+        else:
+            return None, 0, 0, f"{beyond} at every speed"
+    except ConvergenceError as exc:
+        return None, 0, 0, str(exc)
+    if start == 0 and end == U.size:
+        return res, start, end, ""
+    if end == U.size:
+        return res, start, end, f"below it {beyond}"
+    if start == 0:
+        return res, start, end, f"above it {beyond}"
+    return res, start, end, f"elsewhere {beyond}"
+
+
+def pk_check(gaf: GAFProblem, structure) -> PKResult:
+    """The p–k solution on a GAF file's table over ``gaf.U_range``
+    (:func:`casflutter.aeroelastic.pk_flutter`), each mode followed over the speeds where
+    the table holds it, and a note on every mode it leaves out.
+
+    p–k follows a mode from its in-vacuo frequency, and every iteration must stay inside the
+    table's reduced frequencies: a mode whose ``k = omega b / U`` lies beyond the table at
+    the low speeds is followed from the first speed where it does not (and where the
+    iteration stays inside), up to the last speed where the iteration stays inside; a mode
+    the table never holds is left out.
+
+    Parameters
+    ----------
+    gaf : GAFProblem
+        The GAF file.
+    structure : ModalStructure
+        Σs of its modes.
+
+    Returns
+    -------
+    PKResult
+        Every mode p–k could follow (``modes``), ``NaN`` at the speeds where it could not;
+        the lowest flutter speed among them; ``message`` names the modes left out or
+        followed over a part of the speeds, and why.  With no mode followed at all
+        ``modes`` is empty and the message says why p–k is unavailable.
+    """
+    U = np.linspace(*gaf.U_range, _PK_SPEEDS)
+    names = gaf.table.mode_names
+    tracked, best, spans = [], None, []
+    notes: dict = {}           # what is said -> the modes it is said of
+    for m in range(structure.n_modes):
+        res, start, end, why = _pk_mode(gaf, structure, U, m)
+        if res is None:
+            notes.setdefault(f"left out: {why}", []).append(m)
+            continue
+        tracked.append(m)
+        spans.append((start, end, res))
+        if why:
+            notes.setdefault(f"followed for U in [{U[start]:.4g}, {U[end - 1]:.4g}] m/s only "
+                             f"({why})", []).append(m)
+        if res.eigenvalues[0, 0].real > 0:
+            where = "the start of gaf.U_range" if start == 0 else "where p–k starts to follow it"
+            notes.setdefault(f"unstable already at U = {U[start]:.4g} m/s, {where}: its "
+                             "flutter lies lower, outside this check", []).append(m)
+        if res.found and (best is None or res.flutter_speed < best.flutter_speed):
+            best = res
+    notes = [f"mode{'s' if len(ms) > 1 else ''} "
+             + ", ".join(f"{m + 1} ({names[m]!r})" for m in ms) + f" {text}"
+             for text, ms in notes.items()]
+    nU, nm = U.size, len(tracked)
+    lam = np.full((nU, nm), np.nan + 1j * np.nan)
+    k = np.full((nU, nm), np.nan)
+    its = np.zeros((nU, nm), dtype=int)
+    for j, (start, end, res) in enumerate(spans):
+        lam[start:end, j], k[start:end, j] = res.eigenvalues[:, 0], res.k[:, 0]
+        its[start:end, j] = res.iterations[:, 0]
+    if notes:
+        log.info("p–k on the table's k <= %g: %s", float(gaf.table.k[-1]), "; ".join(notes))
+    if not tracked:
+        msg = "unavailable: no mode can be followed on the table; " + "; ".join(notes)
+    elif best is not None:
+        msg = best.message + "".join(f"; {n}" for n in notes)
+    else:
+        msg = (f"no tracked mode's damping crosses zero for U in [{U[0]:g}, {U[-1]:g}] m/s; "
+               + ("extend the speeds" if not notes else "; ".join(notes) + "; a flutter "
+                  "where p–k cannot follow a mode is not checked: extend the table to larger "
+                  "k"))
+    found = best is not None
+    return PKResult(U, tuple(tracked), tuple(names[m] for m in tracked), lam, k, its, found,
+                    best.flutter_speed if found else None, best.flutter_omega if found else None,
+                    best.flutter_k if found else None, best.flutter_mode if found else None, msg)
 
 
 def gaf_model(cfg: RunConfig, gaf: GAFProblem, structure, progress
@@ -413,7 +596,9 @@ def gaf_model(cfg: RunConfig, gaf: GAFProblem, structure, progress
     Returns
     -------
     (ModelStage, FlutterStage)
-        The RFA and its ΣAE(U); its flutter in m/s and the p–k solution.
+        The RFA and its ΣAE(U); its flutter in m/s and the p–k solution (:func:`pk_check`:
+        each mode over the speeds the table holds it at; where p–k can follow no mode its
+        message says why, and the RFA's flutter stands).
 
     Raises
     ------
@@ -429,8 +614,7 @@ def gaf_model(cfg: RunConfig, gaf: GAFProblem, structure, progress
     with progress.stage("flutter"):
         fl_U = find_flutter(rsys, (U_lo, U_hi), n_grid=gaf.n_grid,
                             max_refine=cfg.flutter.max_refine)
-        pk = pk_flutter(gaf.table, structure, np.linspace(U_lo, U_hi, 29),
-                        modes=_pk_modes(gaf, U_lo))
+        pk = pk_check(gaf, structure)
     log.info("RFA ΣAE(U): %s; p–k: %s",
              f"Uf = {fl_U.Vf:.5g} m/s, {fl_U.omega_f:.5g} rad/s" if fl_U.Vf is not None
              else "no flutter", f"{pk.flutter_speed:.5g} m/s" if pk.found else "no flutter")

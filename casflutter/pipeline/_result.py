@@ -147,13 +147,20 @@ def _pair(t):
 
 
 def _flutter_summary(res: FlutterResult | None) -> dict | None:
+    """A flutter search's block of ``summary.json``: its first destabilising flutter crossing
+    (``V``, ``freq_hz``, ``mode`` from 1), ``status``, and whether the loop is unstable
+    already at the low end of the range (``unstable_at_start``, with the spectral abscissa
+    there): a crossing is then no flutter onset, and ``V`` no flutter speed."""
     if res is None:
         return None
+    start = {"unstable_at_start": bool(res.unstable_at_start),
+             "spectral_abscissa_start": float(res.spectral_abscissa_start)}
     if res.flutter is None:
-        return {"V": None, "freq_hz": None, "mode": None, "status": res.status}
+        return {"V": None, "freq_hz": None, "mode": None, "status": res.status, **start}
     mode = res.flutter_mode
     return {"V": float(res.Vf), "freq_hz": float(res.omega_f) / (2 * np.pi),
-            "mode": None if mode is None or mode < 0 else int(mode) + 1, "status": res.status}
+            "mode": None if mode is None or mode < 0 else int(mode) + 1, "status": res.status,
+            **start}
 
 
 def skipped_notes(skipped: Mapping[str, str]) -> list[str]:
@@ -475,10 +482,19 @@ class RunResult:
         return bool(self.control.checks["design"].covers(lo, hi))
 
     @property
+    def rom_unstable_at_start(self) -> bool:
+        """The ROM loop (truth and wing routes) is unstable already at the low end of
+        ``flutter.V_range`` (``FlutterResult.unstable_at_start``): it has no flutter speed,
+        and :attr:`success` is false."""
+        return bool(self.route in ("truth", "wing") and self.flutter is not None
+                    and self.flutter.unstable_at_start)
+
+    @property
     def success(self) -> bool:
-        """Every check that ran passed: the interval target, and both closed-loop
-        simulations grow open loop and decay closed loop."""
-        ok = self.interval_ok is not False
+        """Every check that ran passed: the ROM loop is stable at the start of
+        ``flutter.V_range`` (:attr:`rom_unstable_at_start`), the interval target holds, and
+        both closed-loop simulations grow open loop and decay closed loop."""
+        ok = self.interval_ok is not False and not self.rom_unstable_at_start
         if self.closed_loop is not None:
             ok = ok and self.closed_loop.rom_simulation.grows_open_decays_closed \
                 and self.closed_loop.truth_simulation.grows_open_decays_closed

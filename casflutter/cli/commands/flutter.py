@@ -222,10 +222,38 @@ def summarize_gaf(result, problem: str) -> dict:
             "timings": {k: float(v) for k, v in result.timings.items()}, "warnings": warn}
 
 
+def _gaf_config(problem):
+    """The run configuration of ``casflutter flutter`` on a GAF wing file: its flutter route
+    only, built for the file rather than from the seed wing's defaults.
+
+    Parameters
+    ----------
+    problem : casflutter.truth.GAFProblem
+        The GAF wing file.
+
+    Returns
+    -------
+    casflutter.pipeline.RunConfig
+        No optional stage; the file's sensors' kind; ``rom.nf = "auto"`` (no ROM is
+        identified on this route, and the seed wing's ``rom.nf`` is not checked against the
+        file's modes); the frozen ΣAE(V) searched over ``gaf.U_range`` as a speed index
+        (``U / U_ref``) on ``gaf.n_grid`` points, where its flutter speed ``Uf / U_ref``
+        lies.
+    """
+    from ...pipeline import (FlutterSection, ProblemSection, RomSection, RunConfig,
+                             SensorsSection)
+
+    lo, hi = (float(U) / problem.U_ref for U in problem.U_range)
+    return RunConfig(problem=ProblemSection(name=str(problem.path)), stages=(),
+                     rom=RomSection(nf="auto"),
+                     flutter=FlutterSection(V_range=(lo, hi), n_grid=problem.n_grid),
+                     sensors=SensorsSection(kind=problem.structure.sensor))
+
+
 def _run_gaf(args, problem, label: str, fig_path) -> int:
     """``casflutter flutter`` on a GAF wing file."""
     from ...errors import ConfigError
-    from ...pipeline import RunConfig, run as run_config
+    from ...pipeline import run as run_config
 
     if args.convective:
         raise ConfigError(f"--convective does not apply to the GAF wing file {problem.path}: "
@@ -235,10 +263,7 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
             raise ConfigError(f"{flag} does not apply to the GAF wing file {problem.path}: it "
                               "has no records, and its airspeed range is gaf.U_range [m/s]; "
                               "edit the file")
-    cfg = RunConfig(stages=(), sensors=replace(RunConfig().sensors,
-                                               kind=problem.structure.sensor))
-    cfg = replace(cfg, problem=replace(cfg.problem, name=str(problem.path)))
-    result = run_config(cfg, quiet=True, write=False)
+    result = run_config(_gaf_config(problem), quiet=True, write=False)
     doc = summarize_gaf(result, label)
     doc["figure"] = fig_path
     if fig_path is not None:
@@ -248,10 +273,12 @@ def _run_gaf(args, problem, label: str, fig_path) -> int:
         from ...report import plot_vg_vf, speed_axes
 
         pk, fl = result.pk, result.rfa_flutter
-        # the oscillatory branches of the modes p-k follows (not the real aerodynamic roots)
+        # the oscillatory branches of the modes p-k follows (not the real aerodynamic
+        # roots); of every structural mode when p-k follows none
         lam = fl.tracking.eigenvalues
+        shown = pk.modes or tuple(range(problem.structure.n_modes))
         low = [b for b in fl.tracking.upper_branches()
-               if fl.origin[b] in pk.modes and np.mean(np.abs(lam[:, b].imag)) > 0]
+               if fl.origin[b] in shown and np.mean(np.abs(lam[:, b].imag)) > 0]
         fig = plot_vg_vf(fl, branches=low, hz=False, speed_unit="m/s",
                          speed_label="airspeed U [m/s]", mode_names=problem.structure.mode_names)
         ag, af = fig.axes

@@ -2,9 +2,9 @@
 wing with its controller designed over speed, ``problems/seed_wing/run.toml``).
 
 Exit status: 0 when the run finished and every check it made passed (the ``verify.required``
-interval, the closed-loop simulations), 3 when it finished and wrote its outputs but a check
-failed (``checks passed: False``; summary.json says which), 1 or 2 for a run refused or
-stopped."""
+interval, the closed-loop simulations, a ROM loop stable at the start of ``flutter.V_range``),
+3 when it finished and wrote its outputs but a check failed (``checks passed: False``;
+summary.json says which), 1 or 2 for a run refused or stopped."""
 
 from __future__ import annotations
 
@@ -27,6 +27,16 @@ def _speed(block) -> str:
         text += f", U = {sig(block['airspeed_m_s'])} m/s"
     if block.get("dynamic_pressure_Pa") is not None:
         text += f", q = {sig(block['dynamic_pressure_Pa'], 4)} Pa"
+    return text
+
+
+def _unstable_at_start(block, V_lo: float) -> str:
+    """The flutter line of a loop unstable already at the start of ``flutter.V_range``: no
+    flutter speed, and its crossing (if any) no flutter onset."""
+    text = (f"none: the loop is unstable already at V = {sig(V_lo)}, the start of "
+            f"flutter.V_range (spectral abscissa {sig(block['spectral_abscissa_start'], 3)})")
+    if block.get("V") is not None:
+        text += f"; its crossing at V = {sig(block['V'])} is no flutter onset"
     return text
 
 
@@ -138,8 +148,12 @@ def _main(args) -> int:
         hz = s["units"].get("freq_hz") or "Hz"     # cycles per time unit in nondimensional time
         if fl is not None:
             what = "ROM" if s["orders"] is not None else "ΣAE(V), Σf frozen at Uf"
-            lines.append(f"flutter ({what}):   {_speed(fl)}, {sig(fl['freq_hz'])} {hz}, "
-                         f"mode {fl['mode']}")
+            if fl.get("unstable_at_start"):
+                lines.append(f"flutter ({what}):   "
+                             + _unstable_at_start(fl, res.config.flutter.V_range[0]))
+            else:
+                lines.append(f"flutter ({what}):   {_speed(fl)}, {sig(fl['freq_hz'])} {hz}, "
+                             f"mode {fl['mode']}")
         fc = s.get("flutter_convective")
         if fc is not None:
             lines.append(f"flutter (ROM following the wing over speed): {_speed(fc)}, "
@@ -175,14 +189,16 @@ def _main(args) -> int:
                             "speed" if r.get("linear_loop_certified") is False else ""))
     if log_quiet:                    # otherwise the log said it once already
         lines += res.skipped_notes()
-    if res.interval_ok is not None or res.closed_loop is not None:
+    checked = (res.interval_ok is not None or res.closed_loop is not None
+               or res.rom_unstable_at_start)
+    if checked:
         lines.append(f"checks passed: {res.success}")
     lines.append(f"total {s['timings_s']['total']:.1f} s; outputs in {res.out_dir}/")
     if args.json:
         print(json.dumps(s, indent=2))
     elif not args.quiet:
         print("\n".join(lines))
-    if (res.interval_ok is not None or res.closed_loop is not None) and not res.success:
+    if checked and not res.success:
         print(f"casflutter run: a check failed (see {res.out_dir}/summary.json)",
               file=sys.stderr)
         return 3
