@@ -26,6 +26,7 @@ from .._format import result_repr
 from ..data import IOData
 from ..errors import ConfigError, DataError
 from ._model import HWLModel
+from ._regression import _dead_channels, _rank_hint
 
 __all__ = ["CommonDenominatorResult", "identify_common_denominator"]
 
@@ -132,14 +133,21 @@ def identify_common_denominator(data: IOData, na: int = 2,
                         "unknowns per output; record longer data")
     cn = np.linalg.norm(Wm, axis=0)
     if np.any(cn == 0):
-        raise DataError("non-exciting input: some input channel is identically zero; "
-                        "excite every input or drop it")
+        n_w = Wm.shape[1] // (nb + 1)   # columns: the inputs [u; v] at lags 0..nb
+        dead = _dead_channels(data, [("u", c % n_w) if c % n_w < N else ("v", 0)
+                                     for c in np.flatnonzero(cn == 0)])
+        raise DataError(f"non-exciting input: input channel(s) {dead} are identically zero "
+                        "in every record; excite each input in some record, or leave it out "
+                        "of the inputs (records.displacements/records.flap in a wing file, "
+                        "--u/--v)")
     Q, R = np.linalg.qr(Wm / cn)
     sv = np.linalg.svd(R, compute_uv=False)
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else np.inf
     if not cond < 1e12:
         raise DataError(f"non-exciting input: the input regression is rank-deficient "
-                        f"(condition number {cond:.3g}); widen the chirp band or lower nb")
+                        f"(condition number {cond:.3g}); " + _rank_hint(
+                            data, Wm.shape[0], Wm.shape[1] + na,
+                            "widen the chirp band or lower nb"))
 
     def perp(M):
         return M - Q @ (Q.T @ M)

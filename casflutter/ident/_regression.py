@@ -147,6 +147,36 @@ def _rank1(M: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     return a, v / v[0], resid
 
 
+def _dead_channels(data: IOData, kinds_channels) -> list[str]:
+    """Names of the channels behind identically zero regressor columns (``(kind, channel)``
+    with kind ``"u"``, ``"v"`` or ``"ar"``), in order, each once."""
+    names = []
+    for kind, j in kinds_channels:
+        name = (data.u_names[j] if kind == "u" else data.v_name if kind == "v"
+                else data.output_names[j])
+        if name not in names:
+            names.append(name)
+    return names
+
+
+def _rank_hint(data: IOData, n_rows: int, n_unknowns: int, otherwise: str) -> str:
+    """What to do about a rank-deficient regression: a record much shorter than the others
+    (named, with its length: it cannot excite the inputs it carries), records that are short
+    overall (equations per unknown; then also ``otherwise``), else ``otherwise``."""
+    longest = max(data.records, key=lambda r: r.n_samples)
+    short = [r for r in data.records if r.n_samples < 0.25 * longest.n_samples]
+    if short:
+        r = min(short, key=lambda r: r.n_samples)
+        return (f"record {r.name!r} has only {r.n_samples} samples ({r.n_samples * data.dt:g} "
+                f"s) against {longest.n_samples} in {longest.name!r}: too short to excite the "
+                "inputs it carries; record it as long as the others, long enough to sweep "
+                "the whole excitation band")
+    if n_rows < 10 * n_unknowns:
+        return (f"the records are short ({n_rows} equations for {n_unknowns} unknowns per "
+                f"output, fewer than 10 per unknown): record longer data; else {otherwise}")
+    return otherwise
+
+
 def stage1(structure: HWLStructure, data: IOData, *, max_condition: float = 1e10) -> Stage1Result:
     """Linear least squares on the over-parameterised regression, then rank-one SVD.
 
@@ -174,17 +204,21 @@ def stage1(structure: HWLStructure, data: IOData, *, max_condition: float = 1e10
                         "the polynomial degrees p, q")
     dead = [layout[c] for c in np.flatnonzero(col_norm == 0)]
     if dead:
-        raise DataError(f"non-exciting input: regressor column(s) {dead[:4]} are identically "
-                        "zero (a channel that never moves); excite every input or drop it")
+        channels = _dead_channels(data, [(kind, j) for kind, _, _, j in dead if kind != "c"])
+        raise DataError(f"non-exciting input: channel(s) {channels} never move in the records "
+                        f"(regressor column(s) {dead[:4]} are identically zero); excite every "
+                        "input in some record, or leave it out of the inputs (--u/--v, "
+                        "records.displacements/records.flap in a wing file)")
     Phin = Phi / col_norm
     Q, R = np.linalg.qr(Phin)
     sv = np.linalg.svd(R, compute_uv=False)
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else np.inf
     if not cond < max_condition:
         raise DataError(f"non-exciting input: the regression is rank-deficient (condition "
-                        f"number {cond:.3g} > {max_condition:.1g}); use a richer excitation "
-                        "(more amplitude levels for the polynomial terms, wider band) or "
-                        "lower the orders")
+                        f"number {cond:.3g} > {max_condition:.1g}); " + _rank_hint(
+                            data, n_rows, len(layout), "use a richer excitation (more "
+                            "amplitude levels for the polynomial terms, wider band) or lower "
+                            "the orders"))
     theta_over = np.linalg.solve(R, Q.T @ Y) / col_norm[:, None]
     # rank-one factorisation per (i, j)
     index = {key: c for c, key in enumerate(layout)}

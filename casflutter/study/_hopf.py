@@ -31,7 +31,7 @@ from .._format import result_repr
 from .._nlp import make_solver
 from ..errors import ConfigError, ConvergenceError
 from ..truth import load_problem
-from ._sensitivity import FlutterSensitivity, ParameterSensitivity
+from ._sensitivity import FlutterSensitivity, ParameterSensitivity, _parametric_truth
 from ._solvers import cached_solver, solver_builds
 from ._truth_point import load_truth
 
@@ -262,7 +262,7 @@ def flutter_sensitivity_nlp(problem: str = "typical_section",
     FlutterSensitivity
     """
     params = dict(params or {})
-    model = load_problem(problem, params)
+    model = _parametric_truth(problem, params)
     valid = model.params.parameter_names()
     names = list(parameters) if parameters else valid
     bad = [nm for nm in names if nm not in valid]

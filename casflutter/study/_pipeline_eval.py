@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import re
 from pathlib import Path
 from typing import Any, Mapping
@@ -144,6 +145,15 @@ def _pair(value, i):
     return None if value is None else value[i]
 
 
+def _largest(values):
+    """The largest entry of a list: ``None`` without one, NaN when an entry is not finite
+    (a fit error of a ROM that diverges in free run is not hidden behind the others)."""
+    if not values:
+        return None
+    x = [math.nan if v is None else float(v) for v in values]
+    return math.nan if not all(math.isfinite(v) for v in x) else max(x)
+
+
 def flatten_summary(summary: Mapping[str, Any]) -> dict[str, Any]:
     """One row of columns from ``RunResult.summary()`` (the content of ``summary.json``).
 
@@ -160,13 +170,19 @@ def flatten_summary(summary: Mapping[str, Any]) -> dict[str, Any]:
         the controller (``controller_order``, verified ``gamma``, the small-gain and exact
         stable speed intervals as ``*_lo``/``*_hi``), the suppression (``attenuation_percent``
         ...), the ROM sizes and ``time_<stage>`` [s] for every stage and ``time_total``.
+        A value the run does not have is ``None`` (the store's missing value, an empty
+        cell of the table): the truth's flutter and LCO of a wing or GAF file (no truth
+        simulator), the fit error and ROM sizes of a route without an identified ROM, the
+        blocks of the stages that did not run.
     """
-    fl, ft, lco = summary["flutter"], summary["flutter_truth"], summary["lco"] or {}
-    ctl, sup = summary["controller"] or {}, summary["suppression"] or {}
+    fl, ft = summary.get("flutter") or {}, summary.get("flutter_truth") or {}
+    lco = summary.get("lco") or {}
+    ctl, sup = summary.get("controller") or {}, summary.get("suppression") or {}
     amp, tamp = lco.get("amplitude"), lco.get("truth_amplitude")
     out = {
-        "Vf_rom": fl["V"], "freq_hz_rom": fl["freq_hz"], "mode_rom": fl["mode"],
-        "Vf_truth": ft["V"], "freq_hz_truth": ft["freq_hz"], "mode_truth": ft["mode"],
+        "Vf_rom": fl.get("V"), "freq_hz_rom": fl.get("freq_hz"), "mode_rom": fl.get("mode"),
+        "Vf_truth": ft.get("V"), "freq_hz_truth": ft.get("freq_hz"),
+        "mode_truth": ft.get("mode"),
         "lco_V": lco.get("V"), "lco_kind": lco.get("kind"), "lco_freq_hz": lco.get("freq_hz"),
         "lco_amplitude": max(amp) if amp else None, "lco_truth_V": lco.get("truth_V"),
         "lco_truth_kind": lco.get("truth_kind"),
@@ -182,10 +198,10 @@ def flatten_summary(summary: Mapping[str, Any]) -> dict[str, Any]:
         "closed_loop_stable": ctl.get("stable"),
         "attenuation_percent": sup.get("attenuation_percent"),
         "lco_returns": sup.get("lco_returns"), "suppression_V": sup.get("V"),
-        "fit_error_max": max(summary["fit_error_percent"]), "n_params": summary["n_params"],
-        "nf": summary["nf"], "nae": summary["nae"],
+        "fit_error_max": _largest(summary.get("fit_error_percent")),
+        "n_params": summary.get("n_params"), "nf": summary.get("nf"), "nae": summary.get("nae"),
     }
-    out.update({f"time_{k}": v for k, v in summary["timings_s"].items()})
+    out.update({f"time_{k}": v for k, v in (summary.get("timings_s") or {}).items()})
     return out
 
 
@@ -293,7 +309,9 @@ def rom_flutter_evaluator(params: Mapping[str, Any],
         Before any work, for an unknown or invalid name (:func:`pipeline_config`).
     """
     res = _run_point(params, _rom_flutter_settings(settings))
-    out = {"Vf_truth": res.flutter_truth.Vf, "Vf_rom": res.flutter.Vf,
+    # a wing or GAF file (``config`` of a run on one) has no truth simulator: no Vf_truth
+    out = {"Vf_truth": None if res.flutter_truth is None else res.flutter_truth.Vf,
+           "Vf_rom": res.flutter.Vf,
            "Vf_frozen": None if res.flutter_frozen is None else res.flutter_frozen.Vf,
            "Vf_parametric": None if res.parametric is None else res.parametric.flutter.Vf,
            "omega_f_rom": res.flutter.omega_f, "rom_error": res.rom_error,

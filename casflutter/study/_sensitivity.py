@@ -26,7 +26,7 @@ from scipy.linalg import eig
 from .._format import result_repr
 from ..aeroelastic import find_flutter
 from ..errors import ConfigError, ConvergenceError
-from ..truth import load_problem
+from ..truth import load_problem, problem_definition, problem_names
 
 __all__ = ["ParameterSensitivity", "FlutterSensitivity", "flutter_sensitivity",
            "flutter_speed_fd"]
@@ -141,6 +141,67 @@ class FlutterSensitivity:
                     for s in self.ranked()]}
 
 
+#: ``kind`` of a problem file without simulator parameters -> (what it is, the values to edit
+#: instead, the command that gives its flutter speed)
+_NO_PARAMETERS = {
+    "wing": ("a wing file with records (kind = \"wing\")",
+             "values (e.g. modes.frequencies_hz, modes.damping)",
+             "`casflutter run RUN.toml` gives (its [problem] name the file, stages = [])"),
+    "gaf": ("a wing file with a Q(ik) table (kind = \"gaf\")",
+            "values (e.g. modes.frequencies_hz, modes.damping)",
+            "`casflutter flutter FILE` gives"),
+    "plant_family": ("a gridded plant family (kind = \"plant_family\")", "models",
+                     "`casflutter flutter FILE` gives"),
+}
+
+
+def _parametric_truth(problem: str, params: Mapping[str, float] | None = None):
+    """The truth of ``problem`` at ``params``, refused where it has no parameters.
+
+    A wing or GAF file, or a gridded plant family, holds data (modes, records, ``Q(ik)``,
+    state-space models), not a simulator whose parameters can be moved: the derivatives of
+    its flutter speed are not defined.  The file's ``kind`` is read before anything else
+    (no record or table is loaded for the refusal).
+
+    Parameters
+    ----------
+    problem : str
+        Truth problem name or problem file (:func:`casflutter.truth.load_problem`).
+    params : mapping, optional
+        Parameter changes of the nominal point.
+
+    Returns
+    -------
+    AeroelasticTruth
+        The truth, whose ``params.parameter_names()`` are the parameters to differentiate.
+
+    Raises
+    ------
+    ConfigError
+        A problem file without simulator parameters (what it is, and what to do instead),
+        an unknown problem or parameter.
+    """
+    try:
+        kind = problem_definition(problem).get("kind")
+    except ConfigError:   # a built-in problem without problems/ or an unknown name:
+        kind = None       # load_problem below says which
+    if kind in _NO_PARAMETERS:
+        what, values, command = _NO_PARAMETERS[kind]
+        raise ConfigError(
+            f"problem {problem!r} is {what}: it has no simulator parameters to differentiate, "
+            "so flutter-speed sensitivities are not defined for it. Use a truth problem with "
+            f"parameters ({', '.join(problem_names())}, or a problem file of kind = "
+            "\"pitch_plunge\"; `casflutter problems` lists them), or edit the file's "
+            f"{values} and compare the flutter speeds {command} for each version")
+    model = load_problem(problem, dict(params or {}))
+    if not callable(getattr(getattr(model, "params", None), "parameter_names", None)):
+        raise ConfigError(f"problem {problem!r} ({type(model).__name__}) has no simulator "
+                          "parameters to differentiate; use a truth problem with parameters "
+                          f"({', '.join(problem_names())}, or a problem file of kind = "
+                          "\"pitch_plunge\")")
+    return model
+
+
 def _step(value: float, rel_step: float) -> float:
     return rel_step * max(abs(value), 1.0)
 
@@ -201,11 +262,12 @@ def flutter_sensitivity(problem: str = "typical_section",
     ConvergenceError
         No flutter speed in ``V_range`` (widen it), or a matrix that jumps with ``p``.
     ConfigError
-        Unknown problem or parameter names.
+        Unknown problem or parameter names, or a problem file without simulator parameters
+        (a wing or GAF file, a gridded plant family: the message says what to do instead).
     """
 
     params = dict(params or {})
-    model = load_problem(problem, params)
+    model = _parametric_truth(problem, params)
     names = list(parameters) if parameters else model.params.parameter_names()
     valid = model.params.parameter_names()
     bad = [n for n in names if n not in valid]
@@ -263,7 +325,7 @@ def flutter_speed_fd(problem: str, name: str, *, params: Mapping[str, float] | N
     """
 
     params = dict(params or {})
-    p0 = float(getattr(load_problem(problem, params).params, name))
+    p0 = float(getattr(_parametric_truth(problem, params).params, name))
     h = step if step is not None else 1e-4 * max(abs(p0), 1.0)
 
     def Vf(p):

@@ -9,7 +9,13 @@ need a simulator (the truth's flutter, LCO, closed loop and suppression) are ski
 driver.  Every key is checked when the file is read, before any work; a bad key, a wrong
 shape, a missing record file, an unknown channel or a non-finite number raises a
 :class:`~casflutter.errors.ConfigError` (the file's keys) or a
-:class:`~casflutter.errors.DataError` (the record files) naming the key and the fix.
+:class:`~casflutter.errors.DataError` (the record files) naming the key and the fix.  The
+records' sampling is checked against the modes: the highest modal frequency must lie below
+the records' Nyquist frequency ``1 / (2 dt)`` (time stamps in milliseconds are refused, with
+the sampling time they would give in seconds).  A time channel is uniform up to the rounding
+of its stamps as stored (a float32 channel is); a channel of the record files that
+``[records]`` does not name, and a ``t`` or ``time`` channel that contradicts
+``records.dt``, are a :class:`~casflutter.errors.DataWarning`.
 
 Layout (paths are relative to the file's folder)::
 
@@ -37,7 +43,8 @@ Layout (paths are relative to the file's folder)::
     [records]                      # kind = "wing": one record per file
     V0 = 0.69                      # speed index of the records (or U0 [m/s])
     files = ["records/chirp_1.csv", "records/chirp_2.npz", "records/chirp_3.mat"]
-    time = "t"                     # channel of the time stamps (or dt = 0.002 [s])
+    time = "t"                     # channel of the time stamps [s] (or dt = 0.002 [s],
+                                   #   which overrides a time channel)
     displacements = ["u1", "u2"]   # channels of the modal displacements, in mode order
     flap = "flap"                  # channel of the flap [rad] (optional)
     forces = ["Q1", "Q2"]          # channels of the generalised forces y, in mode order
@@ -61,6 +68,7 @@ from __future__ import annotations
 
 import logging
 import math
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable, Mapping
@@ -69,8 +77,9 @@ import numpy as np
 
 from ..data import GAFTable, IOData, Record, load_gaf
 from ..data._matfile import read_mat
-from ..data._records import _read_npz
-from ..errors import ConfigError, DataError
+from ..data._records import (_TIME_NAMES, _not_uniform, _read_npz, _stamp_resolution,
+                             _time_contradiction, _time_contradicts, _uniform_step)
+from ..errors import ConfigError, DataError, DataWarning
 from ..structure import (SENSOR_KINDS, AirspeedMixin, ModalStructure, SpeedConvention,
                          check_sensor_rows)
 
@@ -270,8 +279,12 @@ def _no_sets(sets, path: Path, kind: str) -> None:
                           f"(got {sets[0]!r}); edit the file, or remove problem.set / --set")
 
 
-def _channels(path: Path, names: list[str], time: str | None) -> tuple[dict, float | None]:
-    """The named 1-D channels of an NPZ or MATLAB file, and dt from the time channel."""
+def _channels(path: Path, names: list[str], time: str | None, dt: float | None = None
+              ) -> tuple[dict, float | None, list[str], tuple | None]:
+    """The named 1-D channels of an NPZ or MATLAB file, dt from the time channel, the
+    file's other channels (vectors as long as the named ones, which the fit does not use),
+    and, with ``dt`` given instead of a time channel, ``(name, step)`` of a time channel
+    (``t`` or ``time``) the file carries anyway and that contradicts ``dt`` (else None)."""
     if path.suffix.lower() == ".npz":
         arrays, what = _read_npz(path), "array"
     else:
@@ -290,29 +303,52 @@ def _channels(path: Path, names: list[str], time: str | None) -> tuple[dict, flo
             raise DataError(f"{path}: {what} {c!r} has shape {a.shape}; a channel is one "
                             "vector of samples")
         out[c] = a.astype(float).ravel()
-    dt = None
+    n_samples = out[names[0]].size if names else 0
+
+    def vector(a):
+        a = np.asarray(a)
+        return (a.dtype.kind in "biuf" and a.size == n_samples and n_samples > 1
+                and (a.ndim == 1 or (a.ndim == 2 and 1 in a.shape)))
+
+    clock, dt_file, clash = time, None, None
     if time:
         steps = np.diff(out[time])
-        dt = float(np.median(steps))
-        if not np.all(np.isfinite(steps)) or not dt > 0:
+        if not np.all(np.isfinite(steps)) or not float(np.median(steps)) > 0:
             raise DataError(f"{path}: time channel {time!r} is not increasing")
-        if not np.allclose(steps, dt, rtol=1e-6, atol=1e-12):
-            raise DataError(f"{path}: time channel {time!r} is not uniformly sampled (steps "
-                            f"{steps.min():g} to {steps.max():g}); resample first")
-    return out, dt
+        stored = np.asarray(arrays[time]).dtype
+        res = _stamp_resolution(out[time], stored)
+        dt_file = _uniform_step(out[time], res)
+        if dt_file is None:
+            raise DataError(_not_uniform(
+                str(path), f"channel {time!r}", steps, res, str(stored),
+                "give records.dt = {dt} instead of records.time (the time channel is then "
+                "not read)"))
+    else:
+        clock = next((k for k in arrays if k.lower() in _TIME_NAMES and k not in names
+                      and vector(arrays[k])), None)
+        if clock is not None and dt is not None:
+            step = _time_contradiction(np.asarray(arrays[clock], dtype=float).ravel(), dt)
+            if step is not None:
+                clash = (clock, step)
+    unused = [k for k in arrays if k not in names and k != clock and vector(arrays[k])]
+    return out, dt_file, unused, clash
 
 
-def _read_record(path: Path, forces, disp, flap, time, dt) -> IOData:
+def _read_record(path: Path, forces, disp, flap, time, dt
+                 ) -> tuple[IOData, list[str], tuple | None]:
+    """One record file as IOData, its channels that [records] does not name and a time
+    channel that contradicts ``dt`` (NPZ and MAT files, :func:`_channels`; a CSV file's are
+    DataWarnings of :meth:`IOData.from_csv`)."""
     suffix = path.suffix.lower()
     if suffix == ".csv":
-        return IOData.from_csv(path, y=forces, u=disp, v=flap, time=time, dt=dt)
+        return IOData.from_csv(path, y=forces, u=disp, v=flap, time=time, dt=dt), [], None
     if suffix not in (".npz", ".mat"):
         raise DataError(f"{path}: unknown suffix {path.suffix!r}; records are .csv, .npz or "
                         ".mat files")
     if not path.is_file():
         raise DataError(f"{path}: record file not found; check records.files")
     names = list(forces) + list(disp or []) + ([flap] if flap else [])
-    ch, dt_file = _channels(path, names, time)
+    ch, dt_file, unused, clash = _channels(path, names, time, dt)
     lengths = {c: ch[c].size for c in names}
     if len(set(lengths.values())) != 1:
         raise DataError(f"{path}: channels of different lengths {lengths}; trim them to a "
@@ -323,9 +359,38 @@ def _read_record(path: Path, forces, disp, flap, time, dt) -> IOData:
     try:
         return IOData((Record(Y, U, Vf, path.stem),), dt_file if dt is None else dt,
                       output_names=tuple(forces), u_names=tuple(disp or ()),
-                      v_name=flap or "v")
+                      v_name=flap or "v"), unused, clash
     except DataError as exc:
         raise DataError(f"{path}: {exc}") from None
+
+
+def _check_sampling(structure: ModalStructure, dt: float, src: str, time: str | None
+                    ) -> None:
+    """Refuse records whose Nyquist frequency is not above the highest modal frequency.
+
+    A record sampled at ``dt`` holds frequencies below ``1 / (2 dt)`` only; a mode above it
+    is aliased to a wrong frequency and the ROM identified from the records is meaningless
+    (most often the time stamps are in milliseconds, not seconds).
+    """
+    f = structure.omega / (2 * np.pi)
+    i = int(np.argmax(f))
+    nyquist = 0.5 / dt
+    if f[i] < nyquist:
+        return
+    source = f"the time channel {time!r}" if time else "records.dt"
+    if f[i] < nyquist * 1e3:   # in seconds, the time read as milliseconds would do
+        fix = (f"Is the time in milliseconds? Then dt = {dt / 1e3:g} s (Nyquist "
+               f"{nyquist * 1e3:g} Hz): " + (
+                   f"give the time channel in seconds, or records.dt = {dt / 1e3:g} instead "
+                   "of records.time" if time else f"give records.dt = {dt / 1e3:g} (seconds)"))
+    else:
+        fix = ("Give the sampling time in seconds" + (" (the time channel in seconds, or "
+               "records.dt instead of records.time)" if time else " (records.dt)")
+               + "; records sampled this coarsely cannot identify these modes")
+    raise (DataError if time else ConfigError)(
+        f"{src}: the records are sampled at dt = {dt:g} s (from {source}): their Nyquist "
+        f"frequency {nyquist:g} Hz is not above mode {structure.mode_names[i]!r} at "
+        f"{f[i]:g} Hz, so they cannot show the modes' motion. {fix}")
 
 
 @dataclass(frozen=True)
@@ -374,7 +439,17 @@ class WingProblem(_Wing):
         ConfigError
             A missing, unknown or malformed key (named, with the fix).
         DataError
-            A missing or unreadable record file, an unknown channel, non-finite samples.
+            A missing or unreadable record file, an unknown channel, non-finite samples, a
+            time channel that is not uniform, records sampled too coarsely for the modes
+            (Nyquist frequency not above the highest; a ConfigError when ``records.dt`` is
+            the cause).
+
+        Warns
+        -----
+        DataWarning
+            A channel of the NPZ or MAT record files that ``[records]`` does not name (an
+            input left out makes the fit wrong without an error), or a ``t``/``time``
+            channel that contradicts ``records.dt``.
         """
         path = Path(path)
         _no_sets(sets, path, WING_KIND)
@@ -401,6 +476,8 @@ class WingProblem(_Wing):
         if time is not None and not isinstance(time, str):
             raise ConfigError(f"{src}: records.time = {time!r} must be a channel name")
         dt = _number(rec["dt"], "records.dt", src) if "dt" in rec else None
+        if dt is not None:   # before any record is read
+            _check_sampling(common["structure"], dt, src, None)
         forces = _names(_need(rec, "records", "forces", src, f"the {n} channels of the "
                               "generalised forces, in mode order"), "records.forces", src, n)
         disp = (_names(rec["displacements"], "records.displacements", src, n)
@@ -411,17 +488,42 @@ class WingProblem(_Wing):
         if disp is None and flap is None:
             raise ConfigError(f"{src}: the records need inputs: give records.displacements "
                               "and/or records.flap")
-        datas = []
+        datas, unused, clashes = [], {}, []
         for f in files:
             fp = (path.parent / f) if not Path(f).is_absolute() else Path(f)
             if not fp.is_file():
                 raise DataError(f"{src}: record file {f!r} not found ({fp}); fix "
                                 "records.files (paths are relative to the wing file)")
-            datas.append(_read_record(fp, forces, disp, flap, None if dt else time, dt))
-        dts = {round(d.dt, 12) for d in datas}
-        if len(dts) != 1:
+            data, extra, clash = _read_record(fp, forces, disp, flap, None if dt else time,
+                                              dt)
+            datas.append(data)
+            for c in extra:
+                unused.setdefault(c, []).append(f)
+            if clash is not None:
+                clashes.append((f, *clash))
+        if clashes:   # one warning for the files, not one per file
+            f, clock, step = clashes[0]
+            where = f"{src}: record file {f}" + (f" (and {len(clashes) - 1} more)"
+                                                 if len(clashes) > 1 else "")
+            warnings.warn(_time_contradicts(where, "records.dt", dt, clock, step),
+                          DataWarning, stacklevel=2)
+        # equal to 1e-6, as the steps within a file (a single-precision time channel gives
+        # its sampling time to the stamps' rounding over the record)
+        dts = sorted({round(d.dt, 12) for d in datas})
+        if dts[-1] > dts[0] * (1 + 1e-6):
             raise DataError(f"{src}: the record files have different sampling times "
-                            f"{sorted(dts)}; resample them to one")
+                            f"{dts}; resample them to one")
+        if dt is None:
+            _check_sampling(common["structure"], datas[0].dt, src, time)
+        if unused:
+            # an input the records carry but [records] does not name is most often one the
+            # fit needs (the flap): without it the ROM fits the forces wrongly, with no error
+            warnings.warn(f"{src}: channel(s) {sorted(unused)} of the record files (e.g. "
+                          f"{unused[sorted(unused)[0]][0]}) are not used: they are not among "
+                          f"records.forces {list(forces)}, records.displacements "
+                          f"{list(disp or [])} or records.flap ({flap!r}); if one is an "
+                          "input of the records, name it in [records], else drop it from "
+                          "the files", DataWarning, stacklevel=2)
         log.debug("%s: %d record files, dt = %g s", path, len(files), datas[0].dt)
         records = IOData(tuple(r for d in datas for r in d.records), datas[0].dt,
                          output_names=tuple(forces), u_names=tuple(disp or ()),

@@ -71,6 +71,36 @@ def _regularization(text: str) -> float:
     return value
 
 
+def _seconds_or_name(text: str) -> float | str:
+    """The ``--dt`` word: a number of seconds, else the name of a variable holding it."""
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+def _dt(value: float | str | None, suffix: str) -> float | str | None:
+    """``--dt``: the sampling time [s], or (a .mat file) the variable holding it."""
+    if isinstance(value, str) and suffix != ".mat":
+        raise ConfigError(f"--dt {value!r}: give the sampling time in seconds (a variable "
+                          "name holding it works for a .mat file only)")
+    return value
+
+
+def _nf(text: str | None) -> int | str:
+    """``--nf``: the order of Σf, a positive integer or ``auto`` (the default)."""
+    if text is None or text.strip().lower() == "auto":
+        return "auto"
+    try:
+        value = int(text)
+    except ValueError:
+        value = None
+    if value is None or value < 1:
+        raise ConfigError(f"--nf {text!r}: give a positive integer, or --nf auto (the default: "
+                          "the order from the Hankel singular values)")
+    return value
+
+
 def _load(args):
     from ...data import IOData
 
@@ -78,18 +108,19 @@ def _load(args):
     if not path.exists():
         raise ConfigError(f"data file {path} does not exist")
     suffix = path.suffix.lower()
+    dt = _dt(args.dt, suffix)
     split = lambda s: [c for c in s.split(",") if c] if s else None  # noqa: E731
     if suffix == ".npz":
-        return IOData.from_npz(path, dt=args.dt)
+        return IOData.from_npz(path, dt=dt)
     if suffix == ".csv":
         if not args.y:
             raise ConfigError("a CSV needs --y COL1,COL2,... (and --u/--v)")
         return IOData.from_csv(path, y=split(args.y), u=split(args.u), v=args.v,
-                               time=args.time, dt=args.dt)
+                               time=args.time, dt=dt)
     if suffix == ".mat":
         if not args.y:
             raise ConfigError("a .mat file needs --y VARIABLE (and --u/--v VARIABLE)")
-        return IOData.from_mat(path, y=args.y, u=args.u, v=args.v, dt=args.dt, fs=args.fs)
+        return IOData.from_mat(path, y=args.y, u=args.u, v=args.v, dt=dt, fs=args.fs)
     raise ConfigError(f"unknown data format {suffix!r}: use .npz, .csv or .mat")
 
 
@@ -100,6 +131,8 @@ def _main(args) -> int:
     # every argument checked before any work
     orders = _orders(args.orders)
     reg = _regularization(args.regularization)
+    nf = _nf(args.nf)
+    _dt(args.dt, Path(args.data).suffix.lower())
     if args.out:
         check_writable(args.out, "--out")
     if args.max_time is not None and not (math.isfinite(args.max_time) and args.max_time > 0):
@@ -127,7 +160,7 @@ def _main(args) -> int:
         res = identify(data, orders, **settings)
     for w in caught:   # one line each on stderr
         print(f"casflutter: warning: {w.message}", file=sys.stderr)
-    real = realize(res.model, args.nf if args.nf else "auto")
+    real = realize(res.model, nf)
     out_path = None
     if args.out:   # written under a temporary name and renamed: never a half-written file
         out_path = Path(args.out)
@@ -192,9 +225,12 @@ def register(subparsers) -> None:
     p.add_argument("--v", help="flap input v: a CSV column or a .mat variable (omit for a "
                                "record without a flap)")
     p.add_argument("--time", default="t", help="CSV time column")
-    p.add_argument("--dt", type=float, help="sampling time [s]")
+    p.add_argument("--dt", type=_seconds_or_name,
+                   help="sampling time [s] (overrides a CSV time column), or for a MATLAB "
+                        ".mat file the variable holding it")
     p.add_argument("--fs", help=".mat variable holding the sampling frequency")
-    p.add_argument("--nf", type=int, help="order of Σf (default: from the Hankel singular values)")
+    p.add_argument("--nf", help="order of Σf: a positive integer, or auto (default: from the "
+                                "Hankel singular values)")
     p.add_argument("--out", help="write the model (.npz; written under a temporary name "
                                  "beside it and renamed when complete)")
     p.add_argument("--json", action="store_true", help="print JSON instead of the table")
