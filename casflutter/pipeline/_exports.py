@@ -154,37 +154,35 @@ def controller_pole_check(K, *, dt: float | None, actuator_omega: float | None =
            "nyquist_hz": None, "faster_than_nyquist": None, "actuator_bandwidth_hz": None,
            "faster_than_actuator": None, "plant_fastest_hz": None, "faster_than_plant": None,
            "warnings": []}
+    # (key of the reference frequency, key of the flag, reference [rad per time unit],
+    # limit, the warning with {poles} for the poles above the limit)
+    checks = []
     if dt is not None and math.isfinite(dt) and dt > 0:
         nyq = np.pi / dt
-        out["nyquist_hz"] = float(nyq / (2 * np.pi))
-        out["faster_than_nyquist"] = bool(fast > nyq)
-        if fast > nyq:
-            above = ", ".join(f"{w / (2 * np.pi):.4g}" for w in sorted(wn[wn > nyq])[::-1])
-            out["warnings"].append(
-                f"controller poles at {above} {hz} are faster than the "
-                f"{nyq / (2 * np.pi):.4g} {hz} Nyquist frequency of the identification data "
-                f"(dt = {dt:g}): the ROM says nothing about the plant there")
+        checks.append(("nyquist_hz", "faster_than_nyquist", nyq, nyq,
+                       f"controller poles at {{poles}} {hz} are faster than the "
+                       f"{nyq / (2 * np.pi):.4g} {hz} Nyquist frequency of the identification "
+                       f"data (dt = {dt:g}): the ROM says nothing about the plant there"))
     if actuator_omega is not None:
-        out["actuator_bandwidth_hz"] = float(actuator_omega / (2 * np.pi))
-        out["faster_than_actuator"] = bool(fast > actuator_omega)
-        if fast > actuator_omega:
-            above = ", ".join(f"{w / (2 * np.pi):.4g}"
-                              for w in sorted(wn[wn > actuator_omega])[::-1])
-            out["warnings"].append(
-                f"controller poles at {above} {hz} are faster than the flap actuator "
-                f"({actuator_omega / (2 * np.pi):.4g} {hz}, closed_loop.actuator_omega)")
+        checks.append(("actuator_bandwidth_hz", "faster_than_actuator", actuator_omega,
+                       actuator_omega,
+                       f"controller poles at {{poles}} {hz} are faster than the flap actuator "
+                       f"({actuator_omega / (2 * np.pi):.4g} {hz}, closed_loop.actuator_omega)"))
     if plant_omega is not None and math.isfinite(plant_omega) and plant_omega > 0:
-        limit = FASTER_THAN_PLANT * plant_omega
-        out["plant_fastest_hz"] = float(plant_omega / (2 * np.pi))
-        out["faster_than_plant"] = bool(fast > limit)
+        checks.append(("plant_fastest_hz", "faster_than_plant", plant_omega,
+                       FASTER_THAN_PLANT * plant_omega,
+                       f"controller poles at {{poles}} {hz} are more than "
+                       f"{FASTER_THAN_PLANT:g} times faster than the plant's fastest pole "
+                       f"({plant_omega / (2 * np.pi):.4g} {hz} over the design's speeds): the "
+                       "loop's speed is set where the plant's model says nothing; give a "
+                       "controller of lower gain (a slower decay rate, "
+                       "controller.interval_decay) or a model valid that fast"))
+    for ref_key, flag_key, ref, limit, text in checks:
+        out[ref_key] = float(ref / (2 * np.pi))
+        out[flag_key] = bool(fast > limit)
         if fast > limit:
-            above = ", ".join(f"{w / (2 * np.pi):.4g}" for w in sorted(wn[wn > limit])[::-1])
-            out["warnings"].append(
-                f"controller poles at {above} {hz} are more than {FASTER_THAN_PLANT:g} times "
-                f"faster than the plant's fastest pole ({plant_omega / (2 * np.pi):.4g} {hz} "
-                "over the design's speeds): the loop's speed is set where the plant's model "
-                "says nothing; give a controller of lower gain (a slower decay rate, "
-                "controller.interval_decay) or a model valid that fast")
+            poles = ", ".join(f"{w / (2 * np.pi):.4g}" for w in sorted(wn[wn > limit])[::-1])
+            out["warnings"].append(text.format(poles=poles))
     return out
 
 

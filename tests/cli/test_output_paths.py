@@ -77,12 +77,13 @@ def test_figure_suffix_must_be_a_matplotlib_format(tmp_path):
         check_figure(tmp_path / "f.xyz")
 
 
+@pytest.mark.parametrize("command", ["flutter", "lco"])
 @pytest.mark.parametrize("figure, words", [
     ("afile/sub.png", "afile is a file, not a folder"),
     ("f.xyz", "unsupported file type '.xyz'"),
 ])
-def test_flutter_figure_path_is_checked_before_any_work(tmp_path, monkeypatch, capsys, figure,
-                                                         words):
+def test_figure_path_is_checked_before_any_work(tmp_path, monkeypatch, capsys, command, figure,
+                                                words):
     import casflutter.truth
 
     def no_work(*a, **k):
@@ -90,7 +91,7 @@ def test_flutter_figure_path_is_checked_before_any_work(tmp_path, monkeypatch, c
 
     monkeypatch.setattr(casflutter.truth, "load_problem", no_work)
     (tmp_path / "afile").write_text("")
-    assert main(["flutter", "typical_section", "--figure", str(tmp_path / figure)]) == 1
+    assert main([command, "typical_section", "--figure", str(tmp_path / figure)]) == 1
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and err.startswith("casflutter: error: --figure ") and words in err
 
@@ -149,21 +150,3 @@ def test_bench_design_out_in_a_missing_folder_is_written(tmp_path):
                  "--out", str(out)]) == 0
     (rec,) = json.loads(out.read_text())["records"]
     assert rec["held"] is True and sorted(p.name for p in out.parent.iterdir()) == ["bench.json"]
-
-
-@pytest.mark.parametrize("figure, words", [
-    ("afile/sub.png", "afile is a file, not a folder"),
-    ("f.xyz", "unsupported file type '.xyz'"),
-])
-def test_lco_figure_path_is_checked_before_any_work(tmp_path, monkeypatch, capsys, figure,
-                                                     words):
-    import casflutter.truth
-
-    def no_work(*a, **k):
-        raise AssertionError("the work started before the figure path was checked")
-
-    monkeypatch.setattr(casflutter.truth, "load_problem", no_work)
-    (tmp_path / "afile").write_text("")
-    assert main(["lco", "typical_section", "--figure", str(tmp_path / figure)]) == 1
-    err = capsys.readouterr().err.strip()
-    assert "\n" not in err and err.startswith("casflutter: error: --figure ") and words in err
