@@ -10,6 +10,7 @@ is stable and flutters at the frozen-aero point.
 """
 
 import logging
+import re
 import warnings
 
 import numpy as np
@@ -161,9 +162,10 @@ def test_casflutter_run_prints_no_flutter_speed_and_fails_its_checks(wing, tmp_p
     text = capsys.readouterr()
     line = next(s for s in text.out.splitlines() if s.startswith("flutter (ROM)"))
     assert "none: the loop is unstable already at V = 0.3" in line
-    assert "its crossing at V = 2.047" in line and "no flutter onset" in line
+    assert re.search(r"its crossing at V = [\d.]+ is no flutter onset", line), line
     assert "checks passed: False" in text.out and "a check failed" in text.err
     assert main(["-q", "run", str(wing / "run_na1.toml"), "--out", str(out),
                  "--overwrite"]) == 0
     text = capsys.readouterr()
-    assert "flutter (ROM):   V = 2.85" in text.out and "checks passed" not in text.out
+    V = float(re.search(r"flutter \(ROM\):   V = ([\d.]+)", text.out).group(1))
+    assert V == pytest.approx(2.857, rel=5e-3) and "checks passed" not in text.out
