@@ -676,6 +676,7 @@ def _time_contradicts(where: str, given: str, dt: float, channel: str, step: flo
             f"is not; if {channel!r} is the time in seconds, use it instead of the sampling "
             "time (records.time in a wing file, --time without --dt on the command line)")
 
+
 def _input_file(path, suffix: str) -> Path:
     """``path`` as a Path that names an existing file (not a folder)."""
     try:
