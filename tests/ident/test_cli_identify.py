@@ -50,12 +50,19 @@ def test_out_checked_before_the_work(npz, tmp_path, capsys, monkeypatch):
     _no_identify(monkeypatch)
     afile = tmp_path / "afile"
     afile.write_text("x")
-    for out, msg in [(afile / "sub" / "m.npz", "does not exist"),
-                     (tmp_path / "nodir" / "m.npz", "does not exist"),
-                     (tmp_path, "is a directory")]:
+    for out, msg in [(afile / "sub" / "m.npz", "is a file, not a folder"),
+                     (tmp_path, "is a folder")]:
         assert main(["identify", str(npz), "--out", str(out)]) == 1
         err = capsys.readouterr().err
         assert "--out" in err and msg in err
+
+
+def test_out_folder_is_created(npz, tmp_path, capsys):
+    """As every other command's --out: a missing folder is created when the model is
+    written, not refused after the path check."""
+    out = tmp_path / "new" / "deeper" / "m.npz"
+    assert main(["identify", str(npz), "--orders", "2,1,1,1,2,2", "--out", str(out)]) == 0
+    assert ident.HWLModel.load(out).orders.as_tuple() == (2, 1, 1, 1, 2, 2)
 
 
 def test_json_is_valid_and_out_written(npz, tmp_path, capsys):
@@ -125,8 +132,9 @@ def test_search_prints_table_and_refits(npz, capsys):
 
 
 def test_bench_identify_simulation_small(tmp_path, capsys):
-    """The benchmark's JSON keys and its scipy reference on a small paper-structure case."""
-    out = tmp_path / "b.json"
+    """The benchmark's JSON keys and its scipy reference on a small paper-structure case;
+    the missing folder of --out is created."""
+    out = tmp_path / "new" / "b.json"
     assert main(["bench", "identify", "--criterion", "simulation", "--samples", "600",
                  "--repeat", "1", "--out", str(out)]) == 0
     doc = json.loads(out.read_text())
@@ -138,6 +146,14 @@ def test_bench_identify_simulation_small(tmp_path, capsys):
     assert doc["criterion"] == "simulation" and doc["ipopt_status"] == "Solve_Succeeded"
     assert doc["cost"] <= doc["scipy_reference"]["cost"] * (1 + 1e-9)
     assert doc["cost"] <= doc["cost_initial"]
+
+
+def test_bench_identify_out_checked_before_the_work(tmp_path, capsys, monkeypatch):
+    from casflutter.cli.bench import identify as bench_identify
+
+    monkeypatch.setattr(bench_identify, "run", lambda *a, **k: pytest.fail("ran"))
+    assert main(["bench", "identify", "--out", str(tmp_path / "b.txt")]) == 1
+    assert "--out" in capsys.readouterr().err
 
 
 def test_max_time_exits_one_with_one_line(npz, capsys):

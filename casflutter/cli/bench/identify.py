@@ -30,6 +30,7 @@ import tracemalloc
 
 import numpy as np
 
+from ..._outputs import atomic_file, check_output_path
 from ...errors import ConfigError
 
 PAPER_ORDERS = (3, 1, 1, 1, 2, 2)
@@ -203,14 +204,13 @@ def run(n_samples: int | None = None, noise: float | None = None, seed: int = 1,
 
 def _main(args) -> int:
     if args.out:
-        from ..commands.identify import check_writable
-        check_writable(args.out, "--out")
+        check_output_path(args.out, what="--out", suffixes=(".json",))
     out = run(args.samples, args.noise, args.seed, args.repeat, criterion=args.criterion,
               case=args.case)
     text = json.dumps(out, indent=2, allow_nan=False)
     if args.out:
-        with open(args.out, "w") as fh:
-            fh.write(text + "\n")
+        with atomic_file(args.out, what="--out") as tmp:
+            tmp.write_text(text + "\n")
     print(text if not args.out else f"wrote {args.out}", file=sys.stdout)
     return 0
 

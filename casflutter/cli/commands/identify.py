@@ -14,36 +14,14 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import sys
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..._outputs import atomic_file
+from ..._outputs import atomic_file, check_output_path
 from ...errors import ConfigError, DataWarning
-
-
-def check_writable(path, flag: str) -> None:
-    """Refuse an output path that cannot be written, before any work.
-
-    Raises
-    ------
-    ConfigError
-        The path is a directory, its folder does not exist or is not a folder, or it is not
-        writable.
-    """
-    p = Path(path)
-    if p.is_dir():
-        raise ConfigError(f"{flag} {path}: is a directory; give a file name")
-    parent = p.parent if str(p.parent) else Path(".")
-    if not parent.exists():
-        raise ConfigError(f"{flag} {path}: the folder {parent} does not exist; create it first")
-    if not parent.is_dir():
-        raise ConfigError(f"{flag} {path}: {parent} is not a folder")
-    if (p.exists() and not os.access(p, os.W_OK)) or not os.access(parent, os.W_OK):
-        raise ConfigError(f"{flag} {path}: not writable")
 
 
 def _orders(text: str):
@@ -133,8 +111,12 @@ def _main(args) -> int:
     reg = _regularization(args.regularization)
     nf = _nf(args.nf)
     _dt(args.dt, Path(args.data).suffix.lower())
-    if args.out:
-        check_writable(args.out, "--out")
+    out_path = None
+    if args.out:   # numpy's own rule for savez: the model file ends in .npz
+        out_path = check_output_path(args.out, what="--out")
+        if not out_path.name.endswith(".npz"):
+            out_path = check_output_path(out_path.with_name(out_path.name + ".npz"),
+                                         what="--out")
     if args.max_time is not None and not (math.isfinite(args.max_time) and args.max_time > 0):
         raise ConfigError(f"--max-time {args.max_time}: give a positive number of seconds")
     grid = None if args.search in (None, "default") else parse_grid(args.search)
@@ -161,12 +143,8 @@ def _main(args) -> int:
     for w in caught:   # one line each on stderr
         print(f"casflutter: warning: {w.message}", file=sys.stderr)
     real = realize(res.model, nf)
-    out_path = None
-    if args.out:   # written under a temporary name and renamed: never a half-written file
-        out_path = Path(args.out)
-        if not out_path.name.endswith(".npz"):   # numpy's own rule for savez
-            out_path = out_path.with_name(out_path.name + ".npz")
-        with atomic_file(out_path) as tmp, open(tmp, "wb") as fh:
+    if out_path is not None:   # written under a temporary name and renamed
+        with atomic_file(out_path, what="--out") as tmp, open(tmp, "wb") as fh:
             res.model.save(fh)
     if args.json:
         out = {
