@@ -11,6 +11,8 @@ of the package), and the arrays of the file as written.
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -127,6 +129,18 @@ def test_a_family_file_loads_without_its_positions_and_says_so(tmp_path, caplog)
     np.testing.assert_array_equal(B, rec.B[:, :4])
     np.testing.assert_array_equal(C, rec.C[:, :, :4])
     np.testing.assert_array_equal(D, rec.D)
+
+
+def test_problems_lists_the_states_analysed_and_the_ones_left_out(tmp_path, capsys):
+    from casflutter.cli import main
+
+    path = write(tmp_path)
+    assert main(["problems", str(path), "--json"]) == 0
+    (info,) = json.loads(capsys.readouterr().out)
+    assert (info["n_states"], info["n_states_file"], info["left_out_states"]) == (4, 6, [4, 5])
+    assert main(["problems", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "plant family: 4 states" in out and "the file has 6 states; states [4, 5]" in out
 
 
 def test_a_decaying_position_block_is_left_out_and_a_growing_one_is_kept(tmp_path, caplog):

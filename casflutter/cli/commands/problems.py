@@ -27,11 +27,13 @@ def _family_info(name: str, record) -> dict:
     """The listing of a gridded plant family (roles checked by building the family)."""
     from ...aeroelastic import load_family
 
-    sig = load_family(record).signals
-    v = record.speeds
+    family = load_family(record)
+    sig, v = family.signals, record.speeds
+    left_out = [int(i) for i in family.left_out_states]
     return {"name": name, "truth": None, "kind": "plant_family",
             "description": record.description or record.describe(),
-            "n_states": record.n_states, "speed_unit": record.speed_unit,
+            "n_states": family.n_states, "n_states_file": record.n_states,
+            "left_out_states": left_out, "speed_unit": record.speed_unit,
             "time_unit": record.time_unit, "feedback": record.feedback,
             "speeds": {"min": float(v[0]), "max": float(v[-1]), "count": int(v.size),
                        "interpolation": record.interpolation},
@@ -48,6 +50,10 @@ def _print_family(info: dict) -> None:
     v = info["speeds"]
     print(f"{info['name']}  (plant family: {info['n_states']} states, {len(info['inputs'])} "
           f"inputs, {len(info['outputs'])} outputs, {v['count']} speeds)")
+    if info["left_out_states"]:
+        print(f"  the file has {info['n_states_file']} states; states "
+              f"{info['left_out_states']} (0-based) are left out: rigid-body positions, which "
+              "feed no output or other state and keep a pole at the origin in every loop")
     print(f"  {info['description']}")
     print(f"  speeds {v['min']:g} .. {v['max']:g} {info['speed_unit']} ({v['interpolation']} "
           f"between them);  time unit: {info['time_unit']};  feedback: {info['feedback']}")
