@@ -23,9 +23,13 @@ from __future__ import annotations
 
 import logging
 import sys
+import warnings
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Iterator
 
-__all__ = ["PACKAGE_LOGGER", "PROGRESS", "PROGRESS_END", "CliHandler", "configure_cli_logging", "remove_cli_logging",
-           "cli_level"]
+__all__ = ["PACKAGE_LOGGER", "PROGRESS", "PROGRESS_END", "CliHandler", "configure_cli_logging",
+           "remove_cli_logging", "cli_level", "own_warnings_logged"]
 
 #: Name of the package logger; every casflutter logger is a child of it.
 PACKAGE_LOGGER = "casflutter"
@@ -135,6 +139,53 @@ def remove_cli_logging(handler: CliHandler, level: int = logging.NOTSET) -> None
     logger = logging.getLogger(PACKAGE_LOGGER)
     logger.removeHandler(handler)
     logger.setLevel(level)
+
+
+#: the package's own source folder: a warning issued from a file under it is casflutter's own
+_PACKAGE = Path(__file__).resolve().parent
+
+
+def _own_warning(filename: str, text: str) -> bool:
+    """A warning issued by casflutter's code, not numpy's floating-point word about it
+    (``overflow encountered in matmul``)."""
+    if " encountered in " in text:
+        return False
+    try:
+        return Path(filename).resolve().is_relative_to(_PACKAGE)
+    except (OSError, ValueError):
+        return False
+
+
+@contextmanager
+def own_warnings_logged(logger: logging.Logger) -> Iterator[None]:
+    """casflutter's own Python warnings (records used not as meant, an unstable ROM's free
+    run, a loop unstable at the start of a search) as one WARNING record each on
+    ``logger``, each text once, as every other message (``casflutter: warning: ...`` on
+    the command line); numpy's floating-point warnings and other packages' are shown as
+    before.
+
+    Nested uses share the outer one's record of what was said, so a warning raised both
+    while a command checks its input and again inside :func:`casflutter.run` shows once.
+    """
+    active = getattr(warnings.showwarning, "_casflutter_said", None)
+    if active is not None:          # an outer use routes them already
+        yield
+        return
+    said: set[str] = set()
+    with warnings.catch_warnings():
+        shown = warnings.showwarning
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            text = str(message)
+            if not _own_warning(filename, text):
+                shown(message, category, filename, lineno, file, line)
+            elif text not in said:
+                said.add(text)
+                logger.warning("%s", text)
+
+        show._casflutter_said = said
+        warnings.showwarning = show
+        yield
 
 
 logging.getLogger(PACKAGE_LOGGER).addHandler(logging.NullHandler())

@@ -30,7 +30,8 @@ import traceback
 
 from .. import __version__
 from .._interrupt import Terminated, sigterm_raises
-from .._logging import PACKAGE_LOGGER, configure_cli_logging, remove_cli_logging
+from .._logging import (PACKAGE_LOGGER, configure_cli_logging, own_warnings_logged,
+                        remove_cli_logging)
 from .._threads import single_threaded
 from ._help import plain_help
 from ..errors import CasflutterError
@@ -154,7 +155,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         # one BLAS thread: the same seed gives bit-identical numbers however the process was
         # launched (make demo pins the pools through the environment, a bare shell does not)
-        with sigterm_raises(), single_threaded():
+        with sigterm_raises(), single_threaded(), own_warnings_logged(_log):
             code = int(args.func(args) or 0)
         sys.stdout.flush()  # a broken pipe shows here, not at interpreter exit
         return code

@@ -43,7 +43,6 @@ from __future__ import annotations
 
 import logging
 import time
-import warnings
 from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
@@ -52,6 +51,7 @@ import control
 import numpy as np
 
 from .._linalg import spectral_abscissa
+from .._logging import own_warnings_logged
 from .._outputs import provenance, utc_now
 from .._processes import map_in_processes
 from .._threads import deterministic, single_threaded
@@ -108,44 +108,6 @@ class _Progress:
         dt = time.perf_counter() - t
         self.timings[name] = self.timings.get(name, 0.0) + dt
         log.debug("stage %s: %.2f s", name, dt)
-
-
-#: the package's own source folder: a warning issued from a file under it is the run's own
-_PACKAGE = Path(__file__).resolve().parents[1]
-
-
-def _own_warning(filename: str, text: str) -> bool:
-    """A warning issued by casflutter's code, not numpy's floating-point word about it
-    (``overflow encountered in matmul``)."""
-    if " encountered in " in text:
-        return False
-    try:
-        return Path(filename).resolve().is_relative_to(_PACKAGE)
-    except (OSError, ValueError):
-        return False
-
-
-@contextmanager
-def _warnings_logged():
-    """The stages' own Python warnings (an unstable ROM's free run, records used not as
-    meant, a loop unstable at the start of a search) as one WARNING line each on the
-    pipeline's logger, each text once, as every other message of a run (``casflutter:
-    warning: ...`` on the command line); numpy's floating-point warnings and other packages'
-    are shown as before."""
-    said = set()
-    with warnings.catch_warnings():
-        shown = warnings.showwarning
-
-        def show(message, category, filename, lineno, file=None, line=None):
-            text = str(message)
-            if not _own_warning(filename, text):
-                shown(message, category, filename, lineno, file, line)
-            elif text not in said:
-                said.add(text)
-                log.warning("%s", text)
-
-        warnings.showwarning = show
-        yield
 
 
 def _linear_rom(cfg: RunConfig) -> str | None:
@@ -278,7 +240,7 @@ def design_family(cfg: RunConfig):
 
 
 @deterministic
-@_warnings_logged()
+@own_warnings_logged(log)
 def run(config: RunConfig | str | Path | None = None, *, out_dir=None, seed: int | None = None,
         quiet: bool = False, write: bool | None = None, overwrite: bool = False) -> RunResult:
     """Run the stages of a configuration (module docstring), and write its outputs when asked.
