@@ -77,8 +77,9 @@ import numpy as np
 
 from ..data import GAFTable, IOData, Record, load_gaf
 from ..data._matfile import read_mat
-from ..data._records import (_TIME_NAMES, _not_uniform, _read_npz, _stamp_resolution,
-                             _time_contradiction, _time_contradicts, _uniform_step)
+from ..data._records import read_npz
+from ..data._sampling import (TIME_NAMES, not_uniform, stamp_resolution, time_contradiction,
+                              time_contradicts, uniform_step)
 from ..errors import ConfigError, DataError, DataWarning
 from ..structure import (SENSOR_KINDS, AirspeedMixin, ModalStructure, SpeedConvention,
                          check_sensor_rows)
@@ -286,7 +287,7 @@ def _channels(path: Path, names: list[str], time: str | None, dt: float | None =
     and, with ``dt`` given instead of a time channel, ``(name, step)`` of a time channel
     (``t`` or ``time``) the file carries anyway and that contradicts ``dt`` (else None)."""
     if path.suffix.lower() == ".npz":
-        arrays, what = _read_npz(path), "array"
+        arrays, what = read_npz(path), "array"
     else:
         arrays = {k: v for k, v in read_mat(path).items() if not k.startswith("__")}
         what = "variable"
@@ -316,18 +317,18 @@ def _channels(path: Path, names: list[str], time: str | None, dt: float | None =
         if not np.all(np.isfinite(steps)) or not float(np.median(steps)) > 0:
             raise DataError(f"{path}: time channel {time!r} is not increasing")
         stored = np.asarray(arrays[time]).dtype
-        res = _stamp_resolution(out[time], stored)
-        dt_file = _uniform_step(out[time], res)
+        res = stamp_resolution(out[time], stored)
+        dt_file = uniform_step(out[time], res)
         if dt_file is None:
-            raise DataError(_not_uniform(
+            raise DataError(not_uniform(
                 str(path), f"channel {time!r}", steps, res, str(stored),
                 "give records.dt = {dt} instead of records.time (the time channel is then "
                 "not read)"))
     else:
-        clock = next((k for k in arrays if k.lower() in _TIME_NAMES and k not in names
+        clock = next((k for k in arrays if k.lower() in TIME_NAMES and k not in names
                       and vector(arrays[k])), None)
         if clock is not None and dt is not None:
-            step = _time_contradiction(np.asarray(arrays[clock], dtype=float).ravel(), dt)
+            step = time_contradiction(np.asarray(arrays[clock], dtype=float).ravel(), dt)
             if step is not None:
                 clash = (clock, step)
     unused = [k for k in arrays if k not in names and k != clock and vector(arrays[k])]
@@ -505,7 +506,7 @@ class WingProblem(_Wing):
             f, clock, step = clashes[0]
             where = f"{src}: record file {f}" + (f" (and {len(clashes) - 1} more)"
                                                  if len(clashes) > 1 else "")
-            warnings.warn(_time_contradicts(where, "records.dt", dt, clock, step),
+            warnings.warn(time_contradicts(where, "records.dt", dt, clock, step),
                           DataWarning, stacklevel=2)
         # equal to 1e-6, as the steps within a file (a single-precision time channel gives
         # its sampling time to the stamps' rounding over the record)

@@ -48,17 +48,17 @@ def test_a_non_uniform_time_column_names_the_override(tmp_path):
 
 
 def test_resolution_follows_the_stored_type():
-    from casflutter.data._records import _stamp_resolution, _uniform_step
+    from casflutter.data._sampling import stamp_resolution, uniform_step
 
     t = np.array([0.0, 8.0])
-    assert _stamp_resolution(t, np.float32) == pytest.approx(np.spacing(np.float32(8.0)))
-    assert _stamp_resolution(t, np.float64) == pytest.approx(np.spacing(8.0))
-    assert _stamp_resolution(t, np.int64) == 0.0
+    assert stamp_resolution(t, np.float32) == pytest.approx(np.spacing(np.float32(8.0)))
+    assert stamp_resolution(t, np.float64) == pytest.approx(np.spacing(8.0))
+    assert stamp_resolution(t, np.int64) == 0.0
     # exact float64 steps keep their median (no change for data that passed before)
     t64 = np.arange(K) * DT
-    assert _uniform_step(t64, _stamp_resolution(t64, np.float64)) == float(np.median(np.diff(t64)))
+    assert uniform_step(t64, stamp_resolution(t64, np.float64)) == float(np.median(np.diff(t64)))
     jitter = t64 + 1e-5 * (np.arange(K) % 2)
-    assert _uniform_step(jitter, _stamp_resolution(jitter, np.float32)) is None
+    assert uniform_step(jitter, stamp_resolution(jitter, np.float32)) is None
 
 
 def test_dt_contradicting_the_time_column_is_warned_about(tmp_path):
