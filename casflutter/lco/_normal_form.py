@@ -119,11 +119,26 @@ def _critical_vectors(A: np.ndarray, target: complex):
     return lam[k], q, p
 
 
-def _scan(measure, vrange, n_grid, what, speed_scale=1.0, speed_unit=""):
+def _scan(measure, vrange, n_grid, what, speed_scale=1.0, speed_unit="", *, real=None,
+          real_what=""):
+    """The first speed of ``vrange`` where ``measure`` (of the oscillatory eigenvalues)
+    crosses zero; ``real`` (of the real eigenvalues) names a static loss of stability when
+    there is no such crossing, so that a diverging equilibrium is never called stable."""
     lo, hi = map(float, vrange)
     grid = np.linspace(lo, hi, n_grid)
     vals = np.array([measure(v) for v in grid])
     u = f" {speed_unit}" if speed_unit else ""
+    if real is not None and not np.any(vals >= 0):
+        static = np.array([real(v) for v in grid])
+        for k in range(1, n_grid):
+            if static[k - 1] < 0 <= static[k]:
+                Vd = brentq(real, grid[k - 1], grid[k], xtol=1e-13 * max(1.0, hi), rtol=1e-14)
+                raise ConfigError(
+                    f"no flutter (Hopf) point in the speed range [{lo * speed_scale:g}, "
+                    f"{hi * speed_scale:g}]{u}, but the equilibrium diverges statically at "
+                    f"V = {Vd * speed_scale:.6g}{u} ({real_what}): no limit cycle starts "
+                    "there; the oscillatory eigenvalues stay stable ("
+                    f"{what} {vals.max():.3g} at most)")
     if vals[0] >= 0:
         raise ConfigError(f"the equilibrium is already unstable at the start of the speed range "
                           f"{lo * speed_scale:g}{u} ({what} {vals[0]:.3g} >= 0): lower the "
@@ -147,13 +162,22 @@ def find_hopf(forms: MultilinearForms, vrange, n_grid: int = 121, *, speed_scale
         Unstable at the range start, or no oscillatory eigenvalue crosses the imaginary
         axis in the range.
     """
-    def abscissa(V):
+    def split(V):
         lam = np.linalg.eigvals(forms.A(V))
-        osc = lam[np.abs(lam.imag) > 1e-9 * max(1.0, np.max(np.abs(lam)))]
+        osc = np.abs(lam.imag) > 1e-9 * max(1.0, np.max(np.abs(lam)))
+        return lam[osc], lam[~osc].real
+
+    def abscissa(V):
+        osc = split(V)[0]
         return float(np.max(osc.real)) if osc.size else -np.inf
 
+    def real_abscissa(V):
+        real = split(V)[1]
+        return float(np.max(real)) if real.size else -np.inf
+
     Vh = _scan(abscissa, vrange, n_grid, "spectral abscissa of the oscillatory eigenvalues",
-               speed_scale, speed_unit)
+               speed_scale, speed_unit, real=real_abscissa,
+               real_what="a real eigenvalue crosses zero")
     A = forms.A(Vh)
     lam = np.linalg.eigvals(A)
     osc = lam[np.abs(lam.imag) > 0]
@@ -175,13 +199,22 @@ def find_neimark_sacker(forms: MultilinearForms, vrange, n_grid: int = 121, *,
         Unstable at the range start, or no complex eigenvalue leaves the unit circle in the
         range.
     """
-    def radius(V):
+    def split(V):
         lam = np.linalg.eigvals(forms.A(V))
-        osc = lam[np.abs(lam.imag) > 1e-9]
+        osc = np.abs(lam.imag) > 1e-9
+        return lam[osc], lam[~osc].real
+
+    def radius(V):
+        osc = split(V)[0]
         return float(np.max(np.abs(osc))) - 1.0 if osc.size else -np.inf
 
+    def real_radius(V):
+        real = split(V)[1]
+        return float(np.max(np.abs(real))) - 1.0 if real.size else -np.inf
+
     Vns = _scan(radius, vrange, n_grid, "spectral radius - 1 of the complex eigenvalues",
-                speed_scale, speed_unit)
+                speed_scale, speed_unit, real=real_radius,
+                real_what="a real eigenvalue of the map leaves the unit circle")
     A = forms.A(Vns)
     lam = np.linalg.eigvals(A)
     osc = lam[np.abs(lam.imag) > 1e-9]

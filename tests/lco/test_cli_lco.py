@@ -66,6 +66,22 @@ def test_errors(capsys):
     assert "does not exist" in capsys.readouterr().err
 
 
+def test_a_diverging_section_is_not_called_stable(capsys):
+    """NATA with its elastic axis at mid-chord (a = 0): the quasi-steady moment about it,
+    rho U^2 b^2 (1/2 + a) cl_alpha alpha, beats the linear pitch spring k_1 at
+    U_d = sqrt(k_1 / (rho b^2 (1/2 + a) cl_alpha)), whatever the plunge does, long before
+    the oscillatory modes would flutter."""
+    assert main(["lco", "nata", "--set", "a=0", "--set", "I_alpha=0.06", "--vrange", "1",
+                 "60"]) == 1
+    err = capsys.readouterr().err
+    k1, rho, b, cl = 2.82, 1.225, 0.135, 6.28
+    Ud = (k1 / (rho * b**2 * 0.5 * cl)) ** 0.5
+    assert "no flutter (Hopf) point" in err and "diverges statically" in err
+    assert "stays stable" not in err
+    V = float(err.split("diverges statically at V = ")[1].split()[0])
+    assert V == pytest.approx(Ud, rel=1e-5)
+
+
 def test_settings_are_validated():
     with pytest.raises(ConfigError, match="LCOSettings.degree"):
         LCOSettings(degree=0)
