@@ -83,6 +83,22 @@ def _number(key: str, value: Any) -> float:
     return v
 
 
+def _check_lco_table(table: Mapping[str, Any], source: str) -> None:
+    """``[lco]`` of a rig file: only ``vrange = [lo, hi]`` (m/s, ``0 <= lo < hi``)."""
+    unknown = sorted(k for k in table if k != "vrange")
+    if unknown:
+        raise ConfigError(f"{source}: unknown key(s) {', '.join(map(repr, unknown))} in [lco]; "
+                          "allowed: vrange (the default speed range of `casflutter lco`)")
+    if "vrange" in table:
+        vr = table["vrange"]
+        if not (isinstance(vr, (list, tuple)) and len(vr) == 2):
+            raise ConfigError(f"{source}: [lco] vrange = {vr!r}: give [low, high] in m/s, e.g. "
+                              "vrange = [4.0, 16.0]")
+        lo, hi = (_number(f"[lco] vrange[{i}]", v) for i, v in enumerate(vr))
+        if not 0 <= lo < hi:
+            raise ConfigError(f"{source}: [lco] vrange = {list(vr)!r}: need 0 <= low < high")
+
+
 @dataclass(frozen=True)
 class FlapCoefficients:
     """Steady trailing-edge flap coefficients (per radian of flap, moment about the elastic
@@ -150,10 +166,13 @@ class PitchPlungeParams:
              f"must not exceed m_heave = {self.m_heave} (the wing moves in heave too)")
         need(self.k_alpha[0] > 0, "k_alpha",
              "the linear pitch stiffness k_alpha[0] must be positive")
-        S = self.m_wing * self.x_alpha * self.b
-        need(self.m_heave * self.I_alpha > S * S, "I_alpha",
-             f"the mass matrix is not positive definite: need m_heave I_alpha > "
-             f"(m_wing x_alpha b)^2 = {S * S:g}")
+        # I_alpha = I_cg + m_wing (x_alpha b)^2 about the elastic axis (parallel axes); with
+        # m_wing <= m_heave it also makes the mass matrix positive definite
+        offset = self.m_wing * (self.x_alpha * self.b) ** 2
+        need(self.I_alpha > offset, "I_alpha",
+             f"below m_wing (x_alpha b)^2 = {offset:g} kg m^2, the inertia of the wing's mass "
+             f"about the elastic axis alone (parallel axes, x_alpha = {self.x_alpha:g}, b = "
+             f"{self.b:g}): check I_alpha, x_alpha and b")
 
     # ---- construction --------------------------------------------------------------
     @classmethod
@@ -190,6 +209,7 @@ class PitchPlungeParams:
         for t in _TABLES:
             if t in data and not isinstance(data[t], Mapping):
                 raise ConfigError(f"{source}: {t!r} must be a table ([{t}])")
+        _check_lco_table(data.get("lco", {}), source)
         kw = {k: data[k] for k in fields if k in data and k != "flap"}
         if "flap" in data:
             kw["flap"] = _flap_from(data["flap"], source)

@@ -205,7 +205,13 @@ def _toml(d):
     ({"set": ("kind", "wing")}, "'kind'"),
     ({"set": ("k_alpha", [])}, "'k_alpha'"),
     ({"set": ("k_alpha", [-1.0, 2.0])}, "'k_alpha'.*positive"),
-    ({"set": ("I_alpha", 1e-6)}, "'I_alpha'.*positive definite"),
+    ({"set": ("I_alpha", 1e-6)}, "'I_alpha'.*parallel axes"),
+    # m_heave I_alpha > S^2 (a positive definite mass matrix) but I_alpha below the wing's
+    # own m_wing (x_alpha b)^2 = 0.0041 kg m^2 about the elastic axis
+    ({"set": ("I_alpha", 0.002)}, "'I_alpha'.*m_wing \\(x_alpha b\\)\\^2 = 0.0041"),
+    ({"lco": {"vrange": "4-16"}}, "\\[lco\\] vrange.*\\[low, high\\]"),
+    ({"lco": {"vrange": [16.0, 4.0]}}, "\\[lco\\] vrange.*low < high"),
+    ({"lco": {"npoints": 7}}, "unknown key.*'npoints' in \\[lco\\]"),
     ({"set": ("m_wing", 20.0)}, "'m_wing'.*m_heave"),
     ({"set": ("c_h", "soft")}, "'c_h'.*number"),
     ({"flap": {"cl_beta": 3.0}}, "missing key.*'cm_beta'"),
@@ -219,8 +225,9 @@ def test_bad_files_name_the_key(tmp_path, change, match):
         d[change["add"][0]] = change["add"][1]
     if "set" in change:
         d[change["set"][0]] = change["set"][1]
-    if "flap" in change:
-        d["flap"] = change["flap"]
+    for table in ("flap", "lco"):
+        if table in change:
+            d[table] = change[table]
     path = _write(tmp_path, _toml(d))
     with pytest.raises(ConfigError, match=match):
         load_problem(str(path))
