@@ -12,17 +12,19 @@ and the criticality of the Hopf point.
   rotation number, transfer-operator stability, Neimark--Sacker coefficient.
 - :func:`established_loop_lco` -- the ROM loop's LCO by simulation, continued while it
   grows; :func:`compare_lco` -- the speed-following ROM's LCO beside the wing's.
-- :class:`LCOBranch`, :class:`LCOPoint`, :class:`Fold`, :class:`HopfClassification` --
-  the frozen results (``LCOBranch.to_dict()`` is the JSON of ``casflutter lco``).
+- :class:`LCOBranch`, :class:`LCOPoint`, :class:`Fold`, :class:`HopfClassification`,
+  :class:`SettledMotion` (what the motion settles on above a subcritical point whose
+  branch has no stable cycle) -- the frozen results (``LCOBranch.to_dict()`` is the JSON of ``casflutter lco``).
 """
 
 from ._results import (SUBCRITICAL, SUPERCRITICAL, Fold, HopfClassification, LCOBranch,
-                       LCOPoint, LCOSettings)
+                       LCOPoint, LCOSettings, SettledMotion)
 from ._following import LcoComparison, compare_lco, established_loop_lco
 from ._rom_loop import InvariantCircle, rom_lco_branch, rom_loop_flutter, rom_loop_map
 from ._truth import Outputs, continue_lco, default_vrange, lco_branch, speed_convention, truth_outputs
 
 __all__ = ["LCOSettings", "LCOPoint", "Fold", "HopfClassification", "LCOBranch",
+           "SettledMotion",
            "SUPERCRITICAL", "SUBCRITICAL", "lco_branch", "continue_lco", "truth_outputs",
            "speed_convention", "default_vrange", "Outputs", "rom_lco_branch", "rom_loop_map",
            "rom_loop_flutter",

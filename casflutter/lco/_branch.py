@@ -26,7 +26,8 @@ from .._format import result_repr
 from ..errors import ConvergenceError
 from ._results import SUBCRITICAL, SUPERCRITICAL, Fold, HopfClassification, LCOSettings
 
-__all__ = ["BranchRun", "BranchStart", "continue_branch", "run_from_hopf", "tangent"]
+__all__ = ["BranchRun", "BranchStart", "continue_branch", "run_from_hopf", "run_from_orbit",
+           "tangent"]
 
 log = logging.getLogger("casflutter.lco")
 
@@ -315,3 +316,54 @@ def run_from_hopf(disc, start: BranchStart, settings: LCOSettings, vrange: tuple
                     "V = %.6g", kind, kind_branch, cp.V)
     run = continue_branch(disc, X1, t1, M, settings, vrange, cp.V, disc.size(X1))
     return hopf, run
+
+
+def run_from_orbit(disc, X0: np.ndarray, M: np.ndarray, settings: LCOSettings,
+                   vrange: tuple) -> BranchRun | None:
+    """Solve the orbit ``X0`` (a guess, e.g. a simulated cycle) at its speed and continue
+    its branch both ways.
+
+    Parameters
+    ----------
+    disc
+        The discretisation (as :func:`continue_branch`).
+    X0 : numpy.ndarray
+        The guess; its speed entry is kept fixed while it is solved.
+    M : numpy.ndarray
+        Diagonal metric of the continuation.
+    settings : LCOSettings
+    vrange : tuple
+        Speed-index range.
+
+    Returns
+    -------
+    BranchRun or None
+        The branch ordered from its low-speed end (as continued downwards) through ``X0``
+        to its other end, with both stop reasons; None when the orbit does not converge.
+    """
+    iV = disc.iV
+    V0 = float(X0[iV])
+    c = np.zeros(X0.size)
+    c[iV] = 1.0
+    res = disc.solve(X0, disc.reference(X0), c, V0)
+    if not res.success:
+        return None
+    X1 = res.x
+    try:
+        t1 = tangent(disc, X1, disc.reference(X1), c, M)
+    except np.linalg.LinAlgError:
+        return None
+    size = disc.size(X1)
+    up = continue_branch(disc, X1, t1, M, settings, vrange, V0, size)
+    down = continue_branch(disc, X1, -t1, M, settings, vrange, V0, size)
+    n_down = len(down.points)
+    folds = [Fold(V=f.V, amplitude=f.amplitude, index=n_down - 2 - f.index, located=f.located,
+                  tangent_V=f.tangent_V, max_multiplier=f.max_multiplier)
+             for f in reversed(down.folds)]
+    folds += [Fold(V=f.V, amplitude=f.amplitude, index=n_down - 1 + f.index,
+                   located=f.located, tangent_V=f.tangent_V, max_multiplier=f.max_multiplier)
+              for f in up.folds]
+    return BranchRun(X=down.X[:0:-1] + up.X, points=down.points[:0:-1] + up.points,
+                     tangents=[-t for t in down.tangents[:0:-1]] + up.tangents, folds=folds,
+                     completed=up.completed and down.completed,
+                     stop_reason=f"one way: {down.stop_reason}; the other: {up.stop_reason}")

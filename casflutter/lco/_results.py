@@ -10,8 +10,8 @@ import numpy as np
 from .._format import result_repr
 from ..errors import ConfigError
 
-__all__ = ["LCOSettings", "LCOPoint", "Fold", "HopfClassification", "LCOBranch",
-           "SUPERCRITICAL", "SUBCRITICAL"]
+__all__ = ["LCOSettings", "LCOPoint", "Fold", "HopfClassification", "SettledMotion",
+           "LCOBranch", "SUPERCRITICAL", "SUBCRITICAL"]
 
 SUPERCRITICAL = "supercritical"
 SUBCRITICAL = "subcritical"
@@ -253,6 +253,61 @@ class HopfClassification:
 
 
 @dataclass(frozen=True)
+class SettledMotion:
+    """What the motion does just above a subcritical Hopf point whose branch has no stable
+    cycle: one simulation there, and the branch of the cycle it settles on, if any.
+
+    The continuation follows only the branch through the Hopf point.  A stable limit cycle
+    that is not connected to it within the range (lightly damped sections with a polynomial
+    spring have one) would be missed, and "subcritical, no stable cycle" would read as "the
+    motion grows without bound".  So the equilibrium, unstable there, is simulated from the
+    first orbit of the branch; a cycle it settles on is solved by collocation at that speed
+    and continued both ways.
+
+    Attributes
+    ----------
+    V : float
+        Speed index of the simulation.
+    kind : str
+        ``"lco"`` (settles on a cycle), ``"divergence"`` (grows without bound, or past
+        ``max_amplitude``) or ``"decay"`` (returns to the equilibrium; not expected above
+        flutter).
+    duration : float
+        Simulated time (the truth's time unit).
+    freq_hz : float
+        Frequency of the settled cycle (NaN unless ``kind == "lco"``).
+    amplitude : dict
+        Output amplitudes of the settled cycle in the simulation (half peak-to-peak).
+    points : tuple of LCOPoint
+        The branch through the settled cycle, ordered along the branch (empty when there is
+        no cycle or its collocation did not converge).
+    folds : tuple of Fold
+        Folds of that branch.
+    note : str
+        What was found, in words (for the report).
+    """
+
+    __repr__ = result_repr
+
+    V: float
+    kind: str
+    duration: float
+    freq_hz: float
+    amplitude: dict
+    points: tuple = ()
+    folds: tuple = ()
+    note: str = ""
+
+    def to_dict(self, speed=float) -> dict:
+        """``V``, ``kind``, ``freq_hz``, ``amplitude``, ``branch``, ``folds``, ``note``."""
+        return {"V": float(speed(self.V)), "kind": self.kind,
+                "freq_hz": None if not math.isfinite(self.freq_hz) else float(self.freq_hz),
+                "amplitude": {k: float(v) for k, v in self.amplitude.items()},
+                "branch": [p.to_dict(speed) for p in self.points],
+                "folds": [f.to_dict(speed) for f in self.folds], "note": self.note}
+
+
+@dataclass(frozen=True)
 class LCOBranch:
     """A branch of periodic orbits continued in the speed from a Hopf point.
 
@@ -285,6 +340,9 @@ class LCOBranch:
         Speed-index range of the computation.
     timings : dict
         Wall seconds: ``hopf``, ``branch``, ``total``.
+    settled : SettledMotion or None
+        For a subcritical point whose branch has no stable cycle (continuous systems): what
+        a simulation just above the Hopf point settles on, and that cycle's own branch.
     """
 
     __repr__ = result_repr
@@ -303,6 +361,7 @@ class LCOBranch:
     stop_reason: str
     vrange: tuple
     timings: dict = field(default_factory=dict)
+    settled: SettledMotion | None = None
 
     @property
     def kind(self) -> str:
@@ -376,7 +435,8 @@ class LCOBranch:
         Returns
         -------
         dict
-            ``problem``, ``hopf``, ``kind``, ``branch``, ``folds`` and the units.
+            ``problem``, ``hopf``, ``kind``, ``branch``, ``folds``, the units and
+            ``settled`` (:class:`SettledMotion`, or None).
         """
         h = self.hopf
         return {
@@ -399,4 +459,5 @@ class LCOBranch:
             "stop_reason": self.stop_reason,
             "vrange": [float(self.speed(v)) for v in self.vrange],
             "timings": {k: float(v) for k, v in self.timings.items()},
+            "settled": None if self.settled is None else self.settled.to_dict(self.speed),
         }

@@ -6,10 +6,17 @@ at the value for which the normal form predicts a speed offset of ``start_offset
 Hopf speed, then it is continued in ``V`` by pseudo-arclength (:mod:`._branch`).  The
 direction in which the first orbit leaves the Hopf point, and its speed offset, check the
 first Lyapunov coefficient (:mod:`._normal_form`).
+
+Only the branch through the Hopf point is continued.  Where that point is subcritical and
+its branch has no stable cycle in the range, the system is simulated just above the Hopf
+point (CVODES) from the branch's first orbit: a cycle it settles on is solved by collocation
+and its own branch continued both ways, or the growth without bound is said
+(:class:`~casflutter.lco.SettledMotion`).
 """
 
 from __future__ import annotations
 
+import logging
 import math
 import time
 from dataclasses import dataclass
@@ -17,13 +24,18 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from scipy.interpolate import interp1d
+
 from .._resources import problems_dir, read_toml
+from ..data import analyze_response
 from ..errors import ConfigError
 from ..truth import problem_definition
-from ._branch import BranchStart, run_from_hopf
+from ._branch import BranchStart, run_from_hopf, run_from_orbit
 from ._collocation import Collocation
 from ._normal_form import MultilinearForms, find_hopf, lyapunov_flow
-from ._results import LCOBranch, LCOPoint, LCOSettings
+from ._results import SUBCRITICAL, LCOBranch, LCOPoint, LCOSettings, SettledMotion
+
+log = logging.getLogger(__name__)
 
 __all__ = ["Outputs", "truth_outputs", "speed_convention", "lco_branch", "continue_lco",
            "default_vrange"]
@@ -159,6 +171,8 @@ def continue_lco(f: ca.Function, outputs: Outputs, vrange, settings: LCOSettings
     Returns
     -------
     LCOBranch
+        With :attr:`~LCOBranch.settled` set where the Hopf point is subcritical and its
+        branch has no stable cycle in the range (module docstring).
 
     Raises
     ------
@@ -208,12 +222,98 @@ def continue_lco(f: ca.Function, outputs: Outputs, vrange, settings: LCOSettings
     hopf, run = run_from_hopf(disc, start, settings, (lo, hi), speed_scale=speed_scale,
                               speed_unit=speed_unit)
     t_branch = time.perf_counter() - t1b
+    settled = None
+    if hopf.kind == SUBCRITICAL and run.points and not any(p.stable for p in run.points):
+        t2 = time.perf_counter()
+        settled = _settled_motion(f, outputs, disc, cp.V, omega, run.points[0].state,
+                                  settings, (lo, hi), speed_scale, speed_unit, time_unit)
+        log.info("%s", settled.note)
+        t_branch += time.perf_counter() - t2
     return LCOBranch(problem=problem, system="truth", hopf=hopf, points=tuple(run.points),
                      folds=tuple(run.folds), outputs=outputs.names, output_units=outputs.units,
                      speed_unit=speed_unit, speed_scale=speed_scale, time_unit=time_unit,
                      completed=run.completed, stop_reason=run.stop_reason, vrange=(lo, hi),
                      timings={"hopf": t_hopf, "branch": t_branch,
-                              "total": time.perf_counter() - t0})
+                              "total": time.perf_counter() - t0}, settled=settled)
+
+
+#: periods of the critical pair simulated just above a subcritical Hopf point
+_SETTLE_PERIODS = 400
+
+
+def _integrate(f: ca.Function, x0: np.ndarray, V: float, t: np.ndarray) -> np.ndarray | None:
+    """States ``(n, len(t))`` of ``x' = f(x, V)`` from ``x0`` at the times ``t`` (CVODES in
+    one call: the simulation runs in compiled code), or None where the integration fails
+    (the state escapes)."""
+    x = ca.MX.sym("x", int(f.size1_in(0)))
+    F = ca.integrator("settle", "cvodes", {"x": x, "ode": f(x, V)}, float(t[0]), t[1:],
+                      {"reltol": 1e-8, "abstol": 1e-12 * max(float(np.max(np.abs(x0))), 1e-300),
+                       "max_num_steps": 100000})
+    try:
+        X = np.asarray(F(x0=x0)["xf"], float)
+    except RuntimeError:
+        return None
+    X = np.column_stack([x0, X])
+    return X if np.all(np.isfinite(X)) else None
+
+
+def _settled_motion(f: ca.Function, outputs: Outputs, disc: "_OdeDisc", Vh: float,
+                    omega: float, x0: np.ndarray, settings: LCOSettings, vrange: tuple,
+                    speed_scale: float, speed_unit: str, time_unit: str) -> SettledMotion:
+    """Simulate ``x' = f(x, V)`` just above the Hopf point from the branch's first orbit,
+    classify what it settles on and continue a settled cycle's branch
+    (:class:`SettledMotion`)."""
+    V = min(1.02 * Vh, 0.5 * (Vh + vrange[1]))
+    duration = _SETTLE_PERIODS * 2.0 * math.pi / omega
+    x0 = np.asarray(x0, float)
+    bound = 1e6 * max(float(np.max(np.abs(x0))), 1e-300)
+    t = np.linspace(0.0, duration, 32 * _SETTLE_PERIODS + 1)
+    u = f" {speed_unit}" if speed_unit and " " not in speed_unit else ""   # not a definition
+    at = f"at V = {V * speed_scale:.5g}{u}, {100 * (V / Vh - 1):.2g} % above the flutter speed,"
+    grows = (f"{at} the motion from the first orbit grows without bound: no stable limit "
+             "cycle catches it")
+    states = _integrate(f, x0, V, t)
+    if states is None or float(np.max(np.abs(states))) > bound:
+        return SettledMotion(V=V, kind="divergence", duration=duration, freq_hz=math.nan,
+                             amplitude={}, note=grows)
+    Y = np.asarray(outputs.function.map(t.size)(states, np.full((1, t.size), V)), float)
+    blowup = np.inf if settings.max_amplitude is None else settings.max_amplitude
+    an = analyze_response(t, Y.T, blowup=blowup)
+    amp = {n: float(a) for n, a in zip(outputs.names, an.amplitude)}
+    if an.kind == "divergence":
+        return SettledMotion(V=V, kind="divergence", duration=duration, freq_hz=math.nan,
+                             amplitude={}, note=grows)
+    if an.kind != "lco":
+        return SettledMotion(V=V, kind=an.kind, duration=duration, freq_hz=math.nan,
+                             amplitude={}, note=f"{at} the motion from the first orbit "
+                             f"does not settle on a limit cycle ({an.kind})")
+    words = ", ".join(f"{n} {a:.4g}{' ' + un if un else ''}" for (n, a), un in
+                      zip(amp.items(), outputs.units))
+    hz = "Hz" if time_unit == "s" else f"cycles per {time_unit}"
+    found = (f"{at} the motion settles on a stable limit cycle ({words}; "
+             f"{an.frequency_hz:.4g} {hz}) that the branch from the Hopf point does not reach")
+    col = disc.col
+    T = 1.0 / an.frequency_hz
+    last = t >= duration - 1.5 * T                 # the last cycle and a half, resampled
+    cycle = interp1d(t[last], states[:, last], kind="cubic", axis=1)
+    guess = col.initial_guess(lambda tau: cycle(duration - T + tau * T), T, V)
+    W = col.nodes(guess)
+    A = 0.5 * (W.max(axis=1) - W.min(axis=1))
+    A = np.maximum(A, 1e-3 * A.max())
+    M = np.concatenate([np.tile(1.0 / (col.npts * A ** 2), col.npts),
+                        [1.0 / T ** 2, 1.0 / (0.05 * V) ** 2]])
+    run = run_from_orbit(disc, guess, M, settings, vrange)
+    if run is None:
+        return SettledMotion(V=V, kind="lco", duration=duration, freq_hz=an.frequency_hz,
+                             amplitude=amp, note=f"{found}; its collocation did not converge, "
+                             "so its branch is not continued")
+    speeds = [p.V * speed_scale for p in run.points]
+    stable = [p.V * speed_scale for p in run.points if p.stable]
+    span = (f"; its own branch spans V = {min(speeds):.5g} to {max(speeds):.5g}{u}"
+            + (f", stable from {min(stable):.5g}{u}" if stable else ""))
+    return SettledMotion(V=V, kind="lco", duration=duration, freq_hz=an.frequency_hz,
+                         amplitude=amp, points=tuple(run.points), folds=tuple(run.folds),
+                         note=found + span)
 
 
 def lco_branch(truth, vrange=None, settings: LCOSettings | None = None,

@@ -73,6 +73,17 @@ def draw_branch(branch, name: str, ax, *, color=None, label: str | None = None,
     for f in branch.folds:
         ax.plot([float(branch.speed(f.V))], [f.amplitude[name]], marker="^", ms=8, color=color,
                 ls="none", zorder=5)
+    settled = getattr(branch, "settled", None)
+    if settled is not None and settled.points:
+        Vs = branch.speed(np.array([p.V for p in settled.points]))
+        As = np.array([p.amplitude[name] for p in settled.points])
+        for k, (i0, i1, s) in enumerate(_runs(np.array([p.stable for p in settled.points]))):
+            ax.plot(Vs[i0:i1 + 1], As[i0:i1 + 1], ls="-" if s else "--", color="C3",
+                    lw=1.8 if s else 1.3,
+                    label="cycle a simulation settles on" if k == 0 else None)
+        for f in settled.folds:
+            ax.plot([float(branch.speed(f.V))], [f.amplitude[name]], marker="^", ms=8,
+                    color="C3", ls="none", zorder=5)
     return first
 
 
@@ -126,6 +137,12 @@ def plot_bifurcation(branch, outputs=None, *, frequency: bool = True, hb_points=
         f = branch.freq_hz
         for i0, i1, s in _runs(branch.stable):
             a.plot(V[i0:i1 + 1], f[i0:i1 + 1], ls="-" if s else "--", color="C0")
+        settled = getattr(branch, "settled", None)
+        if settled is not None and settled.points:
+            Vs = branch.speed(np.array([p.V for p in settled.points]))
+            fs = np.array([p.freq_hz for p in settled.points])
+            for i0, i1, s in _runs(np.array([p.stable for p in settled.points])):
+                a.plot(Vs[i0:i1 + 1], fs[i0:i1 + 1], ls="-" if s else "--", color="C3")
         a.plot([float(branch.speed(branch.hopf.V))], [branch.hopf.freq_hz], "o", mfc="white",
                mec="C0")
         unit = "Hz" if branch.time_unit == "s" else f"cycles per {branch.time_unit}"
@@ -166,6 +183,9 @@ def _legend_proxies(ax, point: str = "Hopf point") -> None:
                Line2D([], [], color="0.2", marker="^", ls="none", label="fold")]
     old = ax.get_legend()
     extra = [h for h in (old.legend_handles if old is not None else [])]
+    labels = {h.get_label() for h in extra}
+    extra += [h for h in ax.get_lines()        # labelled lines not in a legend yet
+              if not h.get_label().startswith("_") and h.get_label() not in labels]
     ax.legend(handles=handles + extra, loc="upper left", fontsize="x-small", ncol=2)
 
 

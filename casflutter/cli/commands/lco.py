@@ -144,6 +144,16 @@ def run(args) -> int:
                   f"{h['V']:.4g}: the LCO jumps in at flutter and persists down to the fold "
                   "(hysteresis)")
     print(f"  {'stopped' if branch.completed else 'FAILED'}: {branch.stop_reason}")
+    if branch.settled is not None:
+        print(f"  no stable cycle on this branch; {branch.settled.note}")
+        pts = branch.settled.points
+        step = max(1, len(pts) // 12)
+        for i, p in enumerate(pts):
+            if i % step == 0 or i == len(pts) - 1:
+                print(f"  {branch.speed(p.V):10.5g} {p.freq_hz:9.5g} "
+                      f"{'yes' if p.stable else 'no':>6}  " + _fmt_amp(p.amplitude, names))
+        for f in branch.settled.folds:
+            print(f"  fold of cycles at V = {branch.speed(f.V):.6g} {doc['units']['V']}")
     if fig_path:
         print(f"  bifurcation diagram: {fig_path}")
     return 0 if branch.completed else 3
