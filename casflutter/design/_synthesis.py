@@ -61,6 +61,7 @@ from .._settings import build_settings
 from .._threads import single_threaded
 from ..errors import CasflutterError, ConfigError, DataError, DimensionError, SynthesisError
 from ._fullorder import full_order_controller, reduced_controllers
+from ._out_of_reach import modes_out_of_reach
 from ._plant import Partition, partition
 from ._problem import Cut, Problem, realize, verify_closed_loop
 from ._qp import CutQP
@@ -327,6 +328,22 @@ def _check_initial(G: control.StateSpace, order: int, nmeas: int, ncon: int) -> 
     if G.ninputs != nmeas or G.noutputs != ncon:
         raise DimensionError(f"initial controller is {G.noutputs}x{G.ninputs}, "
                              f"need {ncon}x{nmeas} (ncon x nmeas)")
+
+
+def _check_reach(parts: Sequence[Partition]) -> None:
+    """Refuse, before any work, a plant with a mode that does not decay and that no
+    controller moves (the controls do not reach it or the measurements do not see it)."""
+    for k, P in enumerate(parts):
+        if P.nx == 0:
+            continue
+        stuck = modes_out_of_reach(P.A, P.B2, P.C2, 0.0)
+        if stuck:
+            which = f"plant {k}: " if len(parts) > 1 else ""
+            raise SynthesisError(
+                f"{which}{stuck[0].describe()} does not decay, and no controller of any order "
+                "moves it, so none can stabilise the loop; give the plant a control that "
+                "reaches it and a measurement that sees it",
+                best_spectral_abscissa=float(stuck[0].eigenvalue.real), starts=())
 
 
 def _initial_gain(prob: Problem, kind: str, rng: np.random.Generator,
@@ -700,6 +717,7 @@ def synthesize(plants, nmeas: int, ncon: int, order: int, *, starts: int = 3, se
                    ("initial", [control.ss(G) for G in given])])
     for G in given:
         _check_initial(control.ss(G), order, nmeas, ncon)
+    _check_reach(parts + sparts)
     with single_threaded():
         return _synthesize(parts, sparts, sys_list, stab_list, nmeas, ncon, order, starts,
                            seed, given, opts, t_start)

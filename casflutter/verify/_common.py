@@ -14,7 +14,7 @@ import numpy as np
 from ..errors import CasflutterError, ConfigError
 
 __all__ = ["IllPosedError", "NotHurwitzError", "as_statespace", "ssdata", "check_continuous",
-           "spectral_abscissa", "is_hurwitz"]
+           "spectral_abscissa", "is_hurwitz", "rounding_margin"]
 
 #: Anything accepted where a system is expected: a python-control ``StateSpace``
 #: (or ``TransferFunction``) or a plain static gain matrix (``StateSpace`` with 0 states).
@@ -96,5 +96,10 @@ def is_hurwitz(A: np.ndarray) -> tuple[bool, float]:
     ``alpha < -100 eps max(1, ||A||_F)``, so that a pole at the origin computed as a
     round-off-sized negative number does not count as stable."""
     alpha = spectral_abscissa(A)
-    margin = 100 * np.finfo(float).eps * max(1.0, float(np.linalg.norm(A))) if A.size else 0.0
-    return bool(alpha < -margin), alpha
+    return bool(alpha < -rounding_margin(A)), alpha
+
+
+def rounding_margin(A: np.ndarray) -> float:
+    """``100 eps max(1, ||A||_F)``: how far left of the imaginary axis a pole of ``A`` must
+    lie to count as stable (:func:`is_hurwitz`)."""
+    return 100 * np.finfo(float).eps * max(1.0, float(np.linalg.norm(A))) if A.size else 0.0

@@ -11,6 +11,8 @@ to, but not at, rank loss: in reach.
 
 from __future__ import annotations
 
+import re
+
 import control
 import numpy as np
 import pytest
@@ -91,3 +93,20 @@ def test_a_fully_reachable_and_seen_plant_has_none():
     assert modes_out_of_reach([[0.0]], [[0.0]], [[1.0]], 0.05) == [
         OutOfReach(0j, reached=False, seen=True)]
     assert modes_out_of_reach([[0.0]], [[1.0]], [[1.0]], 0.05) == []
+
+
+@pytest.mark.parametrize("B2, C2, why", [
+    ([[0.0], [1.0]], [[1.0, 1.0]], "unreached by the controls"),
+    ([[1.0], [1.0]], [[0.0, 1.0]], "unseen by the measurements")])
+def test_synthesis_names_a_growing_mode_no_controller_moves(B2, C2, why):
+    """Refused before any start, with the mode named (PBH at λ = 1 by hand: the row or
+    column of the unstable state is zero in B2 or C2)."""
+    from casflutter.design import synthesize
+    from casflutter.errors import SynthesisError
+
+    A = np.diag([1.0, -1.0])
+    P = control.ss(A, np.hstack([[[1.0], [1.0]], B2]), np.vstack([[[1.0, 1.0]], C2]),
+                   [[0.0, 1.0], [0.0, 0.0]])
+    with pytest.raises(SynthesisError,
+                       match=re.escape(f"the mode at λ = 1 ({why}) does not decay")):
+        synthesize(P, 1, 1, 0)

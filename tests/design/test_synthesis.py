@@ -216,14 +216,56 @@ def test_bench_cli_writes_records(tmp_path):
     assert data["summary"]["n_records"] == 2 and data["summary"]["all_stable"]
 
 
-def test_bench_cli_rejects_unwritable_out_before_work(tmp_path):
+def test_bench_cli_rejects_unwritable_out_before_work(tmp_path, capsys):
     from casflutter.cli import main
 
     blocker = tmp_path / "file"
     blocker.write_text("")
     rc = main(["bench", "synthesis", "--plants", str(COMPLEIB / "AC4.json"), "--orders", "0",
                "--out", str(blocker / "sub" / "out.json"), "--hinfsyn-timeout", "0"])
-    assert rc == 2
+    assert rc == 1 and "--out" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args, what", [
+    (["--orders", "1.5"], "--orders"), (["--orders", ""], "--orders"),
+    (["--starts", "0"], "--starts"), (["--starts", "-1"], "--starts"),
+    (["--jobs", "0"], "--jobs")])
+def test_bench_cli_refuses_bad_arguments_before_work(tmp_path, capsys, monkeypatch, args, what):
+    from casflutter.cli import main
+    from casflutter.cli.bench import synthesis as bench
+
+    monkeypatch.setattr(bench, "run_plant", lambda *a, **k: pytest.fail("ran"))
+    rc = main(["bench", "synthesis", "--plants", str(COMPLEIB / "AC4.json"),
+               "--out", str(tmp_path / "o.json"), *args])
+    assert rc == 1 and what in capsys.readouterr().err
+
+
+def test_bench_cli_refuses_a_plant_that_is_not_json(tmp_path, capsys):
+    from casflutter.cli import main
+
+    mat = tmp_path / "plant.mat"
+    mat.write_bytes(b"MATLAB 5.0 MAT-file")
+    assert main(["bench", "synthesis", "--plants", str(mat), "--out",
+                 str(tmp_path / "o.json")]) == 1
+    assert "COMPleib-format JSON" in capsys.readouterr().err
+
+
+def test_bench_cli_fails_when_no_controller_is_found(tmp_path, capsys):
+    """A mode growing at +1 that the control does not reach: no controller of any order
+    stabilises the plant, so the benchmark records the refusal and exits 1, not 0."""
+    from casflutter.cli import main
+
+    plant = {"name": "unreachable", "A": [[1.0, 0.0], [0.0, -1.0]], "B1": [[1.0], [1.0]],
+             "B": [[0.0], [1.0]], "C1": [[1.0, 1.0]], "C": [[1.0, 1.0]], "D11": [[0.0]],
+             "D12": [[1.0]], "D21": [[0.0]]}
+    path = tmp_path / "unreachable.json"
+    path.write_text(json.dumps(plant))
+    out = tmp_path / "o.json"
+    assert main(["bench", "synthesis", "--plants", str(path), "--orders", "0", "--out",
+                 str(out), "--hinfsyn-timeout", "0"]) == 1
+    assert "no stabilising controller for unreachable order 0" in capsys.readouterr().err
+    (rec,) = json.loads(out.read_text())["records"]
+    assert rec["gamma"] is None and not rec["stable"]
 
 
 def test_bench_streams_records_after_each_order(tmp_path, monkeypatch):

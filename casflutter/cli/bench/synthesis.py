@@ -21,7 +21,13 @@ A plant that fails (a file that cannot be read, a plant the synthesis refuses, n
 stabilises it, or an internal error) gets a record per order with ``gamma`` null,
 ``stable`` false and ``error`` (``class`` and ``message``); the benchmark goes on with the
 next order and plant, and the exit status is 1 when a plant could not be run at all (its
-file, or an internal error), 0 otherwise.
+file, or an internal error) or an order got no stabilising controller, 0 otherwise.  Bad
+arguments (orders, starts, a plant that is not a JSON file) are refused before any work.
+
+``hinfsyn_full_order_gamma`` is the H∞ norm that python-control's full-order ``hinfsyn``
+controller achieves on the plant, recomputed from its closed loop; the γ ``hinfsyn``
+reports is kept as ``hinfsyn_reported_gamma`` (on COMPleib's EB1 it reports 2.43 for a
+controller whose loop has norm 3.25, below the true optimum 3.10).
 """
 
 from __future__ import annotations
@@ -38,6 +44,9 @@ from typing import Any
 
 import numpy as np
 
+from ..._outputs import atomic_file, check_output_path
+from ...errors import ConfigError
+
 __all__ = ["register", "run_plant"]
 
 
@@ -47,26 +56,38 @@ def _plant_files(items: list[str]) -> list[Path]:
         p = Path(item)
         if p.is_dir():
             files += sorted(f for f in p.glob("*.json") if f.name != "reference.json")
-        elif p.is_file():
+        elif p.is_file() and p.suffix.lower() == ".json":
             files.append(p)
+        elif p.is_file():
+            raise ConfigError(f"--plants {item}: a {p.suffix or 'suffix-less'} file; the plants "
+                              "are COMPleib-format JSON files (A, B1, B, C1, C, D11, D12, D21; "
+                              "see problems/compleib/README.md)")
         else:
-            raise FileNotFoundError(f"no plant file or directory {item!r}")
+            raise ConfigError(f"--plants {item}: no such plant file or folder")
+    if not files:
+        raise ConfigError(f"--plants {' '.join(items)}: no plant JSON files there")
     return files
 
 
-def _hinfsyn_gamma(P, nmeas: int, ncon: int, timeout: float) -> float | None:
-    """python-control's full-order ``hinfsyn`` γ in a child process with a time limit
-    (it refuses singular problems and may hang on them); ``None`` when it does not answer."""
+def _hinfsyn_gamma(P, nmeas: int, ncon: int, timeout: float
+                   ) -> tuple[float | None, float | None]:
+    """python-control's full-order ``hinfsyn`` in a child process with a time limit (it
+    refuses singular problems and may hang on them): ``(reported, achieved)``, the γ it
+    reports and the H∞ norm of the closed loop its controller gives (``None`` where that
+    loop is unstable), or ``(None, None)`` when it does not answer.  Only the achieved norm
+    is a fair comparison: on some plants (COMPleib's EB1) the reported γ lies below what the
+    controller achieves and below the true optimum."""
     ctx = multiprocessing.get_context("fork")
     q = ctx.Queue()
 
     def work():
         try:
             import control  # noqa: PLC0415
-            _, _, gam, _ = control.hinfsyn(P, nmeas, ncon)
-            q.put(float(gam))
+            _, cl, gam, _ = control.hinfsyn(P, nmeas, ncon)
+            stable = bool(np.max(np.linalg.eigvals(np.asarray(cl.A)).real) < 0)
+            q.put((float(gam), float(control.norm(cl, "inf")) if stable else None))
         except Exception:  # noqa: BLE001 - any refusal means "not applicable"
-            q.put(None)
+            q.put((None, None))
 
     proc = ctx.Process(target=work)
     proc.start()
@@ -76,11 +97,11 @@ def _hinfsyn_gamma(P, nmeas: int, ncon: int, timeout: float) -> float | None:
         # while slycot's Fortran holds the thread, so terminate() left join() waiting forever
         proc.kill()
         proc.join()
-        return None
+        return None, None
     try:
         return q.get(timeout=1.0)
     except Exception:  # noqa: BLE001
-        return None
+        return None, None
 
 
 def _error(exc: BaseException) -> dict[str, str]:
@@ -128,13 +149,15 @@ def _run_orders(P, nmeas: int, ncon: int, meta: dict, path: Path, orders: list[i
     from ...errors import CasflutterError, SynthesisError  # noqa: PLC0415
 
     gstar = meta.get("gamma_full_order_lmi", meta.get("gamma_lower_bound"))
-    full = _hinfsyn_gamma(P, nmeas, ncon, hinfsyn_timeout) if hinfsyn_timeout > 0 else None
+    reported, full = (_hinfsyn_gamma(P, nmeas, ncon, hinfsyn_timeout) if hinfsyn_timeout > 0
+                      else (None, None))
     nx = int(np.asarray(P.A).shape[0])
     records, previous = [], None
     for order in sorted(orders):
         t0 = time.perf_counter()
         rec: dict[str, Any] = {"plant": meta.get("name", path.stem), "order": order, "nx": nx,
                                "gamma_lower_bound": gstar, "hinfsyn_full_order_gamma": full,
+                               "hinfsyn_reported_gamma": reported,
                                "published_static": meta.get("published_static") or None}
         try:
             res = synthesize(P, nmeas, ncon, order, starts=starts, seed=seed,
@@ -272,29 +295,29 @@ def summarize(records: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def _write(out: Path, records: list[dict[str, Any]]) -> None:
-    tmp = out.with_name(out.name + ".tmp")
-    tmp.write_text(json.dumps({"records": records, "summary": summarize(records)}, indent=1,
-                              default=float))
-    tmp.replace(out)
+    with atomic_file(out, what="--out") as tmp:
+        tmp.write_text(json.dumps({"records": records, "summary": summarize(records)},
+                                  indent=1, default=float))
+
+
+def _orders(text: str) -> list[int]:
+    try:
+        orders = [int(o) for o in str(text).split(",") if o.strip()]
+    except ValueError:
+        orders = []
+    if not orders or any(o < 0 for o in orders):
+        raise ConfigError(f"--orders {text!r}: give comma-separated integers >= 0, e.g. 0,1,2,3")
+    return orders
 
 
 def _handler(args: argparse.Namespace) -> int:
-    orders = [int(o) for o in str(args.orders).split(",") if o.strip()]
-    if any(o < 0 for o in orders):
-        print("casflutter bench synthesis: orders must be >= 0", file=sys.stderr)
-        return 2
-    out = Path(args.out)
-    try:   # fail before any work when the result cannot be written
-        out.parent.mkdir(parents=True, exist_ok=True)
-        _write(out, [])
-    except OSError as exc:
-        print(f"casflutter bench synthesis: cannot write --out {out}: {exc}", file=sys.stderr)
-        return 2
-    try:
-        files = _plant_files(args.plants)
-    except FileNotFoundError as exc:
-        print(f"casflutter bench synthesis: {exc}", file=sys.stderr)
-        return 2
+    orders = _orders(args.orders)
+    for name, value in (("--starts", args.starts), ("--jobs", args.jobs)):
+        if value < 1:     # the lowest order has no previous controller to start from
+            raise ConfigError(f"{name} {value}: give an integer >= 1")
+    files = _plant_files(args.plants)
+    out = check_output_path(args.out, what="--out", suffixes=(".json",))
+    _write(out, [])       # fail before any work when the result cannot be written
     time_limit = args.time_limit if args.time_limit and args.time_limit > 0 else None
     jobs = [(f, orders, args.starts, args.seed, time_limit, args.hinfsyn_timeout,
              max(int(args.relaxation_starts), 0)) for f in files]
@@ -319,6 +342,11 @@ def _handler(args: argparse.Namespace) -> int:
     if broken:
         print(f"casflutter bench synthesis: could not run {', '.join(broken)} (see their "
               "records' error)", file=sys.stderr)
+        return 1
+    missing = [f"{r['plant']} order {r['order']}" for r in records if r["gamma"] is None]
+    if missing:
+        print(f"casflutter bench synthesis: no stabilising controller for {', '.join(missing)} "
+              "(see their records' status)", file=sys.stderr)
         return 1
     return 0
 

@@ -89,7 +89,18 @@ def verdict(report, require_v=None) -> dict:
         sg = report.small_gain_V
         out["small_gain_covers"] = bool(report.stable and sg is not None
                                         and (sg[0] < lo or sg[0] == 0.0) and hi < sg[1])
-    if not report.stable:
+    if not report.stable and report.spectral_abscissa < 0:
+        import numpy as np
+
+        from ...verify._common import rounding_margin
+
+        A = np.asarray(report.closed_loop.A)
+        reason = (f"not stable: the slowest closed-loop pole (real part "
+                  f"{report.spectral_abscissa:.6g}) lies within rounding, "
+                  f"{rounding_margin(A):.3g} = 100 eps ||A_cl||, of the imaginary axis: with "
+                  f"||A_cl|| = {np.linalg.norm(A):.3g} it cannot be told from a pole on the "
+                  "axis (the controller's gains are far too large for the plant)")
+    elif not report.stable:
         reason = (f"not stable: the nominal closed loop has a pole with real part "
                   f"{report.spectral_abscissa:.6g} >= 0")
     elif out["robust"] is False:
