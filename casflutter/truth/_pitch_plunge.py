@@ -6,10 +6,12 @@ The classic two-degree-of-freedom section per unit span (heave ``h`` positive do
     [[m_heave,            m_wing x_alpha b], [h'']      [[c_h, 0      ], [h']
      [m_wing x_alpha b,   I_alpha         ]] [alpha''] + [0,  c_alpha]] [alpha']
 
-      + [[k_h, 0], [0, 0]] [h, alpha] + [0, k_alpha(alpha) alpha] = [-L, M] + flap,
+      + [k_h(h) h, k_alpha(alpha) alpha] = [-L, M] + flap,
 
 with the pitch spring moment ``k_alpha(alpha) alpha = k_1 alpha + k_2 alpha^2 + k_3 alpha^3
-+ ...`` (the list ``k_alpha = [k_1, k_2, ...]``, linear term first).  Two aerodynamic models:
++ ...`` (the list ``k_alpha = [k_1, k_2, ...]``, linear term first) and the heave spring
+force ``k_h(h) h`` likewise (``k_h`` a number for a linear spring, or a list for a hardening
+or softening one).  Two aerodynamic models:
 
 ``aero = "wagner"``
     Theodorsen's non-circulatory (apparent-mass) terms and the circulatory lift through
@@ -41,7 +43,8 @@ eq. 7 is diagonal).
 TOML keys (top level): ``kind = "pitch_plunge"``, ``b`` [m], ``a``, ``rho`` [kg/m^3],
 ``m_heave`` [kg] (everything that moves in heave), ``m_wing`` [kg] (the pitching wing),
 ``x_alpha`` [semichords, centre of mass aft of the elastic axis], ``I_alpha`` [kg m^2 about the
-elastic axis], ``k_h`` [N/m], ``c_h`` [kg/s], ``c_alpha`` [kg m^2/s], ``k_alpha`` [list:
+elastic axis], ``k_h`` [N/m, or a list: N/m, N/m^2, ...], ``c_h`` [kg/s], ``c_alpha``
+[kg m^2/s], ``k_alpha`` [list:
 N m/rad, N m/rad^2, ...], ``aero``; optional ``cl_alpha`` [1/rad] (default ``2 pi``) and the
 tables ``[flap]`` (``cl_beta``, ``cm_beta``), ``[problem]`` (``name``, ``description``,
 ``source``), ``[reference]``, ``[rom]`` (settings of ``casflutter flutter``) and ``[lco]``.
@@ -123,7 +126,8 @@ class PitchPlungeParams:
     m_wing: float = _p("kg", "mass of the pitching wing")
     x_alpha: float = _p("semichords", "centre of mass of the wing aft of the elastic axis")
     I_alpha: float = _p("kg m^2", "pitch inertia of the wing about the elastic axis")
-    k_h: float = _p("N/m", "heave spring")
+    k_h: tuple = _p("N/m^j", "heave spring force k_1 h + k_2 h^2 + ... (linear term first; "
+                    "a number: linear)")
     c_h: float = _p("kg/s", "heave damper")
     c_alpha: float = _p("kg m^2/s", "pitch damper")
     k_alpha: tuple = _p("N m/rad^j", "pitch spring moment k_1 alpha + k_2 alpha^2 + ... "
@@ -134,17 +138,18 @@ class PitchPlungeParams:
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
-            if f.name in ("k_alpha", "aero", "flap"):
+            if f.name in ("k_alpha", "k_h", "aero", "flap"):
                 continue
             object.__setattr__(self, f.name, _number(f.name, getattr(self, f.name)))
-        ka = self.k_alpha
-        if isinstance(ka, (int, float)) and not isinstance(ka, bool):
-            ka = (ka,)
-        if not isinstance(ka, (list, tuple)) or not ka:
-            raise ConfigError(f"rig key 'k_alpha' must be a non-empty list of numbers (linear "
-                              f"term first), got {self.k_alpha!r}")
-        ka = tuple(_number(f"k_alpha[{i}]", v) for i, v in enumerate(ka))
-        object.__setattr__(self, "k_alpha", ka)
+        for key in ("k_alpha", "k_h"):
+            k = getattr(self, key)
+            if isinstance(k, (int, float)) and not isinstance(k, bool):
+                k = (k,)
+            if not isinstance(k, (list, tuple)) or not k:
+                raise ConfigError(f"rig key {key!r} must be a number or a non-empty list of "
+                                  f"numbers (linear term first), got {getattr(self, key)!r}")
+            object.__setattr__(self, key,
+                               tuple(_number(f"{key}[{i}]", v) for i, v in enumerate(k)))
         if self.aero not in _AERO:
             raise ConfigError(f"rig key 'aero' = {self.aero!r} is not allowed; choose one of "
                               f"{', '.join(map(repr, _AERO))}")
@@ -157,8 +162,9 @@ class PitchPlungeParams:
             if not cond:
                 raise ConfigError(f"rig key {key!r} = {getattr(self, key)!r}: {msg}")
 
-        for key in ("b", "rho", "m_heave", "m_wing", "I_alpha", "k_h", "cl_alpha"):
+        for key in ("b", "rho", "m_heave", "m_wing", "I_alpha", "cl_alpha"):
             need(getattr(self, key) > 0, key, "must be positive")
+        need(self.k_h[0] > 0, "k_h", "the linear heave stiffness k_h[0] must be positive")
         need(-1 < self.a < 1, "a", "must lie in (-1, 1) (semichords aft of mid-chord)")
         need(self.c_h >= 0, "c_h", "must be >= 0")
         need(self.c_alpha >= 0, "c_alpha", "must be >= 0")
@@ -229,7 +235,7 @@ class PitchPlungeParams:
 
     def with_sets(self, sets: Iterable[str] = ()) -> "PitchPlungeParams":
         """Apply ``["name=value", ...]`` (the CLI's ``--set``): numbers; ``k_alpha`` as a
-        comma-separated list (``k_alpha=2.82,-62.3``); ``aero=quasi_steady``;
+        comma-separated list (``k_alpha=2.82,-62.3``, ``k_h`` likewise); ``aero=quasi_steady``;
         ``flap.cl_beta=3.4`` / ``flap.cm_beta=-0.6``.
 
         Raises
@@ -251,9 +257,10 @@ class PitchPlungeParams:
                 flap = dict(flap or {})
                 flap[key] = _parse_number(name, value)
                 continue
-            if name == "k_alpha":
+            if name in ("k_alpha", "k_h"):
                 parts = [v for v in value.strip("[]").split(",") if v.strip()]
-                changes[name] = tuple(_parse_number(f"k_alpha[{i}]", v) for i, v in enumerate(parts))
+                changes[name] = tuple(_parse_number(f"{name}[{i}]", v)
+                                      for i, v in enumerate(parts))
             elif name == "aero":
                 changes[name] = value.strip("'\"")
             elif name in self.parameter_names() and name != "flap":
@@ -285,6 +292,17 @@ class PitchPlungeParams:
     def cm_alpha(self) -> float:
         """Moment-curve slope about the elastic axis, ``(1/2 + a) cl_alpha``."""
         return (0.5 + self.a) * self.cl_alpha
+
+
+def _higher_terms(k: tuple, z):
+    """``k_2 z^2 + k_3 z^3 + ...`` of a spring polynomial (linear term first; zero when it
+    has none), by Horner's rule (``z`` a number or a CasADi symbol)."""
+    if len(k) < 2:
+        return 0.0 * z
+    acc = k[-1]
+    for c in reversed(k[1:-1]):
+        acc = c + z * acc
+    return z * z * acc
 
 
 def _parse_number(name: str, value: str) -> float:
@@ -383,7 +401,7 @@ class PitchPlungeSection(AirspeedMixin, AeroelasticTruth):
         p = self.params
         S = p.m_wing * p.x_alpha * p.b
         M = np.array([[p.m_heave, S], [S, p.I_alpha]]) / p.m_heave
-        K = np.diag([p.k_h, p.k_alpha[0]]) / p.m_heave
+        K = np.diag([p.k_h[0], p.k_alpha[0]]) / p.m_heave
         return M, K
 
     def damping_matrix(self) -> np.ndarray:
@@ -399,15 +417,11 @@ class PitchPlungeSection(AirspeedMixin, AeroelasticTruth):
         return np.diag(self._modal_damping()) / (2.0 * self._omega)
 
     def _nonlinear_force(self, x):
-        k = self.params.k_alpha
-        if len(k) < 2 or not any(k[1:]):
+        p = self.params
+        if not any(p.k_alpha[1:]) and not any(p.k_h[1:]):
             return None
-        al = x[1]
-        acc = k[-1]
-        for c in reversed(k[1:-1]):
-            acc = c + al * acc
-        moment = al * al * acc  # k_2 alpha^2 + k_3 alpha^3 + ...
-        return np.array([0.0 * al, moment / self.params.m_heave])
+        return np.array([_higher_terms(p.k_h, x[0]), _higher_terms(p.k_alpha, x[1])]) \
+            / p.m_heave
 
     def aero_matrices(self, V: float) -> AeroMatrices:
         """Per-unit-span aerodynamics at airspeed ``U = V`` divided by ``m_heave``."""

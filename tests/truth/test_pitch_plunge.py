@@ -165,7 +165,7 @@ def test_vector_field_matches_the_simulators_rhs():
 
 def test_sets_apply_to_the_file_values():
     m = load_problem("nata", ["k_h=3000", "k_alpha=3.0,-60", "flap.cl_beta=3.0"])
-    assert m.params.k_h == 3000 and m.params.k_alpha == (3.0, -60.0)
+    assert m.params.k_h == (3000.0,) and m.params.k_alpha == (3.0, -60.0)
     assert m.params.flap.cl_beta == 3.0 and m.params.flap.cm_beta == CMB
     with pytest.raises(ConfigError, match="unknown parameter 'kh'.*k_h"):
         load_problem("nata", ["kh=1"])
@@ -248,7 +248,7 @@ def test_cli_problems_and_flutter_take_a_file(capsys, tmp_path):
     assert main(["problems", str(path), "--json"]) == 0
     info = json.loads(capsys.readouterr().out)
     rows = {r["name"]: r for r in info[0]["parameters"]}
-    assert info[0]["name"] == "nata" and rows["k_h"]["value"] == KH
+    assert info[0]["name"] == "nata" and rows["k_h"]["value"] == [KH]
     assert main(["problems"]) == 0
     assert "nata  (PitchPlungeSection)" in capsys.readouterr().out
     assert main(["flutter", str(path), "--no-parametric", "--figure", "none", "--json"]) == 0
