@@ -257,3 +257,20 @@ def test_cli_problems_and_flutter_take_a_file(capsys, tmp_path):
     assert doc["truth"]["V_flutter"] == pytest.approx(U, rel=1e-6)
     assert doc["units"]["V_flutter"] == "m/s"
     assert doc["rom"]["V_flutter"] == pytest.approx(U, rel=0.06)
+
+
+def test_a_rig_file_without_rom_settings_gets_the_truths_flutter(capsys, tmp_path):
+    """No [rom] table: `casflutter flutter` gives the truth's own flutter speed (checked
+    against the flutter determinant written out by hand), not a demand for chirp settings;
+    --truth-only does the same for a problem that has them."""
+    d = {k: v for k, v in BASE.items() if k not in ("reference", "rom", "lco")}
+    path = _write(tmp_path, _toml(d))
+    U, _ = nata_flutter_determinant(12.0, 12.0)
+    for args in (["flutter", str(path), "--vrange", "2", "25", "--json"],
+                 ["flutter", "nata", "--truth-only", "--vrange", "2", "25", "--json"]):
+        assert main(args) == 0
+        doc = json.loads(capsys.readouterr().out)
+        assert doc["truth"]["V_flutter"] == pytest.approx(U, rel=1e-6)
+        assert doc["rom"] is None and doc["note"].startswith("the truth only")
+    assert main(["flutter", str(path)]) == 1
+    assert "--vrange" in capsys.readouterr().err

@@ -52,6 +52,10 @@ def register(subparsers) -> None:
                         "its lags follow the reduced frequency, as strip theory's do)")
     p.add_argument("--no-parametric", action="store_true",
                    help="skip the parametric ROM (its block is then null)")
+    p.add_argument("--truth-only", action="store_true",
+                   help="only the truth's flutter and divergence speeds, from the eigenvalues "
+                        "of its linearisation (no records, no ROM); the default for a rig "
+                        "file without a [rom] table")
     p.add_argument("--figure", default=None, metavar="PATH",
                    help="save the V-g/V-f figure to PATH (.png, .pdf, .svg ...; checked "
                         "before the work); default: no figure")
@@ -140,28 +144,32 @@ def summarize(result, problem: str) -> dict:
     }
 
 
-def _figure(result, path: str, omega_max: float) -> None:
-    """The V-g / V-f panels of the truth and the ROMs in the units of the printed table: the
-    problem's speed (m/s where it has a speed scale, with the speed index on a second axis;
-    else the speed index) and the table's frequency unit; one legend, the modes numbered
-    from 1 and named."""
+def _panels(result) -> list:
+    """``(title, FlutterResult)`` of the truth and the ROMs of a run."""
+    rom = ("ROM at V0 (time scaled with V)" if result.config.rom.convective
+           else "ROM at V0 (V² scaling)")
+    panels = [("truth", result.flutter_truth), (rom, result.flutter)]
+    if result.parametric is not None:
+        panels.append(("parametric ROM", result.parametric.flutter))
+    return panels
+
+
+def _figure(truth, panels: list, path: str, omega_max: float) -> None:
+    """The V-g / V-f panels (``(title, FlutterResult)``) in the units of the printed table:
+    the problem's speed (m/s where it has a speed scale, with the speed index on a second
+    axis; else the speed index) and the table's frequency unit; one legend, the modes
+    numbered from 1 and named."""
     import matplotlib.pyplot as plt
     import numpy as np
 
     from ...lco import speed_convention
     from ...report import frequency_unit, plot_vg_vf
 
-    truth = result.truth
     ms = truth.modal_structure()
     scale, unit = speed_convention(truth)
     index = f"speed index {ms.speed_index.split(',')[0]}"      # the definition, not its terms
     airspeed = unit == "m/s"
     funit = frequency_unit(ms.time_unit) or "rad/s"       # the table's unit
-    rom = ("ROM at V0 (time scaled with V)" if result.config.rom.convective
-           else "ROM at V0 (V² scaling)")
-    panels = [("truth", result.flutter_truth), (rom, result.flutter)]
-    if result.parametric is not None:
-        panels.append(("parametric ROM", result.parametric.flutter))
     fig, axes = plt.subplots(2, len(panels), sharex=True, figsize=(5.0 * len(panels), 7.0),
                              squeeze=False)
     legend = {}
@@ -188,6 +196,59 @@ def _figure(result, path: str, omega_max: float) -> None:
     fig.tight_layout(rect=(0, 0.03 * (1 + (len(legend) - 1) // 4), 1, 1))
     save_figure(fig, path, dpi=110)
     plt.close(fig)
+
+
+def _without_rom_route(problem: str) -> bool:
+    """A problem file (not a built-in problem) without a ``[rom]`` table: no ROM route."""
+    from ...truth import problem_definition, problem_names
+
+    return problem not in problem_names() and "rom" not in problem_definition(problem)
+
+
+def _run_truth_only(args, truth, label: str, fig_path) -> int:
+    """The truth's own flutter and divergence speeds (``--truth-only``, or a problem file
+    without ``[rom]`` settings): eigenvalues of its linearisation over the range."""
+    from ...aeroelastic import find_flutter
+    from ...errors import ConfigError
+    from ...lco import default_vrange
+
+    to_unit, from_unit, vunit = _speed_conv(truth)
+    fscale, funit = _freq_unit(truth)
+    if args.vrange is not None:
+        lo, hi = (from_unit(v) for v in args.vrange)
+    else:
+        try:
+            lo, hi = default_vrange(truth)
+        except ConfigError:
+            raise ConfigError(f"{label}: no speed range for the truth's flutter; give --vrange "
+                              "LO HI (or [lco] vrange in the problem file)") from None
+    if not 0 <= lo < hi:
+        raise ConfigError(f"--vrange: need 0 <= LO < HI, got {to_unit(lo):g} {to_unit(hi):g}")
+    res = find_flutter(truth, (lo, hi))
+    route = ("--truth-only" if args.truth_only else
+             "the problem file has no [rom] table (V0, V_range, dt, duration, band) for the "
+             "ROM route")
+    doc = {"problem": label, "truth": _block(res, truth, to_unit, fscale), "rom": None,
+           "parametric_rom": None, "frozen_aero_truth": None,
+           "units": {"V_flutter": vunit, "V_divergence": vunit, "omega_flutter": funit,
+                     "V_range": vunit, "speed_index": truth.modal_structure().speed_index},
+           "V_range": [to_unit(lo), to_unit(hi)],
+           "warnings": [] if res.Vf is not None or res.divergence is not None else
+           [f"truth: {res.message}"],
+           "note": f"the truth only: {route}", "figure": fig_path}
+    if fig_path is not None:
+        _figure(truth, [("truth", res)], fig_path, float(truth.modal_structure().omega.max()))
+    if args.json:
+        print_json(doc)
+        return 0
+    b = doc["truth"]
+    vu = "m/s" if vunit == "m/s" else "index"
+    print(f"{label}: flutter speed ({vunit}), frequency ({funit}); {doc['note']}")
+    print(f"  {'':8} {f'V_flutter [{vu}]':>18} {'omega_flutter':>14} {'mode':>12} "
+          f"{f'V_divergence [{vu}]':>20}")
+    print(f"  {'truth':8} {_fmt(b['V_flutter']):>18} {_fmt(b['omega_flutter']):>14} "
+          f"{str(b['mode']):>12} {_fmt(b['V_divergence']):>20}")
+    return print_notes(doc)
 
 
 def _fmt(x, unit="") -> str:
@@ -341,6 +402,8 @@ def run(args) -> int:
     from ...pipeline import flutter_config, run as run_config
 
     label = problem_label(args.problem)
+    if args.truth_only or _without_rom_route(args.problem):
+        return _run_truth_only(args, truth, label, fig_path)
     _, from_unit, vunit = _speed_conv(truth)
     updates = {"problem.set": changes}
     if args.vrange is not None:
@@ -357,7 +420,7 @@ def run(args) -> int:
     doc = summarize(result, label)
     doc["figure"] = fig_path
     if fig_path is not None:
-        _figure(result, fig_path, float(truth.modal_structure().omega.max()))
+        _figure(truth, _panels(result), fig_path, float(truth.modal_structure().omega.max()))
     if args.json:
         print_json(doc)
         return 0
