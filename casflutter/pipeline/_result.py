@@ -382,6 +382,17 @@ class RunResult:
         """``(Vf_rom - Vf_truth) / Vf_truth``."""
         return _rel(self.Vf, self.Vf_truth)
 
+    def divergence_errors(self) -> dict:
+        """``(Vd - Vd_truth) / Vd_truth`` of the ROM (``"rom"``) and the parametric ROM
+        (``"parametric_rom"``), each ``None`` where either has no divergence in the range."""
+        def vd(res):
+            return None if res is None or res.divergence is None else res.divergence.V
+
+        truth = vd(self.flutter_truth)
+        parametric = None if self.parametric is None else self.parametric.flutter
+        return {"rom": _rel(vd(self.flutter), truth),
+                "parametric_rom": _rel(vd(parametric), truth)}
+
     @property
     def scaling_error(self) -> float | None:
         """``(Vf_frozen - Vf_truth) / Vf_truth``: the error the V² scaling alone causes."""
@@ -433,14 +444,20 @@ class RunResult:
                          f"would stand for the truth with its aerodynamics frozen at V0, "
                          f"which flutters at {pct(self.scaling_error)}.")
         elif self.flutter_frozen is not None:
-            text += (f" The V² scaling of ΣAE freezes the aerodynamic time scale (reduced "
-                     f"frequency, Wagner lag rates, apparent mass and damping) at V0; the truth "
+            text += (f" The V² scaling of ΣAE freezes the aerodynamic time scale (the "
+                     f"reduced frequency: the aerodynamic damping, and any lag or apparent-mass "
+                     f"terms) at V0; the truth "
                      f"with its aerodynamics frozen at V0 flutters at "
                      f"{pct(self.scaling_error)}, so the scaling explains the error up to "
                      f"{pct(self.identification_error)} from identification and Tustin.")
         if self.parametric is not None:
             text += (f" Parametric ROM ({len(self.parametric.rom.speeds)} speeds): "
                      f"{pct(self.parametric_error)}.")
+        dv = self.divergence_errors()
+        if self.flutter_truth is not None and self.flutter_truth.divergence is not None:
+            text += (f" Divergence speed error vs the truth's: ROM {pct(dv['rom'])}"
+                     + (f", parametric ROM {pct(dv['parametric_rom'])}"
+                        if self.parametric is not None else "") + ".")
         return text
 
     def skipped_notes(self) -> list[str]:

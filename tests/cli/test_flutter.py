@@ -113,3 +113,21 @@ def test_convective_rom_lands_on_the_truth(capsys):
     assert rc == 0 and "scaled" in capsys.readouterr().out
     assert main(["flutter", "problems/goland_gaf", "--convective"]) == 1
     assert "already scale" in capsys.readouterr().err
+
+
+def test_a_diverging_rig_reports_the_roms_divergence_errors(capsys):
+    """NATA with its elastic axis at mid-chord diverges (no flutter) at
+    U_d = sqrt(k_1 / (rho b^2 (1/2 + a) cl_alpha)); the ROMs' divergence speeds are compared
+    with the truth's in relative_errors and the explanation (flutter errors are n/a)."""
+    assert main(["flutter", "nata", "--set", "a=0", "--set", "I_alpha=0.06", "--vrange", "1",
+                 "60", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    Ud = (2.82 / (1.225 * 0.135 ** 2 * 0.5 * 6.28)) ** 0.5
+    assert doc["truth"]["V_flutter"] is None
+    assert doc["truth"]["V_divergence"] == pytest.approx(Ud, rel=1e-6)
+    err = doc["relative_errors"]
+    rom_vd = doc["rom"]["V_divergence"]
+    assert err["rom_divergence"] == pytest.approx(rom_vd / doc["truth"]["V_divergence"] - 1,
+                                                  abs=1e-12)
+    assert "parametric_rom_divergence" in err
+    assert "Divergence speed error vs the truth's: ROM" in doc["explanation"]

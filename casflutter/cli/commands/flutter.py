@@ -137,7 +137,9 @@ def summarize(result, problem: str) -> dict:
         "relative_errors": {"rom": err(result.rom_error),
                             "rom_vs_frozen": err(result.identification_error),
                             "v2_scaling": err(result.scaling_error),
-                            "parametric_rom": err(result.parametric_error)},
+                            "parametric_rom": err(result.parametric_error),
+                            **{f"{k}_divergence": err(v)
+                               for k, v in result.divergence_errors().items()}},
         "explanation": result.explanation(),
         "timings": {k: float(v) for k, v in result.timings.items()},
         "warnings": warn,
