@@ -351,3 +351,28 @@ def test_zero_start_stabilises_a_plant_with_nearly_defective_eigenvalues():
     Dk = np.asarray(res.controller.D)
     p = partition(P, nmeas, ncon)
     assert np.max(np.linalg.eigvals(p.A + p.B2 @ Dk @ p.C2).real) < 0
+
+
+def test_a_double_integrator_designs_without_floating_point_warnings():
+    """Order 1 on a double integrator (position measured, force input; a classic regular
+    H∞ problem): far-left eigenvalue cuts with gradients past 1e154 once overflowed the
+    curvature's norm and printed numpy warnings.  Truth: the closed loop built here is
+    stable (numpy) and its norm (python-control) is the γ reported."""
+    import warnings
+
+    import control
+
+    P = control.ss([[0.0, 1.0], [0.0, 0.0]], [[0.0, 0.0, 0.0], [1.0, 0.0, 1.0]],
+                   [[1.0, 0.0], [0.0, 0.0], [1.0, 0.0]],
+                   [[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        res = synthesize(P, 1, 1, 1, starts=2, seed=0)
+    p, K = partition(P, 1, 1), res.controller
+    Ak, Bk, Ck, Dk = (np.asarray(M, float) for M in (K.A, K.B, K.C, K.D))
+    cl = control.ss(np.block([[p.A + p.B2 @ Dk @ p.C2, p.B2 @ Ck], [Bk @ p.C2, Ak]]),
+                    np.vstack([p.B1 + p.B2 @ Dk @ p.D21, Bk @ p.D21]),
+                    np.hstack([p.C1 + p.D12 @ Dk @ p.C2, p.D12 @ Ck]),
+                    p.D11 + p.D12 @ Dk @ p.D21)
+    assert res.success and np.max(np.linalg.eigvals(cl.A).real) < 0
+    assert res.gamma == pytest.approx(float(control.norm(cl, "inf")), rel=1e-6)
