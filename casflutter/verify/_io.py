@@ -6,8 +6,9 @@ Plant file (casflutter format)::
      "nmeas": 2, "ncon": 1, "Vf": 1.2, "n_delta": 2, "name": "..."}
 
 COMPleib plant files (keys ``A, B1, B, C1, D11, D12, C, D21, D22``, as in
-``problems/compleib``) are also read: ``P = [[A, [B1 B]], [[C1; C], [[D11 D12]; [D21 D22]]]]``
-with ``nmeas = ny`` and ``ncon = nu``.
+``problems/compleib``; ``B2`` and ``C2`` are read for ``B`` and ``C``) are also read:
+``P = [[A, [B1 B]], [[C1; C], [[D11 D12]; [D21 D22]]]]`` with ``nmeas = ny`` and
+``ncon = nu``.
 
 Controller file: ``{"A", "B", "C", "D"}``; ``A``, ``B``, ``C`` may be omitted (or empty)
 for a static gain ``D``.  Matrices with a zero dimension are stored with their shape
@@ -180,6 +181,8 @@ def plant_from_json(d: dict) -> PlantData:
         raise DataError(f"a plant file must hold a JSON object, got {type(d).__name__}")
     name = d.get("name")
     if "B1" in d:
+        # B2 / C2 are the names some COMPleib exports use for B / C (as load_compleib reads)
+        d = {**{k: d[k + "2"] for k in ("B", "C") if k not in d and k + "2" in d}, **d}
         missing = [k for k in _COMPLEIB_KEYS if k not in d]
         if missing:
             raise DataError(f"COMPleib plant {name!r}: keys {missing} are missing")

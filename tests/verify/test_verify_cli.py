@@ -50,6 +50,16 @@ def test_compleib_plant_is_partitioned_from_the_file():
     assert_allclose(np.asarray(pd_.sys.D)[:raw["nz"], :raw["nw"]], raw["D11"])
 
 
+def test_compleib_plant_with_b2_c2_keys_is_the_same_plant(tmp_path):
+    """Some COMPleib exports name B and C as B2 and C2 (load_compleib reads both)."""
+    raw = json.loads((DATA / "AC4.json").read_text())
+    raw["B2"], raw["C2"] = raw.pop("B"), raw.pop("C")
+    (tmp_path / "AC4.json").write_text(json.dumps(raw))
+    a, b = load_plant(DATA / "AC4.json").sys, load_plant(tmp_path / "AC4.json").sys
+    for x, y in zip((a.A, a.B, a.C, a.D), (b.A, b.B, b.C, b.D)):
+        assert_allclose(np.asarray(y), np.asarray(x), rtol=0, atol=0)
+
+
 def test_cli_on_compleib_plant_json_output(tmp_path, capsys):
     pd_ = load_plant(DATA / "AC4.json")
     A, B, C = (np.asarray(M) for M in (pd_.sys.A, pd_.sys.B, pd_.sys.C))
