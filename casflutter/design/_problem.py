@@ -64,23 +64,17 @@ def _io_scales(parts: Sequence[Partition]) -> tuple[np.ndarray, np.ndarray]:
         lo, hi = (float(np.min(small)), big) if small.size else (1.0, 1.0)
         w = np.geomspace(0.5 * lo, 2.0 * hi, 24)
         n = P.nx
-        T = _balance(P)                  # the balanced realisation: rounding is even there
-        Ab = P.A * (1.0 / np.diag(T))[:, None] * np.diag(T)[None, :]
-        B2b, C2b = P.B2 / np.diag(T)[:, None], P.C2 * np.diag(T)[None, :]
-        M = 1j * w[:, None, None] * np.eye(n)[None] - Ab[None]
+        M = 1j * w[:, None, None] * np.eye(n)[None] - P.A[None]
         try:
-            X = np.linalg.solve(M, np.broadcast_to(B2b.astype(complex), (w.size,) + B2b.shape))
+            X = np.linalg.solve(M, np.broadcast_to(P.B2.astype(complex), (w.size,) + P.B2.shape))
         except np.linalg.LinAlgError:
             continue
+        G = np.abs(P.C2[None] @ X + P.D22[None])
         # an entry with no path from its control to its measurement (from the sparsity, or
         # at the rounding level of the solve at every frequency) is a zero, whatever
         # rounding leaves in it: scaled to one it would make that measurement's gains
         # astronomically large
-        G = np.abs(C2b[None] @ X + P.D22[None])
-        floor = 1e3 * np.finfo(float).eps * (
-            np.linalg.norm(C2b, axis=1)[None, :, None] * np.linalg.norm(X, axis=1)[:, None, :]
-            + np.abs(P.D22)[None])
-        samples.append(np.where(_paths(P) & np.any(G > floor, axis=0), G, 0.0))
+        samples.append(np.where(_paths(P) & _above_rounding(P, w), G, 0.0))
     if not samples:
         return np.ones(nu), np.ones(ny)
     S = np.concatenate(samples, axis=0)
@@ -101,6 +95,25 @@ def _io_scales(parts: Sequence[Partition]) -> tuple[np.ndarray, np.ndarray]:
     su = np.exp(np.clip(lc, -200, 200))
     sy = np.exp(np.clip(-lr, -200, 200))
     return su, sy
+
+
+def _above_rounding(P: Partition, w: np.ndarray) -> np.ndarray:
+    """``(ny, nu)``: whether ``|G22_ij(jω)|`` rises above the rounding level of its solve,
+    ``1e3 eps |C2_i| |X_j|``, at one frequency of ``w`` at least (computed in the balanced
+    realisation, where rounding is even over the states)."""
+    t = np.diag(_balance(P))
+    Ab = P.A / t[:, None] * t[None, :]
+    B2b, C2b = P.B2 / t[:, None], P.C2 * t[None, :]
+    M = 1j * w[:, None, None] * np.eye(P.nx)[None] - Ab[None]
+    try:
+        X = np.linalg.solve(M, np.broadcast_to(B2b.astype(complex), (w.size,) + B2b.shape))
+    except np.linalg.LinAlgError:
+        return np.ones(P.D22.shape, bool)
+    G = np.abs(C2b[None] @ X + P.D22[None])
+    floor = 1e3 * np.finfo(float).eps * (
+        np.linalg.norm(C2b, axis=1)[None, :, None] * np.linalg.norm(X, axis=1)[:, None, :]
+        + np.abs(P.D22)[None])
+    return np.any(G > floor, axis=0)
 
 
 def _paths(P: Partition) -> np.ndarray:
