@@ -268,11 +268,19 @@ def flutter_sensitivity(problem: str = "typical_section",
 
     params = dict(params or {})
     model = _parametric_truth(problem, params)
-    names = list(parameters) if parameters else model.params.parameter_names()
-    valid = model.params.parameter_names()
+    # the numbers are differentiated; lists (a rig's spring polynomials), words and tables
+    # stay as the problem has them
+    valid = [n for n in model.params.parameter_names()
+             if isinstance(getattr(model.params, n), (int, float))
+             and not isinstance(getattr(model.params, n), bool)]
+    names = list(parameters) if parameters else valid
     bad = [n for n in names if n not in valid]
     if bad:
-        raise ConfigError(f"unknown parameter(s) {bad} of {problem!r}; valid: {', '.join(valid)}")
+        others = [n for n in bad if n in model.params.parameter_names()]
+        why = (f" ({', '.join(others)}: not a single number; change it with --set and compare "
+               "the flutter speeds)" if others else "")
+        raise ConfigError(f"unknown parameter(s) {bad} of {problem!r}{why}; valid: "
+                          f"{', '.join(valid)}")
     nominal = {n: getattr(model.params, n) for n in valid}
     res = find_flutter(model.state_matrix, V_range, n_grid=n_grid,
                        omega=model.modal_structure().omega)

@@ -85,3 +85,19 @@ def test_goland_sensitivity_matches_finite_differences(name):
     s = flutter_sensitivity("goland", [name], V_range=(0.5, 3.0), n_grid=61)
     fd = flutter_speed_fd("goland", name, V_range=(0.5, 3.0), n_grid=61)
     np.testing.assert_allclose(s[name].dVf_dp, fd, rtol=1e-5, atol=1e-7)
+
+
+def test_a_rig_files_numbers_are_differentiated_and_its_lists_left_alone():
+    """The NATA rig file: its spring polynomials (lists), aerodynamics (a word) and flap
+    (a table) stay as the file has them; the numbers' sensitivities agree with finite
+    differences of the refined flutter speed itself."""
+    from casflutter.errors import ConfigError
+
+    s = flutter_sensitivity("nata", V_range=(2.0, 25.0))
+    by = {x.name: x for x in s.sensitivities}
+    assert {"k_alpha", "k_h", "aero", "flap"}.isdisjoint(by) and {"rho", "c_alpha"} <= set(by)
+    for n in ("rho", "c_alpha"):
+        fd = flutter_speed_fd("nata", n, V_range=(2.0, 25.0))
+        assert by[n].dVf_dp == pytest.approx(fd, rel=1e-4)
+    with pytest.raises(ConfigError, match="k_alpha: not a single number"):
+        flutter_sensitivity("nata", ["k_alpha"], V_range=(2.0, 25.0))
