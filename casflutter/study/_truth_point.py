@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any, Mapping
 
 from ..errors import ConfigError
@@ -11,7 +12,7 @@ __all__ = ["TRUTH_OPTIONS", "load_truth"]
 
 #: Options of the truth evaluators (``truth_flutter``, ``truth_hopf``) besides the parameters.
 TRUTH_OPTIONS = {
-    "problem": "truth problem name (casflutter problems)",
+    "problem": "truth problem name (casflutter problems) or a rig file (kind = pitch_plunge)",
     "V_min": "lowest speed index of the flutter search (default 0.02)",
     "V_max": "highest speed index of the flutter search (default 4.0)",
     "n_grid": "grid points of the eigenvalue tracking (default 81)",
@@ -47,11 +48,20 @@ def load_truth(params: Mapping[str, Any], settings: Mapping[str, Any] | None = N
         Unknown problem, or a name that is neither a parameter nor an option.
     """
     merged = {**(settings or {}), **params}
-    merged.pop("_base_dir", None)
+    base = merged.pop("_base_dir", None)
     name = str(merged.pop("problem", "typical_section"))
-    if name not in PROBLEMS:
-        raise ConfigError(f"unknown problem {name!r}; available: {', '.join(PROBLEMS)}")
-    valid = PROBLEMS[name].Params.parameter_names()
+    if name in PROBLEMS:
+        valid = PROBLEMS[name].Params.parameter_names()
+    else:                       # a problem file (a rig section), beside the study file
+        path = Path(name)
+        if not path.is_absolute() and base is not None and (Path(base) / path).is_file():
+            name = str(Path(base) / path)
+        try:
+            valid = load_problem(name).params.parameter_names()
+        except (ConfigError, AttributeError):
+            raise ConfigError(f"unknown problem {name!r}: give one of {', '.join(PROBLEMS)} "
+                              "or a problem file with simulator parameters (kind = "
+                              "\"pitch_plunge\", e.g. \"nata\")") from None
     truth_params = {k: v for k, v in merged.items() if k in valid}
     options = {k: v for k, v in merged.items() if k not in valid}
     allowed = list(TRUTH_OPTIONS) + list(extra_options)

@@ -174,7 +174,8 @@ class PitchPlungeParams:
              "the linear pitch stiffness k_alpha[0] must be positive")
         # I_alpha = I_cg + m_wing (x_alpha b)^2 about the elastic axis (parallel axes); with
         # m_wing <= m_heave it also makes the mass matrix positive definite
-        offset = self.m_wing * (self.x_alpha * self.b) ** 2
+        xb = self.x_alpha * self.b
+        offset = self.m_wing * xb * xb         # (not **: a huge value gives inf, not an error)
         need(self.I_alpha > offset, "I_alpha",
              f"below m_wing (x_alpha b)^2 = {offset:g} kg m^2, the inertia of the wing's mass "
              f"about the elastic axis alone (parallel axes, x_alpha = {self.x_alpha:g}, b = "

@@ -305,3 +305,19 @@ def test_output_named_like_a_column_does_not_hide_the_point_status(tmp_path):
     rows = {r["x"]: r for r in sweep_table(st, res.store)}
     assert rows[1.0]["status"] == "ok" and rows[1.0]["out_status"] == "flutter"
     assert rows[1.0]["out_x"] == -1 and rows[2.0]["status"] == "failed"
+
+
+def test_a_sweep_point_takes_a_rig_file(tmp_path):
+    """A study's problem may be a rig file (by name, or a path beside the study file):
+    its parameters are swept like a built-in problem's."""
+    from casflutter._resources import problems_dir
+    from casflutter.errors import ConfigError
+    from casflutter.study._truth_point import load_truth
+
+    truth, options = load_truth({"c_h": 0.0}, {"problem": "nata", "V_min": 1.0})
+    assert truth.params.c_h == 0.0 and options == {"V_min": 1.0}
+    (tmp_path / "rig.toml").write_text((problems_dir() / "nata" / "problem.toml").read_text())
+    truth, _ = load_truth({"rho": 1.0}, {"problem": "rig.toml", "_base_dir": str(tmp_path)})
+    assert truth.params.rho == 1.0 and truth.params.k_alpha[0] == 2.82
+    with pytest.raises(ConfigError, match="unknown problem 'nope.toml'"):
+        load_truth({}, {"problem": "nope.toml", "_base_dir": str(tmp_path)})

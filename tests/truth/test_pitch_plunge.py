@@ -212,6 +212,7 @@ def _toml(d):
     ({"lco": {"vrange": "4-16"}}, "\\[lco\\] vrange.*\\[low, high\\]"),
     ({"lco": {"vrange": [16.0, 4.0]}}, "\\[lco\\] vrange.*low < high"),
     ({"lco": {"npoints": 7}}, "unknown key.*'npoints' in \\[lco\\]"),
+    ({"set": ("b", 1e300)}, "'I_alpha'.*= inf kg m\\^2.*check I_alpha, x_alpha and b"),
     ({"set": ("m_wing", 20.0)}, "'m_wing'.*m_heave"),
     ({"set": ("c_h", "soft")}, "'c_h'.*number"),
     ({"flap": {"cl_beta": 3.0}}, "missing key.*'cm_beta'"),
