@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import logging
 import time
+import warnings
 from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
@@ -58,7 +59,7 @@ from .._threads import deterministic, single_threaded
 from ..aeroelastic import (AeroelasticSystem, FlutterResult, find_flutter, load_family,
                           simulate_loop)
 from ..data import envelope_growth_rate
-from ..errors import CasflutterError, ConfigError, ConvergenceError
+from ..errors import CasflutterError, ConfigError, ConvergenceError, DataWarning
 from ..lco import (LCOSettings, compare_lco, lco_branch, rom_lco_branch, rom_loop_flutter,
                    speed_convention)
 from ..realize import realize
@@ -184,10 +185,24 @@ def _stage_names(cfg: RunConfig, route: Route, skipped) -> list[str]:
     return names
 
 
+#: damping coupling (:meth:`AeroelasticTruth.damping_coupling`) above which the ROM's
+#: diagonal Σs is said to leave part of the truth's damping out
+_COUPLED_DAMPING = 0.05
+
+
 def _structure(cfg: RunConfig, problem):
     """Σs with the run's sensors (``None`` for a family file)."""
     if not callable(getattr(problem, "modal_structure", None)):
         return None
+    coupling = problem.damping_coupling() if callable(
+        getattr(problem, "damping_coupling", None)) else 0.0
+    if coupling > _COUPLED_DAMPING:
+        warnings.warn(
+            f"the structural dampers of {getattr(problem, 'name', 'the problem')!r} couple its "
+            f"modes (modal damping off the diagonal up to {100 * coupling:.3g} % of the "
+            "diagonal), and the ROM's Σs (eq. 7) keeps only the diagonal: the ROM's flutter "
+            "speed can differ from the truth's by some per cent, on either side (compare the "
+            "two in the flutter table)", DataWarning, stacklevel=2)
     return problem.modal_structure().with_sensors(cfg.sensors.rows or None, cfg.sensors.kind)
 
 

@@ -204,6 +204,23 @@ class AeroelasticTruth(ModalStates, abc.ABC):
         """Number of structural modes ``N``."""
         return int(self._omega.size)
 
+    def damping_coupling(self) -> float:
+        """How strongly the structural damping couples the modes: the largest
+        ``|D_ij| / sqrt(D_ii D_jj)`` (``i != j``) of the modal damping matrix ``D``; 0 for
+        modal damping, which Σs (eq. 7, diagonal) holds exactly.
+
+        Returns
+        -------
+        float
+        """
+        D = self._modal_damping()
+        d = np.sqrt(np.abs(np.diag(D)))
+        off = np.abs(D - np.diag(np.diag(D)))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(off > 0, off / np.outer(d, d), 0.0)
+        ratio = np.where(np.isfinite(ratio), ratio, np.inf)
+        return float(np.max(ratio, initial=0.0))
+
     def modal_structure(self) -> ModalStructure:
         """Σs of the truth (eq. 6-7): frequencies, damping, flow constant, mode shapes, the
         problem's sensor rows (read as displacements unless the problem says otherwise) and
