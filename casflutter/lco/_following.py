@@ -95,9 +95,24 @@ class LcoComparison:
         return np.asarray(self.rom.sensors.amplitude, dtype=float)
 
     @property
+    def comparable(self) -> bool:
+        """Whether both responses are limit cycles (a diverging or decaying response has no
+        amplitude to compare)."""
+        return self.rom.sensors.kind == "lco" and self.truth.kind == "lco"
+
+    @property
     def amplitude_error_percent(self) -> np.ndarray:
-        """``100 (rom / truth − 1)`` per sensor."""
+        """``100 (rom / truth − 1)`` per sensor; NaN unless both are limit cycles."""
+        if not self.comparable:
+            return np.full(self.rom_amplitude.shape, np.nan)
         return 100.0 * (self.rom_amplitude / np.asarray(self.truth.amplitude, float) - 1.0)
+
+    def describe_error(self) -> str:
+        """``"+3.1 %, -2.0 %"`` per sensor, or what the two responses are when they are not
+        both limit cycles (``"ROM divergence, truth lco"``)."""
+        if not self.comparable:
+            return f"ROM {self.rom.sensors.kind}, truth {self.truth.kind}: no amplitudes to compare"
+        return ", ".join(f"{e:+.1f} %" for e in self.amplitude_error_percent)
 
     def record(self) -> dict:
         """Plain numbers (``summary.json``).
@@ -113,7 +128,8 @@ class LcoComparison:
                 "rom_kind": self.rom.sensors.kind, "truth_kind": self.truth.kind,
                 "rom_amplitude": self.rom_amplitude.tolist(),
                 "truth_amplitude": list(self.truth.amplitude),
-                "amplitude_error_percent": self.amplitude_error_percent.tolist(),
+                "amplitude_error_percent": [None if not np.isfinite(e) else float(e)
+                                            for e in self.amplitude_error_percent],
                 "rom_freq_hz": float(self.rom.sensors.frequency_hz),
                 "truth_freq_hz": float(self.truth.freq_hz)}
 

@@ -451,7 +451,7 @@ def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth,
     for c in following:
         log.info("speed-following ROM's LCO at %.4g x truth Vf (V = %.5g): %s, amplitude "
                  "%s of the truth's", c.speed_factor, c.V, c.rom.sensors.kind,
-                 ", ".join(f"{e:+.1f} %" for e in c.amplitude_error_percent))
+                 c.describe_error())
     branches = _branches(done)
     return LcoResult(rom=sim, truth=tr, V=V_lco, V_hopf_exact_order=V_hopf,
                      flutter_exact_order=fl_exact, V_hopf_loop=V_loop,

@@ -338,8 +338,7 @@ def figure_captions(result) -> dict:
                 f"(right), both at V = {c.V:.4g}, {c.speed_factor:g} x the truth's flutter "
                 f"speed: sensor amplitudes ROM {_amplitudes(c.rom_amplitude, units)}, truth "
                 f"{_amplitudes(c.truth.amplitude, units)} (ROM "
-                + ", ".join(f"{e:+.1f} %" for e in c.amplitude_error_percent)
-                + "); ROM frequency "
+                + c.describe_error() + "); ROM frequency "
                 f"{c.rom.sensors.frequency_hz:.4g} Hz, truth {c.truth.freq_hz:.4g} Hz.")
         cap["lco_branches"] = (
             "LCO branches from the flutter points, continued in the airspeed: the truth "

@@ -42,3 +42,19 @@ def test_speed_factors_must_be_positive():
     with pytest.raises(ConfigError, match="speed_factors"):
         compare_lco(None, None, 1.0, [1.05, 0.0], duration=1.0, mode=0, deflection=0.01,
                     dt=0.002)
+
+
+def test_a_diverging_rom_has_no_amplitude_error():
+    """A ROM loop that diverges (amplitudes of 1e11) beside a truth that settles: no
+    percentage, which would read +4e13 %, but what each response is."""
+    from types import SimpleNamespace as NS
+
+    from casflutter.lco import LcoComparison
+
+    c = LcoComparison(speed_factor=1.2, V=1.3,
+                      rom=NS(sensors=NS(kind="divergence", amplitude=[2e11, 9e11],
+                                        frequency_hz=0.053)),
+                      truth=NS(kind="lco", amplitude=[4.4, 3.0], freq_hz=2.68))
+    assert not c.comparable and np.all(np.isnan(c.amplitude_error_percent))
+    assert c.record()["amplitude_error_percent"] == [None, None]
+    assert c.describe_error().startswith("ROM divergence, truth lco")

@@ -167,12 +167,16 @@ def _main(args) -> int:
                 f"{name.replace('_', '-')} V = {sig(v, 4)}" for name, v in rev.items()
                 if v is not None))
         if s["lco"] is not None:
-            lines.append(f"LCO: {sig(s['lco']['freq_hz'])} {hz} ({s['lco']['kind']})")
+            kind = s["lco"]["kind"]
+            lines.append(f"LCO: {sig(s['lco']['freq_hz'])} {hz} ({kind})" if kind == "lco"
+                         else f"LCO: none, the ROM loop's response is a {kind}")
             following = s["lco"].get("speed_following") or []
             if following:
                 lines.append("speed-following ROM's LCO amplitude vs the truth's: " + "; ".join(
-                    f"{c['speed_factor']:g} Vf " + ", ".join(
+                    f"{c['speed_factor']:g} Vf " + (", ".join(
                         f"{e:+.1f} %" for e in c["amplitude_error_percent"])
+                        if None not in c["amplitude_error_percent"] else
+                        f"ROM {c['rom_kind']}, truth {c['truth_kind']}")
                     for c in following))
     if s["controller"] is not None:
         lines += _controller_lines(s["controller"], res, unit)
