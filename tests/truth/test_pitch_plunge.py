@@ -275,3 +275,10 @@ def test_a_rig_file_without_rom_settings_gets_the_truths_flutter(capsys, tmp_pat
         assert doc["rom"] is None and doc["note"].startswith("the truth only")
     assert main(["flutter", str(path)]) == 1
     assert "--vrange" in capsys.readouterr().err
+
+
+def test_problems_shows_the_files_value_as_the_default(capsys):
+    assert main(["problems", "nata", "--set", "rho=1.0", "--json"]) == 0
+    (info,) = json.loads(capsys.readouterr().out)
+    rho = next(r for r in info["parameters"] if r["name"] == "rho")
+    assert (rho["value"], rho["default"]) == (1.0, 1.225)

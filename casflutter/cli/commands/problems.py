@@ -81,7 +81,9 @@ def _info(name: str, sets) -> dict:
         rows = [{"name": n, "value": getattr(params, n), "default": d, "unit": u, "doc": doc}
                 for n, d, u, doc in params.describe()]
     else:                                            # a problem file: the file is the default
-        rows = [{"name": n, "value": v, "default": v, "unit": u, "doc": doc}
+        filed = dict((n, v) for n, v, _, _ in (load_problem(name).params.describe()
+                                               if sets else params.describe()))
+        rows = [{"name": n, "value": v, "default": filed[n], "unit": u, "doc": doc}
                 for n, v, u, doc in params.describe()]
     name = problem_label(name)
     try:
