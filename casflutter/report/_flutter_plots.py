@@ -41,9 +41,12 @@ def _mode_label(mode: int | None, mode_names) -> str:
     """``"mode 2 (torsion 1)"`` for the 0-based ``mode`` (numbered from 1 for a reader)."""
     if mode is None or mode < 0:
         return ""
-    name = (f" ({mode_names[mode]})" if mode_names is not None and mode < len(mode_names)
-            else "")
-    return f"mode {mode + 1}{name}"
+    label = f"mode {mode + 1}"
+    if mode_names is None or mode >= len(mode_names):
+        return label
+    name = str(mode_names[mode])
+    # a name that already numbers the mode ("mode 1 (pitch)", a rig's) is taken as it is
+    return name if name == label or name.startswith(label + " ") else f"{label} ({name})"
 
 
 def plot_vg_vf(result, *, branches=None, hz: bool = True, ax=None, mode_names=None,

@@ -190,3 +190,12 @@ def test_report_captions_replace_the_file_keys(tmp_path):
     assert "<figcaption>Fig. 9. The LCO of each model.</figcaption>" in text
     assert "<figcaption>fig9_lco</figcaption>" not in text
     assert "<figcaption>f.png</figcaption>" in text       # no caption: the file's name
+
+
+def test_mode_labels_number_a_mode_once():
+    """A rig names its modes "mode 1 (pitch)": the legend does not number them twice."""
+    from casflutter.report._flutter_plots import _mode_label
+
+    assert _mode_label(0, ["mode 1 (pitch)", "mode 2 (heave)"]) == "mode 1 (pitch)"
+    assert _mode_label(1, ["bending 1", "torsion 1"]) == "mode 2 (torsion 1)"
+    assert _mode_label(0, ["mode 10 (x)"]) == "mode 1 (mode 10 (x))"
