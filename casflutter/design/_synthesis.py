@@ -473,9 +473,12 @@ class _Phase:
         top = float(np.max(fv))
         act = fv >= top - 0.01 * max(abs(f), abs(top), 1e-12) if self.kind == "stab" \
             else np.ones(fv.size, bool)
-        big = np.max(np.abs(G), axis=1)       # row norms without overflow: |g| = big |g/big|
-        gnorm = big * np.linalg.norm(G / np.where(big > 0, big, 1.0)[:, None], axis=1)
-        gnorm = np.where(np.isfinite(gnorm), gnorm, 0.0)    # (a gradient past the floats)
+        with np.errstate(over="ignore"):
+            gnorm = np.linalg.norm(G, axis=1)
+        if not np.all(np.isfinite(gnorm)):      # squares past the floats: |g| = big |g/big|
+            big = np.max(np.abs(G), axis=1)
+            gnorm = big * np.linalg.norm(G / np.where(big > 0, big, 1.0)[:, None], axis=1)
+            gnorm = np.where(np.isfinite(gnorm), gnorm, 0.0)
         gscale = float(np.max(gnorm))
         if gscale > 1e3 * float(np.max(gnorm[act])):
             gscale = float(np.max(gnorm[act]))

@@ -109,8 +109,9 @@ def verdict(report, require_v=None) -> dict:
                   f"not cover the required [{out['required_V'][0]:.6g}, "
                   f"{out['required_V'][1]:.6g}]")
     elif out["robust"]:
-        reason = (f"stable, and robust over V in [{out['required_V'][0]:.6g}, "
-                  f"{out['required_V'][1]:.6g}]")
+        reason = (f"stable at every V in [{out['required_V'][0]:.6g}, "
+                  f"{out['required_V'][1]:.6g}] (the LFT's exact interval; no gain or phase "
+                  "margins are checked on a single plant)")
     else:
         reason = "stable (no speed range required: pass --require-v LO HI to check one)"
     out["passed"] = bool(report.stable and out["robust"] is not False)
