@@ -139,8 +139,8 @@ def controller_pole_check(K, *, dt: float | None, actuator_omega: float | None =
         ``natural_frequencies_hz`` (cycles per time unit), ``nyquist_hz``,
         ``faster_than_nyquist`` (bool or ``None`` without ``dt``), ``actuator_bandwidth_hz``
         and ``faster_than_actuator`` (``None`` without an actuator), ``plant_fastest_hz``
-        and ``faster_than_plant`` (``None`` without ``plant_omega``), and ``warnings`` (one
-        sentence per flag raised).
+        and ``faster_than_plant`` (``None`` without ``plant_omega``), ``unstable`` (a
+        controller pole with ``Re >= 0``), and ``warnings`` (one sentence per flag raised).
     """
     A = np.asarray(K.A, dtype=float)
     if A.size == 0:
@@ -183,6 +183,15 @@ def controller_pole_check(K, *, dt: float | None, actuator_omega: float | None =
         if fast > limit:
             poles = ", ".join(f"{w / (2 * np.pi):.4g}" for w in sorted(wn[wn > limit])[::-1])
             out["warnings"].append(text.format(poles=poles))
+    growing = lam[lam.real >= 0]
+    out["unstable"] = bool(growing.size)
+    if growing.size:
+        poles = ", ".join(f"{p.real:.4g}{p.imag:+.4g}j" if p.imag else f"{p.real:.4g}"
+                          for p in sorted(growing, key=lambda p: -p.real) if p.imag >= 0)
+        out["warnings"].append(
+            f"the controller itself is unstable (poles at {poles} rad per {time_unit}): the "
+            "loop is stable only while it is closed; a sensor or actuator that drops out, or "
+            "the loop opened for a test, leaves the controller's states growing")
     return out
 
 

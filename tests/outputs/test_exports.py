@@ -126,3 +126,14 @@ def test_a_discrete_controller_file_is_refused_not_misread(tmp_path, capsys):
             assert "time_base" in err and "continuous" in err
         else:
             assert "PASSED" in out
+
+
+def test_an_unstable_controller_is_flagged():
+    """A controller pole at +0.975 rad/s (an aircraft family's order-2 design): stable only
+    inside the loop, which an engineer must be told."""
+    K = control.ss([[0.975, 0.0], [0.0, -3.0]], np.ones((2, 1)), np.ones((1, 2)), [[0.0]])
+    check = controller_pole_check(K, dt=None)
+    assert check["unstable"] is True
+    (text,) = check["warnings"]
+    assert text.startswith("the controller itself is unstable (poles at 0.975 rad per s)")
+    assert controller_pole_check(_controller(3.0), dt=None)["unstable"] is False
