@@ -23,7 +23,6 @@ from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
-
 from scipy.interpolate import interp1d
 
 from .._resources import problems_dir, read_toml
@@ -310,7 +309,8 @@ def _settled_motion(f: ca.Function, outputs: Outputs, disc: "_OdeDisc", Vh: floa
     speeds = [p.V * speed_scale for p in run.points]
     stable = [p.V * speed_scale for p in run.points if p.stable]
     span = (f"; its own branch spans V = {min(speeds):.5g} to {max(speeds):.5g}{u}"
-            + (f", stable from {min(stable):.5g}{u}" if stable else ""))
+            + (f", stable between {min(stable):.5g} and {max(stable):.5g}{u}" if stable
+               else ""))
     return SettledMotion(V=V, kind="lco", duration=duration, freq_hz=an.frequency_hz,
                          amplitude=amp, points=tuple(run.points), folds=tuple(run.folds),
                          note=found + span)
