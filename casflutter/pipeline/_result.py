@@ -383,8 +383,15 @@ class RunResult:
         return _rel(self.Vf, self.Vf_truth)
 
     def divergence_errors(self) -> dict:
-        """``(Vd - Vd_truth) / Vd_truth`` of the ROM (``"rom"``) and the parametric ROM
-        (``"parametric_rom"``), each ``None`` where either has no divergence in the range."""
+        """The ROMs' divergence speeds against the truth's.
+
+        Returns
+        -------
+        dict
+            ``(Vd - Vd_truth) / Vd_truth`` of the ROM (``"rom"``) and of the parametric ROM
+            (``"parametric_rom"``), each ``None`` where either has no divergence in the
+            range.
+        """
         def vd(res):
             return None if res is None or res.divergence is None else res.divergence.V
 
