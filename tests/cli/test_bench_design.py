@@ -14,7 +14,8 @@ import pytest
 
 from casflutter.aeroelastic import load_family
 from casflutter.cli import main
-from casflutter.design import MultiSpeedSettings, design_over_speeds
+from casflutter.design import design_over_speeds
+from casflutter.pipeline import RunConfig, multispeed_settings
 from casflutter.verify import verify_family
 
 KEYS = {"problem", "nx", "n_inputs", "n_outputs", "order", "seed", "interval", "held", "reach",
@@ -36,8 +37,10 @@ def test_records_per_order_and_seed_with_the_certificate(tmp_path):
     family = load_family("goland_4flaps")
     # the family names no disturbances: the H-infinity phase bounds the loop's sensitivities
     assert rec["objective"] == "sensitivity"
-    K = design_over_speeds(family, (60.0, 150.0), 2, seed=0,
-                           settings=MultiSpeedSettings(decay=0.05, sensitivity=True)).controller
+    # the design `casflutter run` makes on a configuration naming the family
+    settings = multispeed_settings(RunConfig(), "sensitivity")
+    assert doc["settings"].startswith("the [controller] defaults of a run configuration")
+    K = design_over_speeds(family, (60.0, 150.0), 2, seed=0, settings=settings).controller
     check = verify_family(family, K, speed_range=family.speed_range)
     assert rec["certified_interval"] == pytest.approx(list(check.stable_interval), rel=1e-9)
     assert rec["robust_flutter_speed"] == pytest.approx(check.robust_flutter_speed, rel=1e-9)
@@ -78,7 +81,8 @@ def test_a_run_configuration_designs_with_its_controller_settings(tmp_path, monk
                                                                   problem, from_run):
     """The bench measures the design ``casflutter run`` makes: a run configuration's
     ``[controller]`` settings (goland_gaf's: no full-order start, ``Dk = 0``, 40 H-inf
-    iterations), a family file the design's defaults."""
+    iterations), a family file the ``[controller]`` defaults of a run that names it (no
+    flap-rate weight: that is a servo's, which a family does not have)."""
     import casflutter.design as design
     from casflutter.errors import SynthesisError
     from casflutter.pipeline import config_path, load_config
@@ -103,8 +107,8 @@ def test_a_run_configuration_designs_with_its_controller_settings(tmp_path, monk
                                        c.n_speeds)
         assert settings.synthesis.max_outer == c.max_outer == 40
         assert settings.full_order is False
-    else:
-        defaults = MultiSpeedSettings()
-        assert (settings.full_order, settings.random_starts, settings.synthesis.max_outer) \
-            == (defaults.full_order, defaults.random_starts, defaults.synthesis.max_outer)
-        assert settings.full_order is True
+    else:   # a run configuration that names the family file: [controller]'s defaults
+        c = RunConfig().controller
+        assert (settings.full_order, settings.strictly_proper, settings.random_starts,
+                settings.synthesis.max_outer, settings.rate_weight) \
+            == (c.full_order, c.strictly_proper, c.random_starts, c.max_outer, 0.0)

@@ -20,7 +20,9 @@ configuration's ``[controller]`` table gives the design's settings (starts, spee
 rate, flap-rate weight, budgets), so the bench measures the design that ``casflutter run``
 makes; its H∞ objective too, except the paper's LFT (``"lft"``), which needs the ROM loop's
 flutter speed and is replaced by the family's own (``--objective auto``).  A family file
-takes the defaults of :class:`casflutter.design.MultiSpeedSettings`.
+takes the ``[controller]`` defaults of a run configuration whose ``[problem]`` names it
+(:func:`casflutter.pipeline.multispeed_settings`), which is what ``casflutter run`` designs
+with on it.
 """
 
 from __future__ import annotations
@@ -184,18 +186,21 @@ def _handler(args: argparse.Namespace) -> int:
         raise ConfigError(f"--interval {lo} {hi}: need LO < HI")
     out = check_output_path(args.out, what="--out", suffixes=(".json",))
     family, about, cfg = _family(args.problem)
-    objective, settings = args.objective, None
-    if cfg is not None:
-        from ...pipeline import multispeed_settings
+    from ...design import default_objective
+    from ...pipeline import RunConfig, multispeed_settings
 
-        ran = cfg.controller.hinf_objective
-        if objective == "auto" and ran in ("sensors", "sensitivity"):
-            objective = ran
-        settings = multispeed_settings(cfg, objective)
+    # a family file: the [controller] defaults of a run that names it, so the bench
+    # measures the design `casflutter run` makes
+    objective, run_cfg = args.objective, RunConfig() if cfg is None else cfg
+    ran = run_cfg.controller.hinf_objective
+    if objective == "auto":
+        objective = ran if ran in ("sensors", "sensitivity") else default_objective(family)
+    settings = multispeed_settings(run_cfg, objective)
     meta = {"problem": args.problem, "family": about, "decay": args.decay,
             "objective": objective,
             "settings": "the run configuration's [controller]" if cfg is not None
-            else "MultiSpeedSettings' defaults", "provenance": provenance()}
+            else "the [controller] defaults of a run configuration naming the family",
+            "provenance": provenance()}
     records: list = []
 
     def keep(rec):
