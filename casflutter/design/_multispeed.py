@@ -71,7 +71,8 @@ from ._bfgs import nonsmooth_bfgs
 from ._out_of_reach import modes_out_of_reach
 from ._plant import partition
 from ._problem import verify_closed_loop
-from ._speeds import DesignChannels, Scaling, SpeedLoops, design_partition
+from ._speeds import (DesignChannels, Scaling, SpeedLoops, design_partition,
+                      unit_free_sensitivity)
 from ._synthesis import SynthesisOptions, SynthesisResult, synthesize
 
 __all__ = ["MultiSpeedSettings", "MultiSpeedDesign", "HoldRecord", "design_over_speeds",
@@ -85,6 +86,8 @@ DEFAULT_DECAY = 0.05
 _TAUS = (6.0, 2.0, 0.6, None)
 #: a BFGS run stops when 20 iterations lowered its objective by less than this many decay rates
 _STALL = 0.01
+#: seconds between the continuation's progress lines (only a large family takes that long)
+_PROGRESS_S = 60.0
 #: the dense scan's local maxima whose neighbouring gaps are scanned again, and how finely
 _REFINED, _SUBDIVIDE = 6, 3
 
@@ -113,7 +116,9 @@ class MultiSpeedSettings:
     sensitivity: bool = False
     """The H∞ plants' channels: at each speed the output and the input sensitivity of the
     loop (whose diagonal entries bound the loop-at-a-time margins) instead of the family's
-    disturbances to the measurements (:class:`._speeds.DesignChannels`)."""
+    disturbances to the measurements (:class:`._speeds.DesignChannels`), in the design's
+    scaled signals so that their norm does not depend on the signals' units
+    (:func:`._speeds.unit_free_sensitivity`)."""
     strictly_proper: bool | None = None
     """Keep ``Dk = 0``; ``None``: strictly proper exactly when some model's controls reach its
     measurements directly (a feed-through would close an algebraic loop that can become
@@ -458,6 +463,7 @@ class _Engine:
         cur = (lo, e) if anchor == "low" else (e, hi)
         s = self.settings
         step, smallest, rounds = s.first_step * (hi - lo), s.min_step * (hi - lo), 0
+        t0 = last = time.perf_counter()
         while cur != (lo, hi) and step >= smallest and rounds < s.max_rounds:
             rounds += 1
             step = min(step, (hi - cur[1]) if anchor == "low" else (cur[0] - lo))
@@ -476,6 +482,10 @@ class _Engine:
                 K, cur, step = Kn, trial, 1.5 * step
             else:
                 step *= 0.5
+            if time.perf_counter() - last > _PROGRESS_S:   # a large family: say it works
+                last = time.perf_counter()
+                log.info("continuation from the %s end: holds [%.5g, %.5g] of [%.5g, %.5g] "
+                         "after %d steps, %.0f s", anchor, *cur, lo, hi, rounds, last - t0)
         return K, cur, rounds
 
     # ------------------------------------------------------------------ starts
@@ -896,7 +906,9 @@ def _finish(eng: _Engine, fams, K: np.ndarray, order: int, interval: tuple, reac
                 for side in (("output", "input") if s.sensitivity else ("",))]
     hv = tuple(float(v) for v in np.linspace(lo, e, s.hinf_speeds)) if s.hinf_speeds else ()
     if hinf_plants is None:
-        parts = [design_partition(f, V, ch) for V in hv for f in fams for ch in channels]
+        sc = models.scaling
+        parts = [unit_free_sensitivity(design_partition(f, V, ch), ch, sc.su, sc.sy)
+                 for V in hv for f in fams for ch in channels]
         nw = max((P.B1.shape[1] for P in parts), default=0)
         nz = max((P.C1.shape[0] for P in parts), default=0)
         hinf = [_as_ss(P, nw, nz) for P in parts]
