@@ -327,10 +327,12 @@ class ControllerSettings(SynthesisOptions):
     """H∞ iterations per start (:class:`casflutter.design.SynthesisOptions`)."""
     max_stab_rounds: int = 300
     """Stabilisation rounds per start (:class:`casflutter.design.SynthesisOptions`)."""
-    flap_rate_weight: float = 0.003
-    """Weight ``w`` of the flap rate in the H∞ plants (per rad/s of flap rate); 0: none.  The
-    seed wing's servo saturates at 300°/s; without the weight a controller asks far more to
-    hold the established LCO."""
+    flap_rate_weight: float = 0.0
+    """Weight ``w`` of the control (flap) rate in the H∞ plants (per rad/s of rate); 0: none.
+    Where a servo saturates, the weight keeps the controller within its rate: the seed wing's
+    configurations set it (its servo saturates at 300°/s; without the weight a controller
+    asks far more to hold the established LCO).  A family's or a rig's run has none unless
+    its configuration asks for one."""
     flap_rate_bandwidth: float = 251.3
     """Bandwidth of the flap-rate filter [rad per time unit] (the seed wing's 40 Hz servo)."""
     start: str = ""
@@ -415,8 +417,15 @@ class VerifySection:
     (:func:`casflutter.verify.speed_sweep`); empty: none."""
     n_sweep: int = 601
     """Points of that sweep."""
+    require_margins: bool = False
+    """Whether the controller's loop-at-a-time margins (``controller.margins``) must also
+    hold over the required interval for the run's checks to pass, as ``casflutter verify
+    --require-v`` asks (``RunResult.robust_ok``); false: they are reported beside the
+    certified interval, not required."""
 
     def __post_init__(self):
+        if not isinstance(self.require_margins, bool):
+            raise ConfigError(f"require_margins = {self.require_margins!r}: true or false")
         for name in ("required", "sweep"):
             v = getattr(self, name)
             if len(v):

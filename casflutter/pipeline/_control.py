@@ -199,15 +199,23 @@ def start_controller(cfg: RunConfig, family, feedback: str | None = None
                       outputs=list(sig.controls), name="K0")
 
 
+def design_objective(cfg: RunConfig, family, has_lft: bool) -> str:
+    """The multi-speed design's H∞ objective: ``controller.hinf_objective``, with
+    ``"auto"`` resolved (``"lft"`` where the run has the LFT at the ROM loop's flutter
+    speed, else :func:`casflutter.design.default_objective` of the family)."""
+    objective = cfg.controller.hinf_objective
+    if objective == "auto":
+        objective = "lft" if has_lft else default_objective(family)
+    return objective
+
+
 def _multispeed(cfg: RunConfig, family, lft_plants=None) -> MultiSpeedDesign:
     c = cfg.controller
     if c.hinf_objective == "lft" and lft_plants is None:
         raise CasflutterError("controller.hinf_objective = \"lft\" needs the LFT at the ROM "
                               "loop's flutter speed (eq. 14); this problem has no ROM loop "
                               "with a flutter speed: use \"sensors\" or \"auto\"")
-    objective = c.hinf_objective
-    if objective == "auto":
-        objective = "lft" if lft_plants is not None else default_objective(family)
+    objective = design_objective(cfg, family, lft_plants is not None)
     hinf = lft_plants if objective == "lft" and c.hinf_speeds else None
     K0 = start_controller(cfg, family)
     return design_over_speeds(family, tuple(c.interval), c.order,

@@ -16,7 +16,7 @@ from .._outputs import plain_json
 from ..lco import LcoComparison, LCOBranch
 from ..truth import AeroelasticTruth, TruthLco, TruthLoopSweep
 from ._config import RunConfig
-from ._control import ControllerStage
+from ._control import ControllerStage, design_objective
 from ._exports import label_summary
 from ._model import FlutterStage, ModelStage, ParametricResult
 from ._suppression import SuppressionStage
@@ -506,6 +506,18 @@ class RunResult:
         return bool(self.control.checks["design"].covers(lo, hi))
 
     @property
+    def robust_ok(self) -> bool | None:
+        """The design family's loop-at-a-time margins (``controller.margins``) hold over
+        :attr:`required_V`, and its certified interval covers it: the verdict of
+        ``casflutter verify --require-v`` on the same family and controller
+        (:meth:`casflutter.verify.FamilyVerification.robust_over`); ``None`` without a
+        target or a controller.  Required by :attr:`success` only with
+        ``verify.require_margins``."""
+        if self.required_V is None or self.control is None:
+            return None
+        return bool(self.control.checks["design"].robust_over(*self.required_V))
+
+    @property
     def rom_unstable_at_start(self) -> bool:
         """The ROM loop (truth and wing routes) is unstable already at the low end of
         ``flutter.V_range`` (``FlutterResult.unstable_at_start``): it has no flutter speed,
@@ -516,9 +528,12 @@ class RunResult:
     @property
     def success(self) -> bool:
         """Every check that ran passed: the ROM loop is stable at the start of
-        ``flutter.V_range`` (:attr:`rom_unstable_at_start`), the interval target holds, and
-        both closed-loop simulations grow open loop and decay closed loop."""
+        ``flutter.V_range`` (:attr:`rom_unstable_at_start`), the interval target holds (and,
+        with ``verify.require_margins``, the margins over it: :attr:`robust_ok`), and both
+        closed-loop simulations grow open loop and decay closed loop."""
         ok = self.interval_ok is not False and not self.rom_unstable_at_start
+        if self.config.verify.require_margins:
+            ok = ok and self.robust_ok is not False
         if self.closed_loop is not None:
             ok = ok and self.closed_loop.rom_simulation.grows_open_decays_closed \
                 and self.closed_loop.truth_simulation.grows_open_decays_closed
@@ -565,7 +580,11 @@ class RunResult:
             out["flutter_parametric"] = _flutter_summary(self.parametric.flutter)
         if self.interval_ok is not None:
             out["verification"] = {"required_V": _pair(self.required_V),
-                                   "interval_ok": self.interval_ok, "success": self.success}
+                                   "interval_ok": self.interval_ok,
+                                   "robust_ok": self.robust_ok,
+                                   "margins": list(cfg.controller.margins),
+                                   "require_margins": cfg.verify.require_margins,
+                                   "success": self.success}
         U_ref = getattr(self.problem, "U_ref", None)
         if U_ref is not None and out["flutter"] is not None and out["flutter"]["V"] is not None:
             out["flutter"]["airspeed_m_s"] = out["flutter"]["V"] * U_ref
@@ -719,7 +738,10 @@ class RunResult:
         if c.design is not None:
             d = c.design
             out.update(interval=list(d.interval), held=bool(d.held), reach=d.reached[1],
-                       interval_decay=d.decay, design_gamma=d.gamma, design_message=d.message,
+                       interval_decay=d.decay, design_gamma=d.gamma,
+                       hinf_objective=design_objective(self.config, c.family,
+                                                       c.lft is not None),
+                       design_message=d.message,
                        design_starts=[{"kind": h.kind, "order": h.order,
                                        "reached": list(h.reached)} for h in d.starts],
                        start=self.config.controller.start or None)

@@ -26,10 +26,12 @@ def _speed_label(result) -> str:
 
 def _mark_speeds(ax, result, *, label: bool) -> None:
     """The absolute (solid red) and robust (dashed orange) flutter speeds."""
-    if result.robust_flutter_speed is not None:
-        ax.axvline(result.robust_flutter_speed, color="tab:orange", ls="--", lw=1.2,
-                   label=(f"robust flutter speed {result.robust_flutter_speed:.5g} "
-                          f"{result.speed_unit}") if label else None)
+    robust = result.robust_flutter_speed
+    if robust is not None:
+        text = (f"margins below threshold from the range's start, {robust:.5g} "
+                if robust <= result.speed_range[0] else f"robust flutter speed {robust:.5g} ")
+        ax.axvline(robust, color="tab:orange", ls="--", lw=1.2,
+                   label=text + result.speed_unit if label else None)
     if result.absolute_flutter_speed is not None:
         ax.axvline(result.absolute_flutter_speed, color="tab:red", lw=1.4,
                    label=(f"absolute flutter speed {result.absolute_flutter_speed:.5g} "

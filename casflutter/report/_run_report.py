@@ -6,6 +6,8 @@ not run is left out.
 
 from __future__ import annotations
 
+import json
+import logging
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -22,6 +24,8 @@ from ._margin_plots import plot_family_verification, plot_model_mismatch
 from ._pipeline_plots import plot_flap_pulses, plot_gain_ramp, plot_hankel, plot_rom_fit
 
 __all__ = ["write_figures", "write_html", "flap_pulse_comparison", "figure_captions"]
+
+log = logging.getLogger(__name__)
 
 
 def _save(fig, path: Path) -> Path:
@@ -284,8 +288,10 @@ def figure_captions(result) -> dict:
         f"on the {name} loses stability (speed and frequency).")
         for name in (result.control.mismatch if result.control is not None else ())})
     if result.route == "family":
-        return {"vg_vf": ("V–g and V–f of the plant family's open-loop branches, crossings "
-                          "marked."), **control}
+        fam = result.model.family
+        return {"vg_vf": (f"V–g and V–f of the plant family {fam.name}'s open-loop branches "
+                          f"against the speed [{fam.speed_unit}], crossings marked."),
+                **control}
     if result.identification is None:   # a GAF wing file: the RFA's V-g/V-f only
         return {"vg_vf": "V–g and V–f of ΣAE(V) with Σf frozen at the flutter airspeed.",
                 "vg_vf_airspeed": ("V–g and V–f of the RFA's ΣAE(U) against the airspeed: the "
@@ -379,8 +385,12 @@ def figure_captions(result) -> dict:
     return cap
 
 
-def write_html(out: Path, summary: dict, figures: dict, captions: dict | None = None) -> Path:
+def write_html(out: Path, summary: dict, figures: dict, captions: dict | None = None, *,
+               config: dict | None = None) -> Path:
     """``report.html`` with every figure embedded.
+
+    A run on a plant family file (``summary["route"] == "family"``) gets the family's
+    design report, any other run the paper's reproduction (:func:`html_report`).
 
     Parameters
     ----------
@@ -392,11 +402,25 @@ def write_html(out: Path, summary: dict, figures: dict, captions: dict | None = 
         Figure name -> PNG path.
     captions : dict, optional
         Figure name -> caption (:func:`figure_captions`).
+    config : dict, optional
+        The run's configuration (``config.json``); default: the folder's ``config.json``
+        when it is there (the run writes it before the report).
 
     Returns
     -------
     Path
+        The report's path.
     """
-    path = Path(out) / "report.html"
-    path.write_text(html_report(summary, figures, captions=captions), encoding="utf-8")
+    out = Path(out)
+    if config is None and (out / "config.json").is_file():
+        try:
+            config = json.loads((out / "config.json").read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:   # the report does without it
+            log.warning("report: cannot read %s (%s); the controller's settings are left "
+                        "out of the report", out / "config.json", exc)
+            config = None
+    path = out / "report.html"
+    path.write_text(html_report(summary, figures, captions=captions,
+                                config=config if isinstance(config, dict) else None),
+                    encoding="utf-8")
     return path

@@ -243,6 +243,10 @@ class FamilyVerification:
         thr = f"{self.gain_margin_db:g} dB / {self.phase_margin_deg:g} deg"
         if self.robust_flutter_speed is None:
             lines.append(f"  robust_flutter_speed: none in the range ({thr} held)")
+        elif self.robust_flutter_speed <= self.speed_range[0]:
+            lines.append(f"  robust_flutter_speed: {self.robust_flutter_speed:.6g} {u}, the "
+                         f"range's start: the margins ({thr}) fail already there "
+                         f"({self.robust_reason})")
         else:
             lines.append(f"  robust_flutter_speed: {self.robust_flutter_speed:.6g} {u} "
                          f"({thr}: {self.robust_reason})")

@@ -86,3 +86,28 @@ def test_verify_accepts_the_run_controller_and_repeats_its_certificate(family_ru
                                                        rel=1e-9)
     assert v["absolute_flutter_speed"] == pytest.approx(
         s["controller"]["absolute_flutter_speed"], rel=1e-9)
+
+
+def test_the_runs_margin_verdict_is_verifys_and_can_be_required(family_run, tmp_path, capsys):
+    """``verification.robust_ok`` is the verdict of ``casflutter verify --require-v`` on the
+    same family, controller and interval (the margins 6 dB / 45 deg held from the range's
+    start to its top, the interval covered); with ``verify.require_margins = true`` the run's
+    exit status follows it (3 when they do not hold), else it is only reported."""
+    out, s = family_run
+    ver = s["verification"]
+    assert ver["margins"] == [6.0, 45.0] and ver["require_margins"] is False
+    assert ver["interval_ok"] is True and ver["success"] is True
+    capsys.readouterr()
+    rc = main(["verify", "goland_4flaps", str(out / "controller.json"), "--require-v", "60",
+               "150", "--json"])
+    v = json.loads(capsys.readouterr().out)["verdict"]
+    assert v["covered"] is True
+    assert ver["robust_ok"] is v["robust"] is v["passed"] is (rc == 0)
+    cfg = tmp_path / "run.toml"
+    cfg.write_text(RUN + "[verify]\nrequire_margins = true\n")
+    again = tmp_path / "out"
+    rc_run = main(["run", str(cfg), "--out", str(again), "--quiet"])
+    s2 = json.loads((again / "summary.json").read_text())
+    assert s2["verification"]["robust_ok"] is ver["robust_ok"]         # the same controller
+    assert rc_run == (0 if ver["robust_ok"] else 3)
+    assert s2["verification"]["success"] is ver["robust_ok"]

@@ -2,7 +2,8 @@
 wing with its controller designed over speed, ``problems/seed_wing/run.toml``).
 
 Exit status: 0 when the run finished and every check it made passed (the ``verify.required``
-interval, the closed-loop simulations, a ROM loop stable at the start of ``flutter.V_range``),
+interval, and the margins over it with ``verify.require_margins``; the closed-loop
+simulations; a ROM loop stable at the start of ``flutter.V_range``),
 3 when it finished and wrote its outputs but a check failed (``checks passed: False``;
 summary.json says which), 1 or 2 for a run refused or stopped."""
 
@@ -60,18 +61,42 @@ def _controller_lines(c: dict, res, unit: str) -> list[str]:
         lines.append(f"  the synthesis's γ {sig(syn.gamma)} is of its design plants, which add "
                      "the flap-rate output (controller.flap_rate_weight = "
                      f"{sig(res.config.controller.flap_rate_weight)})")
+    gm, pm = res.config.controller.margins
     servo = (f", flap behind a {sig(c['servo_omega'])} rad/s servo"
              if c.get("servo_omega") else "")
     for prefix, label in (("", "design model"), ("truth_", "truth's linearisation")):
         if f"{prefix}stable_interval" not in c:
             continue
+        iv, robust = c[prefix + "stable_interval"], c[prefix + "robust_flutter_speed"]
+        # a robust flutter speed at the certified interval's start: the margins never held
+        at_start = robust is not None and iv is not None and robust <= iv[0]
         lines.append(f"  on the {label}{servo}: certified stable over "
-                     f"{sig(c[prefix + 'stable_interval'], none='no interval')} {unit}; absolute / "
-                     f"robust flutter speed {sig(c[prefix + 'absolute_flutter_speed'], none='none')}"
-                     f" / {sig(c[prefix + 'robust_flutter_speed'], none='none')}")
+                     f"{sig(iv, none='no interval')} {unit}; absolute / robust flutter speed "
+                     f"{sig(c[prefix + 'absolute_flutter_speed'], none='none')} / "
+                     + (f"none: the margins ({gm:g} dB / {pm:g} deg) fail already at "
+                        f"{sig(robust)}" if at_start else sig(robust, none='none')))
     for w in (c.get("poles") or {}).get("warnings", ()):
         lines.append(f"  warning: {w}")
     return lines
+
+
+def _margins_line(res, unit: str) -> str:
+    """Whether the loop-at-a-time margins hold over the required interval, in the words
+    of ``casflutter verify --require-v`` (which fails a controller whose margins do not),
+    and whether the run's checks require them (``verify.require_margins``)."""
+    check, (lo, hi) = res.control.checks["design"], res.required_V
+    gm, pm = res.config.controller.margins
+    head = f"margins ({gm:g} dB / {pm:g} deg) over the required [{lo:.5g}, {hi:.5g}] {unit}: "
+    if res.robust_ok:
+        return head + "held (robust)"
+    rfs, reasons = check.robust_flutter_speed, check.robust_reason.split("; ")
+    more = f" and {len(reasons) - 1} more" if len(reasons) > 1 else ""
+    why = ("" if rfs is None or not check.covers(lo, hi) else
+           f" from {rfs:.5g} {unit} ({reasons[0]}{more})")
+    return (head + f"not held{why}: stable, not robust; casflutter verify --require-v "
+            f"{lo:.5g} {hi:.5g} fails this controller"
+            + ("" if res.config.verify.require_margins else
+               " (reported, not required: verify.require_margins = true makes it a check)"))
 
 
 def _model_lines(s: dict) -> list[str]:
@@ -195,6 +220,8 @@ def _main(args) -> int:
         lines += res.skipped_notes()
     checked = (res.interval_ok is not None or res.closed_loop is not None
                or res.rom_unstable_at_start)
+    if res.robust_ok is not None:
+        lines.append(_margins_line(res, unit))
     if checked:
         lines.append(f"checks passed: {res.success}")
     lines.append(f"total {s['timings_s']['total']:.1f} s; outputs in {res.out_dir}/")
