@@ -37,8 +37,9 @@ impossible values fail with a :class:`~casflutter.errors.ConfigError` naming the
 
 from __future__ import annotations
 
+import logging
 import math
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import ClassVar
 
@@ -51,12 +52,13 @@ from ..ident import HWLOrders, IdentificationSettings
 from ..structure import SENSOR_KINDS, check_sensor_rows
 from ..truth import (AeroelasticTruth, RecordSettings, SuppressionSettings, file_problem_names,
                      load_problem, problem_definition, problem_names)
+from ..truth._registry import FILE_KINDS
 from ..verify import load_controller
 
 __all__ = ["RunConfig", "ProblemSection", "DataSection", "RomSection", "FlutterSection",
            "LcoSection", "ControllerSettings", "VerifySection", "ClosedLoopSection",
            "SuppressionSection", "ParametricSection", "SensorsSection", "SolverSection", "STAGES", "load_config",
-           "default_config_path", "config_path", "flutter_config"]
+           "default_config_path", "config_path", "flutter_config", "problem_route_settings"]
 
 #: Optional stages, in the order they run (``RunConfig.stages``).
 STAGES = ("frozen", "parametric", "lco", "controller", "closed_loop", "suppression")
@@ -327,12 +329,10 @@ class ControllerSettings(SynthesisOptions):
     """H∞ iterations per start (:class:`casflutter.design.SynthesisOptions`)."""
     max_stab_rounds: int = 300
     """Stabilisation rounds per start (:class:`casflutter.design.SynthesisOptions`)."""
-    flap_rate_weight: float = 0.0
-    """Weight ``w`` of the control (flap) rate in the H∞ plants (per rad/s of rate); 0: none.
-    Where a servo saturates, the weight keeps the controller within its rate: the seed wing's
-    configurations set it (its servo saturates at 300°/s; without the weight a controller
-    asks far more to hold the established LCO).  A family's or a rig's run has none unless
-    its configuration asks for one."""
+    flap_rate_weight: float = 0.003
+    """Weight ``w`` of the flap rate in the H∞ plants (per rad/s of flap rate); 0: none.  The
+    seed wing's servo saturates at 300°/s; without the weight a controller asks far more to
+    hold the established LCO."""
     flap_rate_bandwidth: float = 251.3
     """Bandwidth of the flap-rate filter [rad per time unit] (the seed wing's 40 Hz servo)."""
     start: str = ""
@@ -742,6 +742,51 @@ _ROUTE_KEYS = {"V0": "data.V0", "dt": "data.dt", "duration": "data.duration",
                "flap": "data.flap", "na": "rom.na", "nb": "rom.nb",
                "V_range": "flutter.V_range", "n_grid": "flutter.n_grid",
                "n_speeds": "parametric.n_speeds"}
+#: the ``[rom]`` keys a problem file's ROM route cannot do without
+_ROUTE_REQUIRED = ("V0", "V_range", "dt", "duration", "band")
+#: the run's keys whose defaults are the seed wing's, in its units (speed index, seconds of
+#: its time march) and with its CFD march's coupling delay: on a simulator's problem file
+#: (a rig section) its ``[rom]`` table gives them or the run configuration sets them; the
+#: coupling delay only the configuration (0 for a simulator's records, as ``casflutter
+#: flutter`` takes; 1 for the paper's loosely coupled march, which the input delay r = 1 of
+#: the HWL orders of Table I expects)
+_PROBLEM_UNIT_KEYS = (*(_ROUTE_KEYS[k] for k in _ROUTE_REQUIRED), "data.coupling_delay")
+
+
+def problem_route_settings(problem: str) -> dict:
+    """The run settings a problem file gives in its own units: its ``[rom]`` table (the keys
+    of ``casflutter flutter``'s ROM route).
+
+    The one mapping from a problem file to the run's keys, shared by :func:`flutter_config`
+    and :func:`load_config` (which takes each of them that the run configuration leaves
+    out).
+
+    Parameters
+    ----------
+    problem : str
+        Problem name or problem file.
+
+    Returns
+    -------
+    dict
+        ``{dotted run key: value}``; empty for a built-in problem and for a problem file
+        without a ``[rom]`` table.
+
+    Raises
+    ------
+    ConfigError
+        An unknown key in the ``[rom]`` table (named), or an unknown problem.
+    """
+    if problem in problem_names():
+        return {}
+    table = problem_definition(problem).get("rom")
+    if not isinstance(table, dict):
+        return {}
+    unknown = [k for k in table if k not in _ROUTE_KEYS]
+    if unknown:
+        raise ConfigError(f"unknown key {unknown[0]!r} in the [rom] table of {problem}; "
+                          f"allowed: {', '.join(_ROUTE_KEYS)}")
+    return {_ROUTE_KEYS[k]: v for k, v in table.items()}
 
 
 def flutter_config(problem: str, *, updates=None) -> RunConfig:
@@ -771,17 +816,12 @@ def flutter_config(problem: str, *, updates=None) -> RunConfig:
     """
     if problem in problem_names():
         return load_config(config_path(problem, "flutter"), updates=updates)
-    table = dict(problem_definition(problem).get("rom", {}))
-    unknown = [k for k in table if k not in _ROUTE_KEYS]
-    if unknown:
-        raise ConfigError(f"unknown key {unknown[0]!r} in the [rom] table of {problem}; "
-                          f"allowed: {', '.join(_ROUTE_KEYS)}")
-    missing = [k for k in ("V0", "V_range", "dt", "duration", "band") if k not in table]
+    settings = problem_route_settings(problem)
+    missing = [k for k in _ROUTE_REQUIRED if _ROUTE_KEYS[k] not in settings]
     if missing:
         raise ConfigError(f"problem {problem} has no ROM-route settings for "
                           f"{', '.join(missing)}: add them to its [rom] table")
-    route = {**_ROUTE, **{_ROUTE_KEYS[k]: v for k, v in table.items()},
-             "problem.name": str(problem), **(updates or {})}
+    route = {**_ROUTE, **settings, "problem.name": str(problem), **(updates or {})}
     table = {}
     for key, value in route.items():
         set_dotted(table, RunConfig, key, value)
@@ -883,11 +923,98 @@ def load_config(path=None, *, updates=None, **overrides) -> RunConfig:
                           "problem.name")
     _relative_problem(table, path)
     _relative_path(table, "controller", "start", path)
+    prob = table.get("problem")
+    file_problem = prob.get("name") if isinstance(prob, dict) else None
     table.update({k: v for k, v in overrides.items() if v is not None})
+    changed: dict = {}                  # what the updates alone set
     for key, value in (updates or {}).items():
         set_dotted(table, RunConfig, key, value)
+        set_dotted(changed, RunConfig, key, value)
     for old, new in _RENAMED.items():
         section, key = old.split(".")
         if isinstance(table.get(section), dict) and key in table[section]:
             raise ConfigError(f"{old} was renamed {new}: rename the key in {path}")
-    return build_settings(RunConfig, table)
+    # a file written for a built-in problem that it names (the seed wing's default file)
+    # whose problem the updates change: its values in that problem's units are not the
+    # new problem's
+    _from_problem_file(table, changed if file_problem in problem_names() else None,
+                       file_problem)
+    config = build_settings(RunConfig, table)
+    default = {f.name: f.default for f in fields(RunConfig)}["stages"]
+    if "stages" in table and set(config.stages) != set(default):
+        # a list of its own (not the default one, which a file may spell out): the stages
+        # were asked for by name, and one that cannot run here is refused
+        from ._run import check_requested_stages
+
+        check_requested_stages(config)
+    return config
+
+
+def _given(table: dict, dotted: str) -> bool:
+    """Whether the raw configuration ``table`` sets ``dotted`` (``"data.V0"``)."""
+    node = table
+    for part in dotted.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return False
+        node = node[part]
+    return True
+
+
+def _from_problem_file(table: dict, changed: dict | None = None,
+                       file_problem: str | None = None) -> None:
+    """A simulator's problem file (a rig section) in its own units: each key of its
+    ``[rom]`` table (:func:`problem_route_settings`) that the configuration leaves out is
+    taken from the file, as ``casflutter flutter`` takes it; a key of
+    :data:`_PROBLEM_UNIT_KEYS` that neither gives is refused, named, before any work (its
+    default is the seed wing's, in the seed wing's units).  Nothing changes for a built-in
+    problem, a wing file or a family file.  With ``changed`` (the configuration file was
+    written for the built-in ``file_problem`` and the updates name the rig), only the
+    updates count as setting those keys: the file's values are in the built-in's units."""
+    prob = table.get("problem")
+    name = prob.get("name") if isinstance(prob, dict) else None
+    if not isinstance(name, str) or name in problem_names():
+        return
+    try:
+        kind = problem_definition(name).get("kind")
+    except ConfigError:
+        return                  # an unknown or unreadable problem: [problem] names it
+    if kind not in FILE_KINDS:
+        return                  # a wing or family file: its records or models give these
+    own = table if changed is None else changed
+
+    def given(key):
+        return _given(own, key)
+
+    taken = {k: v for k, v in problem_route_settings(name).items() if not given(k)}
+    missing = [k for k in _PROBLEM_UNIT_KEYS if not given(k) and k not in taken]
+    if missing:
+        data, flutter = DataSection(), FlutterSection()
+        defaults = {"data.V0": data.V0, "data.dt": data.dt, "data.duration": data.duration,
+                    "data.band": list(data.band), "flutter.V_range": list(flutter.V_range),
+                    "data.coupling_delay": data.coupling_delay}
+        for key in defaults:            # the values the run would take: the file's, if any
+            section, field_name = key.split(".")
+            if _given(table, key):
+                defaults[key] = table[section][field_name]
+        seed = ", ".join(f"{k} = {defaults[k]!r}" for k in missing)
+        rom = [k for k, v in _ROUTE_KEYS.items() if v in missing]
+        whose = ("the seed wing's" if changed is None else
+                 f"those of {file_problem}, for which the configuration file was written")
+        raise ConfigError(
+            f"problem {name} is a {kind} file in its own units, and the run's values of "
+            f"{', '.join(missing)} are {whose} ({seed}): set "
+            f"{', '.join(missing)} in the run configuration"
+            + (f" (or give {name} a [rom] table with {', '.join(rom)}: the settings of "
+               f"casflutter flutter {name}, which the run then takes)" if rom else "")
+            + ("; data.coupling_delay is 0 for a simulator's records (as casflutter flutter "
+               "takes them), 1 for the paper's loosely coupled CFD march, which the HWL "
+               "orders' input delay r = 1 (Table I) expects"
+               if "data.coupling_delay" in missing else ""))
+    for key, value in taken.items():
+        set_dotted(table, RunConfig, key, value)
+    if taken:
+        logging.getLogger("casflutter.pipeline").info(
+            "from the [rom] table of %s (%s): %s", name,
+            "not set in the run configuration" if changed is None else
+            f"the configuration file's values are {file_problem}'s",
+            ", ".join(f"{k} = {v!r}" for k, v in taken.items()))

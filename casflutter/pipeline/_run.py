@@ -13,7 +13,9 @@ The model stages depend on the problem and are chosen in one place
 on a GAF file the rational-function approximation of ``Q(ik)`` with p–k beside it, and on a
 plant family file (``kind = "plant_family"``) the gridded family and its crossings.  Then the
 optional ``stages``, each run only where the problem offers what it needs (a skipped stage is
-logged once and listed in ``RunResult.skipped``):
+logged once and listed in ``RunResult.skipped``; a stage list of the configuration's own
+that names one the problem cannot run is refused by :func:`casflutter.pipeline.load_config`
+before any work, :func:`check_requested_stages`):
 
 - ``frozen`` — the flutter speed of the truth with its aerodynamics frozen at ``V0``
   (:func:`casflutter.truth.frozen_aero_truth`): the V²-scaling part of the ROM's error;
@@ -142,6 +144,40 @@ def _skips(cfg: RunConfig, route: Route, problem) -> dict:
     if "lco" in skipped:
         skipped.pop("truth_lco", None)
     return skipped
+
+
+def check_requested_stages(cfg: RunConfig) -> None:
+    """Refuse, before any work, a stage named in ``stages`` that the problem's route cannot
+    run (:func:`_skips`: a stage that needs a truth simulator on a wing file, ``lco`` on a
+    linear ROM ...).  :func:`casflutter.pipeline.load_config` calls it when the
+    configuration names a stage list of its own; a stage of the default list (left out, or
+    spelt out as in the seed wing's files) that cannot run is only skipped, with a note.
+    The parts of a stage that the problem lacks (the truth's flutter or LCO on a wing file)
+    stay notes.
+
+    Parameters
+    ----------
+    cfg : RunConfig
+        A validated configuration whose ``stages`` the user gave.
+
+    Raises
+    ------
+    ConfigError
+        Naming each requested stage that cannot run and why.
+    """
+    problem = cfg.problem.load()
+    route = route_of(problem)
+    skipped = _skips(cfg, route, problem)
+    refused = [s for s in cfg.stages if s in skipped]
+    if route.kind == "family":     # a family file runs the controller stage alone
+        refused += [s for s in cfg.stages if s != "controller" and s not in refused]
+        skipped = {**{s: f"stage {s!r}: a plant family file has no records or simulator "
+                          "(only the 'controller' stage runs)" for s in refused}, **skipped}
+    if refused:
+        hint = ("" if all("from stages" in skipped[s] for s in refused) else
+                f"; leave {', '.join(map(repr, refused))} out of stages")
+        raise ConfigError(f"stages = {list(cfg.stages)!r} names what cannot run here: "
+                          + "; ".join(skipped[s] for s in refused) + hint)
 
 
 def _checked(cfg: RunConfig, route: Route, problem) -> RunConfig:

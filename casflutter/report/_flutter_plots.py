@@ -202,8 +202,12 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
 
     One row per channel and a spectrum row.  With the truth's response the ROM's is drawn
     in the left column and the truth's in the right one, each over its own last ``cycles``
-    periods with the same vertical scale per row, so that both wave forms and amplitudes
-    can be read and compared.
+    periods (the whole record when it holds fewer, or the response is no cycle).  Where
+    both are bounded the columns share the vertical scale per row, so that both wave forms
+    and amplitudes can be read and compared; where one diverges, each column is scaled to
+    its own signal (a shared scale would flatten the bounded one).  The spectrum axis runs
+    to 4x the largest LCO frequency of the columns (each column's own where neither is an
+    LCO).
 
     Parameters
     ----------
@@ -214,7 +218,8 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
     channels : sequence of int, optional
         0-based channels to draw (default all).
     fmax_hz : float, optional
-        Upper limit of the spectrum axis (default 4× the fundamental).
+        Upper limit of the spectrum axis (default 4× the largest LCO frequency drawn, else
+        4× each column's own frequency).
     truth : casflutter.truth.TruthLco, optional
         The truth's own response beside the ROM's (sensor outputs only), from
         :func:`casflutter.truth.truth_lco`.
@@ -251,10 +256,24 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
     ncol = len(pairs)
     hz = "Hz" if time_unit == "s" else f"cycles per {time_unit}"
     fig, axes = plt.subplots(len(chans) + 1, ncol, figsize=(5.2 * ncol + 1.2, 2.1 * len(chans) + 2.6),
-                             squeeze=False, sharey="row")
+                             squeeze=False)
+    kinds = [a.kind if a is not None else None for *_, a, _ in pairs]
+    if ncol > 1 and "divergence" not in kinds:       # comparable: one vertical scale per row
+        for row in range(len(chans) + 1):
+            for col in range(1, ncol):
+                axes[row, col].sharey(axes[row, 0])
+    # the spectrum axis: up to 4x the largest LCO frequency drawn (the truth's and the ROM's
+    # cycles both on it), else each column's own frequency
+    lco_f = [a.frequency_hz for *_, a, _ in pairs
+             if a is not None and a.kind == "lco" and np.isfinite(a.frequency_hz)
+             and a.frequency_hz > 0]
     for col, (label, t, Z, a, V) in enumerate(pairs):
         f = a.frequency_hz if a is not None else float("nan")
-        tt, ZZ = _last_cycles(t, Z, f, cycles)
+        # the last periods of a cycle; the whole record of a divergence (its "frequency" is
+        # no period) or of a record shorter than those periods
+        tt, ZZ = _last_cycles(t, Z, f if a is not None and a.kind != "divergence"
+                              else float("nan"), cycles)
+        cut = tt.size < t.size
         air = f" ({V * speed_scale:.4g} {speed_unit})" if speed_unit else ""
         head = f"{label} at V = {V:.4g}{air}: {a.kind if a is not None else ''}"
         if a is not None and a.kind == "lco":
@@ -273,16 +292,15 @@ def plot_lco(sim, *, which: str = "sensors", channels=None, fmax_hz: float | Non
                 ax.set_ylabel(names[row], fontsize="small")
             ax.grid(True, alpha=0.3)
         axes[len(chans) - 1, col].set_xlabel(
-            f"time [{time_unit}]" + (f" (last {cycles} periods)" if np.isfinite(f) and f > 0
-                                     else ""))
+            f"time [{time_unit}]" + (f" (last {cycles} periods)" if cut else ""))
         afr = axes[len(chans), col]
         dom = a.dominant if a is not None else 0
         if a is not None and a.spectrum.size:
             afr.plot(a.spectrum_freq_hz, a.spectrum, color="C0" if col == 0 else "k", lw=0.9)
-            if np.isfinite(f):
+            if np.isfinite(f) and a.kind != "divergence":
                 afr.axvline(f, color="r", ls="--", lw=0.8)
-        fmax = fmax_hz or (4 * an.frequency_hz if an is not None
-                           and np.isfinite(an.frequency_hz) else None)
+        own = 4 * f if np.isfinite(f) and f > 0 else None
+        fmax = fmax_hz or (4 * max(lco_f) if lco_f else own)
         if fmax:
             afr.set_xlim(0, fmax)
         afr.set_xlabel(f"frequency [{hz}]")

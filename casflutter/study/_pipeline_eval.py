@@ -263,8 +263,22 @@ def _rom_flutter_settings(settings: Mapping[str, Any]) -> dict:
     if "config" not in settings:
         settings["config"] = str(config_path(problem, "flutter"))
     if not parametric:
-        settings["stages"] = ["frozen"]
+        # the frozen-aero truth beside the ROM where there is a truth (a stage list of the
+        # configuration's own naming one the problem cannot run is refused)
+        settings["stages"] = ["frozen"] if _has_truth(settings) else []
     return settings
+
+
+def _has_truth(settings: Mapping[str, Any]) -> bool:
+    """Whether the problem of the settings' configuration has a truth simulator (``True``
+    when the configuration does not load: the point's own call then names the error)."""
+    from ..truth import AeroelasticTruth
+
+    try:
+        cfg = pipeline_config({}, {**settings, "stages": []})
+    except ConfigError:
+        return True
+    return isinstance(cfg.problem.load(), AeroelasticTruth)
 
 
 def rom_flutter_check(params: Mapping[str, Any], settings: Mapping[str, Any]) -> None:

@@ -132,8 +132,8 @@ def test_an_unstable_rom_loop_has_no_flutter_speed_and_says_so(wing, caplog):
 
 
 def test_a_stage_that_needs_the_flutter_speed_is_refused_with_the_reason(wing):
-    cfg = load_config(wing / "run_na2.toml", updates={"stages": ["lco"]})
-    with pytest.raises(CasflutterError, match=r"unstable already at V = 0\.3.*stage 'lco' "
+    cfg = load_config(wing / "run_na2.toml", updates={"stages": ["controller"]})
+    with pytest.raises(CasflutterError, match=r"unstable already at V = 0\.3.*stage 'controller' "
                                               r"needs the ROM's flutter speed"):
         model_stages(cfg, cfg.problem.load())
 

@@ -124,7 +124,10 @@ def test_lco_figure_puts_rom_and_truth_in_their_own_panels():
     # each column draws its own record only (one line per time panel)
     assert len(axes[0, 0].get_lines()) == len(axes[0, 1].get_lines()) == 1
     assert fig._suptitle.get_text() == "Fig. 9: LCO"
-    assert axes[0, 1].get_shared_y_axes().joined(axes[0, 0], axes[0, 1])
+    # one vertical scale per row where both are bounded; a divergence (this short truth
+    # run's) would flatten the other column, so each is scaled to its own signal then
+    bounded = not any(a.get_title().endswith("divergence") for a in axes[0])
+    assert axes[0, 1].get_shared_y_axes().joined(axes[0, 0], axes[0, 1]) is bounded
     fig = plot_lco(sim, truth=tr, labels=labels, speed_scale=28.9, speed_unit="m/s")
     assert fig.axes[1].get_title().startswith("truth at V = 1.2 (34.68 m/s)")
 

@@ -146,7 +146,7 @@ def test_required_speed_range_decides_robustness(tmp_path, capsys):
     beyond = [f"{lo + 0.1 * (1 - lo):.12g}", f"{1.01 * hi:.12g}"]
     assert main(["verify", *files, "--require-v", *beyond]) == 1
     last = capsys.readouterr().out.strip().splitlines()[-1]
-    assert "FAILED, not robust" in last and f"{hi:.6g}" in last
+    assert "FAILED, not stable over the required" in last and f"{hi:.6g}" in last
     # a range without the delta channel cannot be checked: a clear error, before any work
     save_json(plant_to_json(wing_lft(wing("state"), 1.0), 2, 1), tmp_path / "P2.json")
     assert main(["verify", str(tmp_path / "P2.json"), files[1], "--require-v", "0.5",

@@ -5,7 +5,15 @@ Exit status: 0 when the run finished and every check it made passed (the ``verif
 interval, and the margins over it with ``verify.require_margins``; the closed-loop
 simulations; a ROM loop stable at the start of ``flutter.V_range``),
 3 when it finished and wrote its outputs but a check failed (``checks passed: False``;
-summary.json says which), 1 or 2 for a run refused or stopped."""
+summary.json says which), 1 or 2 for a run refused or stopped.  A stage named in
+``stages`` that cannot run on the problem (``lco`` on a linear ROM, a stage that needs a
+simulator on a wing file ...) is refused before any work (1); only a stage of the default
+list (``stages`` left out, or spelt out as that list) that cannot run is skipped, with a
+note (summary.json ``skipped``), and leaves the status as it is.  On a rig file the keys in
+its own units (``data.V0``, ``dt``, ``duration``, ``band``, ``flutter.V_range``) that the
+configuration leaves out come from the file's ``[rom]`` table (as ``casflutter flutter``
+takes them), not from the seed wing's defaults; one that neither gives, and
+``data.coupling_delay`` left out, is refused before any work (1), named."""
 
 from __future__ import annotations
 

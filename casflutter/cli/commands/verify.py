@@ -6,9 +6,12 @@ closed-loop poles, exact H∞ norm and peak frequency, and for an LFT in ΔV (``
 speed-index intervals (Lum et al. 2016, eq. 10-16).
 
 The verdict is the exit code: 0 when the nominal closed loop is stable and, with
-``--require-v LO HI``, stays stable over that whole speed-index range (the exact interval
-covers it; no margin is required on this route); 1 otherwise, the last line (``verdict`` in
-the JSON) saying which check failed.  A plant family (the first file not a ``.json``) is
+``--require-v LO HI``, stays stable over that whole speed-index range (the LFT's exact
+stability interval covers it; no gain or phase margin is checked on this route, so the
+verdict says "stable", never "robust"); 1 otherwise, the last line (``verdict`` in the JSON)
+saying which check failed.  A file of a run's output folder other than ``plant.json`` and
+``controller.json`` (its ``summary.json``, ``config.json``, ``manifest.json``) is refused
+with the file to pass instead.  A plant family (the first file not a ``.json``) is
 verified by :mod:`casflutter.cli._verify_family`, whose ``--require-v`` also requires the
 ``--margins`` thresholds.
 The JSON is strict: a non-finite number (the γ of an unstable loop, an unbounded interval
@@ -69,23 +72,27 @@ def verdict(report, require_v=None) -> dict:
     ----------
     report : VerificationReport
     require_v : (float, float), optional
-        Speed-index range that the exact stability interval must cover (robustness).
+        Speed-index range that the LFT's exact stability interval must cover (stability
+        only: no margins are checked on a single plant).
 
     Returns
     -------
     dict
-        ``stable``; ``required_V``; ``robust`` (``None`` without ``require_v``: not asked)
-        and ``small_gain_covers`` (whether the paper's small-gain interval alone certifies
-        the range); ``passed``; ``reason`` (one sentence).
+        ``stable``; ``required_V``; ``stable_over_required`` (the exact interval covers
+        ``require_v``; ``None`` without it: not asked) and ``robust``, the same value under
+        its older name (it asks no margins); ``small_gain_covers`` (whether the paper's
+        small-gain interval alone certifies the range); ``passed``; ``reason`` (one
+        sentence saying which test certified what).
     """
-    out = {"stable": bool(report.stable), "required_V": None, "robust": None,
-           "small_gain_covers": None}
+    out = {"stable": bool(report.stable), "required_V": None, "stable_over_required": None,
+           "robust": None, "small_gain_covers": None}
     if require_v is not None:
         lo, hi = (float(x) for x in require_v)
         out["required_V"] = [lo, hi]
         ex = report.exact_V
-        out["robust"] = bool(report.stable and ex is not None
-                             and (ex[0] < lo or ex[0] == 0.0) and hi < ex[1])
+        covered = bool(report.stable and ex is not None
+                       and (ex[0] < lo or ex[0] == 0.0) and hi < ex[1])
+        out["stable_over_required"] = out["robust"] = covered
         sg = report.small_gain_V
         out["small_gain_covers"] = bool(report.stable and sg is not None
                                         and (sg[0] < lo or sg[0] == 0.0) and hi < sg[1])
@@ -103,15 +110,23 @@ def verdict(report, require_v=None) -> dict:
     elif not report.stable:
         reason = (f"not stable: the nominal closed loop has a pole with real part "
                   f"{report.spectral_abscissa:.6g} >= 0")
-    elif out["robust"] is False:
-        ex = report.exact_V
-        reason = (f"not robust: stable only for V in ({ex[0]:.6g}, {ex[1]:.6g}), which does "
-                  f"not cover the required [{out['required_V'][0]:.6g}, "
-                  f"{out['required_V'][1]:.6g}]")
-    elif out["robust"]:
-        reason = (f"stable at every V in [{out['required_V'][0]:.6g}, "
-                  f"{out['required_V'][1]:.6g}] (the LFT's exact interval; no gain or phase "
-                  "margins are checked on a single plant)")
+    elif out["stable_over_required"] is False:
+        ex, (lo, hi) = report.exact_V, out["required_V"]
+        reason = (f"not stable over the required V in [{lo:.6g}, {hi:.6g}]: "
+                  + ("the LFT's exact stability interval could not be computed"
+                     if ex is None else
+                     f"the LFT's exact stability interval (eq. 10-15) is only "
+                     f"({ex[0]:.6g}, {ex[1]:.6g})"))
+    elif out["stable_over_required"]:
+        ex, sg, (lo, hi) = report.exact_V, report.small_gain_V, out["required_V"]
+        reason = (f"stable at every V in [{lo:.6g}, {hi:.6g}]: the LFT's exact stability "
+                  f"interval (eq. 10-15) ({ex[0]:.6g}, {ex[1]:.6g}) covers it, "
+                  + ("and so does the small-gain interval (eq. 16)" if out["small_gain_covers"]
+                     else "the small-gain interval (eq. 16)"
+                     + ("" if sg is None else f" ({sg[0]:.6g}, {sg[1]:.6g})")
+                     + " alone does not")
+                  + "; stability only: no gain or phase margins are checked on a single "
+                  "plant (casflutter verify FAMILY CONTROLLER --require-v checks them)")
     else:
         reason = "stable (no speed range required: pass --require-v LO HI to check one)"
     out["passed"] = bool(report.stable and out["robust"] is not False)
@@ -141,6 +156,46 @@ def _peek(path: str) -> dict:
 
 #: keys only a plant file has (the partition, the ΔV channel, COMPleib's blocks)
 _PLANT_KEYS = {"nmeas", "ncon", "n_delta", "Vf", "B1", "C1", "D11"}
+
+
+#: a run's output files that are neither plant nor controller: what marks each
+_RUN_FILES = {"summary.json": lambda d: {"route", "timings_s", "flutter"} <= set(d),
+              "config.json": lambda d: {"problem", "data", "rom", "flutter"} <= set(d),
+              "manifest.json": lambda d: str(d.get("format", "")).startswith(
+                  "casflutter-output-manifest")}
+
+
+def _check_run_file(path: str, doc: dict, role: str) -> None:
+    """Refuse a run's ``summary.json``, ``config.json`` or ``manifest.json`` given as PLANT
+    or CONTROLLER, naming the file of the same output folder to pass instead."""
+    kind = next((name for name, marks in _RUN_FILES.items() if doc and marks(doc)), None)
+    if kind is None:
+        return
+    folder = Path(path).parent
+    plant, controller = folder / "plant.json", folder / "controller.json"
+    head = (f"{role} {path} is the {kind} of a casflutter run (its output folder), not a "
+            f"{role.lower()} file")
+    if role == "CONTROLLER":
+        if controller.is_file():
+            raise ConfigError(f"{head}: pass {controller}, the controller the run wrote "
+                              "beside it")
+        raise ConfigError(f"{head}: a run writes controller.json only with its 'controller' "
+                          f"stage, and {folder} has none")
+    if plant.is_file():
+        raise ConfigError(f"{head}: pass {plant}, the plant the run verified its controller "
+                          f"on (the LFT at Vf): casflutter verify {plant} {controller}")
+    problem = doc.get("problem")
+    problem = problem.get("name") if isinstance(problem, dict) else problem
+    route = doc.get("route")
+    if route == "family" or (kind != "summary.json" and isinstance(problem, str)):
+        raise ConfigError(f"{head}, and {folder} has no plant.json (a run writes it only "
+                          "with a controller on a ROM loop): pass the run's problem, "
+                          f"casflutter verify {problem} {controller} (a plant family is "
+                          "verified over its speed range)")
+    raise ConfigError(f"{head}, and {folder} has no plant.json: a run writes plant.json "
+                      "(the LFT at Vf) beside controller.json only when its 'controller' "
+                      "stage ran on a ROM loop with a flutter speed; pass such a run's "
+                      "plant.json")
 
 
 def _check_order(plant: str, controller: str, pdoc: dict, kdoc: dict) -> None:
@@ -186,8 +241,10 @@ def run(args) -> int:
                           "speed interval of eq. 10-15: drop them")
     from ...verify import load_controller, load_plant, verify_controller
 
-    pdoc = _peek(args.plant)
-    _check_order(args.plant, args.controller, pdoc, _peek(args.controller))
+    pdoc, kdoc = _peek(args.plant), _peek(args.controller)
+    _check_run_file(args.plant, pdoc, "PLANT")
+    _check_run_file(args.controller, kdoc, "CONTROLLER")
+    _check_order(args.plant, args.controller, pdoc, kdoc)
     plant = load_plant(args.plant)
     K = load_controller(args.controller)
     nmeas = args.nmeas if args.nmeas is not None else plant.nmeas
