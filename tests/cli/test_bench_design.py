@@ -81,8 +81,7 @@ def test_a_run_configuration_designs_with_its_controller_settings(tmp_path, monk
                                                                   problem, from_run):
     """The bench measures the design ``casflutter run`` makes: a run configuration's
     ``[controller]`` settings (goland_gaf's: no full-order start, ``Dk = 0``, 40 H-inf
-    iterations), a family file the ``[controller]`` defaults of a run that names it (no
-    flap-rate weight: that is a servo's, which a family does not have)."""
+    iterations), a family file the ``[controller]`` defaults of a run that names it."""
     import casflutter.design as design
     from casflutter.errors import SynthesisError
     from casflutter.pipeline import config_path, load_config
@@ -111,4 +110,5 @@ def test_a_run_configuration_designs_with_its_controller_settings(tmp_path, monk
         c = RunConfig().controller
         assert (settings.full_order, settings.strictly_proper, settings.random_starts,
                 settings.synthesis.max_outer, settings.rate_weight) \
-            == (c.full_order, c.strictly_proper, c.random_starts, c.max_outer, 0.0)
+            == (c.full_order, c.strictly_proper, c.random_starts, c.max_outer,
+                c.flap_rate_weight)

@@ -146,7 +146,7 @@ def test_bench_design_out_in_a_missing_folder_is_written(tmp_path):
     write_family(fam, tmp_path / "fam.toml", fam.speeds)
     out = tmp_path / "new" / "sub" / "bench.json"
     assert main(["-q", "bench", "design", "--problem", str(tmp_path / "fam.toml"),
-                 "--interval", "0.1", "0.5", "--orders", "0", "--seeds", "0",
+                 "--interval", "0.1", "0.5", "--orders", "1", "--seeds", "0",
                  "--out", str(out)]) == 0
     (rec,) = json.loads(out.read_text())["records"]
     assert rec["held"] is True and sorted(p.name for p in out.parent.iterdir()) == ["bench.json"]
