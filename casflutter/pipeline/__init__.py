@@ -20,13 +20,13 @@ from ._config import (STAGES, ClosedLoopSection, ControllerSettings, DataSection
 from ._control import ControllerStage, multispeed_settings, start_controller
 from ._model import ROUTES, FlutterStage, ModelStage, ParametricResult, Route
 from ._result import ClosedLoopChecks, LcoResult, RunResult, SimulationCheck
-from ._run import design_family, model_stages, run
+from ._run import check_requested_stages, design_family, model_stages, run
 from ._suppression import SuppressionStage
 
 __all__ = [
     "run", "RunResult", "LcoResult", "ParametricResult", "SimulationCheck", "ClosedLoopChecks",
     "ModelStage", "FlutterStage", "ControllerStage", "SuppressionStage", "ROUTES", "Route", "design_family",
-    "multispeed_settings", "start_controller", "model_stages",
+    "multispeed_settings", "start_controller", "model_stages", "check_requested_stages",
     "RunConfig", "load_config", "default_config_path", "config_path", "flutter_config",
     "STAGES",
     "ProblemSection", "DataSection", "RomSection", "FlutterSection", "LcoSection",

@@ -75,7 +75,7 @@ from ._model import (ROUTES, FlutterStage, ModelStage, Route, controlled_family,
 from ._result import ClosedLoopChecks, LcoResult, RunResult, SimulationCheck, skipped_notes
 from ._suppression import suppression_stage
 
-__all__ = ["run", "model_stages", "design_family"]
+__all__ = ["run", "model_stages", "design_family", "check_requested_stages"]
 
 log = logging.getLogger("casflutter.pipeline")
 
@@ -149,11 +149,12 @@ def _skips(cfg: RunConfig, route: Route, problem) -> dict:
 def check_requested_stages(cfg: RunConfig) -> None:
     """Refuse, before any work, a stage named in ``stages`` that the problem's route cannot
     run (:func:`_skips`: a stage that needs a truth simulator on a wing file, ``lco`` on a
-    linear ROM ...).  :func:`casflutter.pipeline.load_config` calls it when the
-    configuration names a stage list of its own; a stage of the default list (left out, or
-    spelt out as in the seed wing's files) that cannot run is only skipped, with a note.
-    The parts of a stage that the problem lacks (the truth's flutter or LCO on a wing file)
-    stay notes.
+    linear ROM ...), where the configuration names a stage list of its own.  A stage of the
+    default list (left out, or spelt out as in the seed wing's files) that cannot run is
+    only skipped by :func:`run`, with a note, as is any stage of a configuration that is
+    not checked here.  ``casflutter run`` checks every configuration it loads.  The parts
+    of a stage that the problem lacks (the truth's flutter or LCO on a wing file) stay
+    notes.
 
     Parameters
     ----------
@@ -165,6 +166,8 @@ def check_requested_stages(cfg: RunConfig) -> None:
     ConfigError
         Naming each requested stage that cannot run and why.
     """
+    if set(cfg.stages) == set(RunConfig().stages):     # the default list: notes only
+        return
     problem = cfg.problem.load()
     route = route_of(problem)
     skipped = _skips(cfg, route, problem)

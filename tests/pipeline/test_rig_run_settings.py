@@ -31,7 +31,8 @@ from casflutter._resources import problems_dir, read_toml  # noqa: E402
 from casflutter._settings import build_settings  # noqa: E402
 from casflutter.cli import main  # noqa: E402
 from casflutter.errors import ConfigError  # noqa: E402
-from casflutter.pipeline import RunConfig, default_config_path, flutter_config  # noqa: E402
+from casflutter.pipeline import (RunConfig, check_requested_stages,  # noqa: E402
+                                 default_config_path, flutter_config)
 
 NATA = problems_dir() / "nata" / "problem.toml"
 
@@ -146,7 +147,7 @@ def test_rig_without_rom_table_is_refused_naming_the_keys(tmp_path):
 def test_requested_stage_that_cannot_run_is_refused_before_any_work(tmp_path, capsys):
     path = _write_run(tmp_path)
     with pytest.raises(ConfigError, match="stage 'lco'.*linear"):
-        cf.load_config(path, updates={"stages": ["lco"]})
+        check_requested_stages(cf.load_config(path, updates={"stages": ["lco"]}))
     out = tmp_path / "out"
     assert main(["run", str(path), "--out", str(out), "--set", 'stages=["lco"]']) == 1
     err = capsys.readouterr().err
@@ -164,7 +165,8 @@ def test_requested_stage_needing_a_simulator_is_refused_on_a_wing_file():
     from casflutter.pipeline import config_path
 
     with pytest.raises(ConfigError, match="stage 'frozen': needs a truth simulator"):
-        cf.load_config(config_path("example_wing", "run"), updates={"stages": ["frozen"]})
+        check_requested_stages(cf.load_config(config_path("example_wing", "run"),
+                                              updates={"stages": ["frozen"]}))
 
 
 # ------------------------------------------------------------------ P5: Fig. 9 axes

@@ -158,10 +158,11 @@ def config_updates(items) -> dict:
 
 
 def _main(args) -> int:
-    from ...pipeline import load_config, run
+    from ...pipeline import check_requested_stages, load_config, run
 
     # validated before any work starts
     cfg = load_config(args.config, updates=config_updates(args.sets))
+    check_requested_stages(cfg)         # a stage asked for by name that cannot run: refused
     # a path that cannot be a folder is refused before the package's stages are even
     # imported; the driver then refuses a non-empty folder without --overwrite, before any
     # work, and writes the outputs atomically at the end
