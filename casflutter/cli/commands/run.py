@@ -76,7 +76,7 @@ def _controller_lines(c: dict, res, unit: str) -> list[str]:
         if f"{prefix}stable_interval" not in c:
             continue
         iv, robust = c[prefix + "stable_interval"], c[prefix + "robust_flutter_speed"]
-        # a robust flutter speed at the certified interval's start: the margins never held
+        # a robust flutter speed at the certified interval's start: the margins fail there
         at_start = robust is not None and iv is not None and robust <= iv[0]
         lines.append(f"  on the {label}{servo}: certified stable over "
                      f"{sig(iv, none='no interval')} {unit}; absolute / robust flutter speed "
@@ -94,7 +94,8 @@ def _margins_line(res, unit: str) -> str:
     and whether the run's checks require them (``verify.require_margins``)."""
     check, (lo, hi) = res.control.checks["design"], res.required_V
     gm, pm = res.config.controller.margins
-    head = f"margins ({gm:g} dB / {pm:g} deg) over the required [{lo:.5g}, {hi:.5g}] {unit}: "
+    head = (f"margins ({gm:g} dB / {pm:g} deg) on the design model over the required "
+            f"[{lo:.5g}, {hi:.5g}] {unit}: ")
     if res.robust_ok:
         return head + "held (robust)"
     rfs, reasons = check.robust_flutter_speed, check.robust_reason.split("; ")
