@@ -690,12 +690,15 @@ class RunResult:
             return None
         sim, tr = self.lco.rom, self.lco.truth
         sens = sim.sensors if sim.sensors is not None else sim.modes
+        # a frequency and an amplitude are a cycle's: a divergence or a decay has none
+        cycle, truth_cycle = sens.kind == "lco", tr is not None and tr.kind == "lco"
         return {"V": self.lco.V, "V_hopf_exact_order": self.lco.V_hopf_exact_order,
                 "V_hopf_loop": self.lco.V_hopf_loop,
-                "freq_hz": sens.frequency_hz, "amplitude": list(sens.amplitude),
+                "freq_hz": sens.frequency_hz if cycle else None,
+                "amplitude": list(sens.amplitude) if cycle else None,
                 "kind": sens.kind, "truth_V": None if tr is None else tr.V,
-                "truth_freq_hz": None if tr is None else tr.freq_hz,
-                "truth_amplitude": None if tr is None else list(tr.amplitude),
+                "truth_freq_hz": tr.freq_hz if truth_cycle else None,
+                "truth_amplitude": list(tr.amplitude) if truth_cycle else None,
                 "truth_kind": None if tr is None else tr.kind,
                 "branches": {name: {"V_hopf": br.hopf.V, "kind": br.hopf.kind,
                                     "points": len(br.points), "completed": br.completed}

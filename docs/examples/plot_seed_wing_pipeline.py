@@ -46,10 +46,15 @@ fl, ft = s["flutter"], s["flutter_truth"]
 print(f"ROM flutter:   Vf = {fl['V']:.3f} at {fl['freq_hz']:.2f} Hz, mode {fl['mode']}   "
       "(paper: Vf = 1.20, lateral mode 2)")
 print(f"truth flutter: Vf = {ft['V']:.3f} at {ft['freq_hz']:.2f} Hz, mode {ft['mode']}")
-print(f"ROM LCO at V = {s['lco']['V']:.3f}: {s['lco']['kind']}, {s['lco']['freq_hz']:.2f} Hz "
-      "(paper: 8.5 Hz)")
-print(f"truth LCO at V = {s['lco']['truth_V']:.3f}: {s['lco']['truth_kind']}, "
-      f"{s['lco']['truth_freq_hz']:.2f} Hz")
+lco = s["lco"]      # a frequency is a cycle's: None for a decay or a divergence
+
+
+def hz(f):
+    return "no cycle" if f is None else f"{f:.2f} Hz"
+
+
+print(f"ROM LCO at V = {lco['V']:.3f}: {lco['kind']}, {hz(lco['freq_hz'])} (paper: 8.5 Hz)")
+print(f"truth LCO at V = {lco['truth_V']:.3f}: {lco['truth_kind']}, {hz(lco['truth_freq_hz'])}")
 c = s["controller"]
 print(f"controller order {c['order']}: gamma = {c['gamma']:.4g}, small-gain V interval "
       f"({c['small_gain_V'][0]:.3f}, {c['small_gain_V'][1]:.3f}), exact stable V interval "

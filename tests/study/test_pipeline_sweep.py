@@ -133,8 +133,9 @@ def test_swept_point_equals_a_direct_run(swept):
         "mode_rom": s["flutter"]["mode"], "Vf_truth": s["flutter_truth"]["V"],
         "freq_hz_truth": s["flutter_truth"]["freq_hz"], "lco_V": s["lco"]["V"],
         "lco_freq_hz": s["lco"]["freq_hz"], "lco_kind": s["lco"]["kind"],
-        "lco_amplitude": max(s["lco"]["amplitude"]),
-        "lco_truth_amplitude": max(s["lco"]["truth_amplitude"]),
+        # amplitudes are a cycle's only (None for a decay or a divergence)
+        "lco_amplitude": max(s["lco"]["amplitude"] or [None]),
+        "lco_truth_amplitude": max(s["lco"]["truth_amplitude"] or [None]),
         "controller_order": s["controller"]["order"], "gamma": s["controller"]["gamma"],
         "small_gain_V_lo": s["controller"]["small_gain_V"][0],
         "small_gain_V_hi": s["controller"]["small_gain_V"][1],
