@@ -6,6 +6,8 @@ it is, with the file to pass instead (probe 5, P10)."""
 from __future__ import annotations
 
 import json
+import sys
+from pathlib import Path
 
 import control
 import numpy as np
@@ -14,34 +16,18 @@ import pytest
 from casflutter.cli import main
 from casflutter.verify import controller_to_json, plant_to_json, save_json
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "verify"))
+from verify_helpers import lqg_controller, wing, wing_lft, wing_plant_at  # noqa: E402
+
 VF = 1.0
 
 
 def _toy():
-    """Two-mode toy wing (state sensors; the LFT of eq. 14 at Vf) and an LQG controller
-    designed at Vf."""
-    N = 2
-    K, Cd = np.diag([1.0, 4.0]), np.diag([0.04, 0.08])
-    As = np.block([[np.zeros((N, N)), np.eye(N)], [-K, -Cd]])
-    Bs = np.vstack([np.zeros((N, N)), np.eye(N)])
-    Nx = np.hstack([np.array([[0.0, 1.0], [-1.0, 1.0]]),
-                    np.array([[-0.15, 0.05], [0.02, -0.05]])])
-    Nv = np.array([[0.3], [-0.5]])
-    Hx = np.hstack([np.eye(N), np.zeros((N, N))])
-
-    def plant_at(V):
-        return control.ss(As + V**2 * Bs @ Nx, V**2 * Bs @ Nv, Hx, np.zeros((N, 1)))
-
-    lft = control.ss(As + VF**2 * Bs @ Nx, np.hstack([-Bs, Bs, VF**2 * Bs @ Nv]),
-                     np.vstack([Nx, Hx]),
-                     np.block([[np.zeros((N, 2 * N)), Nv], [np.zeros((N, 2 * N + 1))]]))
-    P = plant_at(VF)
-    A, B, C = (np.asarray(M, float) for M in (P.A, P.B, P.C))
-    n = A.shape[0]
-    Kc, _, _ = control.lqr(A, B, np.eye(n), np.eye(1))
-    L, _, _ = control.lqe(A, np.eye(n), C, np.eye(n), 0.1 * np.eye(C.shape[0]))
-    Kk = control.ss(A - L @ C - B @ Kc, L, -Kc, np.zeros((1, N)))
-    return lft, Kk, plant_at
+    """Two-mode toy wing of the verification tests (state sensors; the LFT of eq. 14 at
+    Vf) and an LQG controller designed at Vf."""
+    w = wing("state")
+    Kk = lqg_controller(wing_plant_at(w, VF), np.zeros((1, w["N"])))
+    return wing_lft(w, VF), Kk, lambda V: wing_plant_at(w, V)
 
 
 def _upper_end(plant_at, Kk) -> float:
