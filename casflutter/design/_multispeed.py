@@ -69,10 +69,11 @@ from .._threads import single_threaded
 from ..errors import ConfigError, DimensionError, SynthesisError
 from ._bfgs import nonsmooth_bfgs
 from ._out_of_reach import modes_out_of_reach
-from ._plant import partition
+from ._plant import controller_only, partition
 from ._problem import verify_closed_loop
 from ._speeds import DesignChannels, Scaling, SpeedLoops, design_partition
-from ._synthesis import SynthesisOptions, SynthesisResult, synthesize
+from ._synthesis import (STABLE_CONTROLLER_NOTE, SynthesisOptions, SynthesisResult,
+                         synthesize)
 
 __all__ = ["MultiSpeedSettings", "MultiSpeedDesign", "HoldRecord", "design_over_speeds",
            "default_objective"]
@@ -120,6 +121,11 @@ class MultiSpeedSettings:
     """Keep ``Dk = 0``; ``None``: strictly proper exactly when some model's controls reach its
     measurements directly (a feed-through would close an algebraic loop that can become
     singular at some speed)."""
+    stable_controller: bool = False
+    """Keep the controller's own poles decaying at the rate ``decay`` too, in every phase
+    (systune's controller-pole requirement): the loop then stays stable when it is opened,
+    e.g. by a sensor or actuator that drops out or for a ground test.  Without it a
+    controller may be unstable itself (the run's pole check warns)."""
     random_starts: int = 2
     """Seeded random starts at the target order from the low end, after the first one (a
     seeded controller with small couplings, near zero)."""
@@ -140,7 +146,7 @@ class MultiSpeedSettings:
     synthesis: SynthesisOptions = field(default_factory=lambda: SynthesisOptions(
         max_outer=60, max_stab_rounds=100, full_order_start=False))
     """Settings of the H∞ phase (:func:`casflutter.design.synthesize`; its ``decay``,
-    ``strictly_proper`` and ``zero_start`` are set by the design)."""
+    ``strictly_proper``, ``stable_controller`` and ``zero_start`` are set by the design)."""
 
     def __post_init__(self):
         if isinstance(self.synthesis, Mapping):
@@ -277,7 +283,7 @@ class _Models:
     finite only where their loop is stable) and the scaling shared by the whole design."""
 
     def __init__(self, families: Sequence, lo: float, hi: float,
-                 fixed: Sequence[control.StateSpace] = ()):
+                 fixed: Sequence[control.StateSpace] = (), *, own: bool = False):
         self.families = tuple(families)
         sizes = {(len(f.signals.controls), len(f.signals.measurements)) for f in self.families}
         if len(sizes) != 1:
@@ -286,8 +292,10 @@ class _Models:
                                  "controls and measurements on every model")
         self.nu, self.ny = sizes.pop()
         self.fixed = [partition(P, self.ny, self.nu) for P in fixed]
+        self.own = bool(own)
         self._cache: dict = {}
         self._fixed_cache: dict = {}
+        self._own_cache: dict = {}
         probe = np.linspace(lo, hi, 5)
         parts = [p for V in probe for p in self.parts(V)]
         self.scaling = Scaling.of(parts)
@@ -309,6 +317,17 @@ class _Models:
             self._fixed_cache[order] = [self.scaling.plant(p, order) for p in self.fixed]
         return self._fixed_cache[order]
 
+    def own_plants(self, order: int) -> list:
+        """With ``own``, the plant whose loop is the controller alone (no states of its own,
+        no paths: the closed loop's state matrix is ``Ak``), scaled and augmented with
+        ``order`` controller states; else none."""
+        if not self.own or order == 0:
+            return []
+        if order not in self._own_cache:
+            self._own_cache[order] = [self.scaling.plant(controller_only(self.ny, self.nu),
+                                                         order)]
+        return self._own_cache[order]
+
     def fixed_abscissa(self, K: np.ndarray, order: int) -> float:
         """The worst spectral abscissa of the fixed plants' loops closed by ``K`` (scaled
         time; ``-inf`` without fixed plants)."""
@@ -321,7 +340,7 @@ class _Models:
               fixed: bool = False) -> SpeedLoops:
         """The scaled closed loops of every model at ``speeds`` (and of the fixed plants)."""
         sc = self.scaling
-        extra = self.fixed_plants(order) if fixed else []
+        extra = (self.fixed_plants(order) if fixed else []) + self.own_plants(order)
         return SpeedLoops([sc.plant(p, order) for V in speeds for p in self.parts(V)] + extra,
                           free, base)
 
@@ -700,7 +719,8 @@ def design_over_speeds(family, interval, order: int = 3, *,
         raise ConfigError(f"order = {order!r}: an integer >= 0")
     order = int(order)
     with single_threaded():
-        models = _Models(fams, lo, hi, fixed=[control.ss(P) for P in hinf_plants or ()])
+        models = _Models(fams, lo, hi, fixed=[control.ss(P) for P in hinf_plants or ()],
+                         own=s.stable_controller)
         s = _reachable_decay(models, s, lo, hi)
         sp = models.has_d22 if s.strictly_proper is None else bool(s.strictly_proper)
         if sp and order == 0:
@@ -744,10 +764,12 @@ def design_over_speeds(family, interval, order: int = 3, *,
                 if held is not None:
                     best = (held, (lo, hi))
         if best is None:
+            note = f" ({STABLE_CONTROLLER_NOTE})" if s.stable_controller else ""
             raise SynthesisError(
                 f"no start of order {order} decays at the rate {s.decay:g} even at the low end "
-                f"V = {lo:g} of the interval; check that the plant is stabilisable there, or "
-                "lower the decay rate", best_spectral_abscissa=float("nan"))
+                f"V = {lo:g} of the interval{note}"
+                "; check that the plant is stabilisable there, or lower the decay rate",
+                best_spectral_abscissa=float("nan"))
         K, reached = (held, (lo, hi)) if held is not None else best
         return _finish(eng, fams, K, order, (lo, hi), reached, held is not None, records,
                        hinf_plants, plan[0][1], t0)
@@ -859,7 +881,8 @@ def _hinf_phase(eng: _Engine, hinf: list, dims: tuple, K: np.ndarray, Kss, lo: f
     held controller (``rounds`` times at most).  ``None`` keeps the held controller."""
     s, models = eng.settings, eng.models
     opts = replace(s.synthesis, decay=float(s.decay), strictly_proper=eng.strictly_proper,
-                   zero_start=False, full_order_start=False)
+                   stable_controller=s.stable_controller, zero_start=False,
+                   full_order_start=False)
     speeds = np.linspace(lo, e, s.n_speeds)
     for k in range(rounds):
         stab = [_padded(P, dims) for V in speeds for P in models.parts(V)]

@@ -131,6 +131,30 @@ class Partition:
                          self.D21 / sy[:, None], self.D22 * su[None, :] / sy[:, None])
 
 
+def controller_only(nmeas: int, ncon: int, nw: int = 1, nz: int = 1) -> Partition:
+    """The plant with no states and no paths, with ``nmeas`` measurements, ``ncon``
+    controls and ``nw``, ``nz`` zero disturbances and errors.
+
+    Augmented with ``k`` controller states (:meth:`Partition.augmented`), the loop that
+    ``Kbar`` closes on it has the state matrix ``Ak``: as a stability plant it asks the
+    controller itself to decay.
+
+    Parameters
+    ----------
+    nmeas, ncon : int
+        Numbers of measurements and controls.
+    nw, nz : int
+        Numbers of (zero) disturbances and errors, to match other plants of a synthesis.
+
+    Returns
+    -------
+    Partition
+    """
+    return Partition(A=np.zeros((0, 0)), B1=np.zeros((0, nw)), B2=np.zeros((0, ncon)),
+                     C1=np.zeros((nz, 0)), C2=np.zeros((nmeas, 0)), D11=np.zeros((nz, nw)),
+                     D12=np.zeros((nz, ncon)), D21=np.zeros((nmeas, nw)))
+
+
 def partition(P: control.StateSpace, nmeas: int, ncon: int) -> Partition:
     """Split a partitioned ``StateSpace`` (inputs ``[w, u]``, outputs ``[z, y]``).
 

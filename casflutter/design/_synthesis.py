@@ -62,7 +62,7 @@ from .._threads import single_threaded
 from ..errors import CasflutterError, ConfigError, DataError, DimensionError, SynthesisError
 from ._fullorder import full_order_controller, reduced_controllers
 from ._out_of_reach import modes_out_of_reach
-from ._plant import Partition, partition
+from ._plant import Partition, controller_only, partition
 from ._problem import Cut, Problem, realize, verify_closed_loop
 from ._qp import CutQP
 
@@ -80,6 +80,14 @@ _NUMERICAL_FAILURES = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionEr
 """Exceptions that end one start as ``"failed"`` (scipy raises ``ValueError`` on arrays
 with infs or NaNs); the package's own errors (e.g. an Ipopt option refused when the first QP
 is built) are raised as they are."""
+
+
+#: why a design asked for a stable controller (``stable_controller``) may find none
+STABLE_CONTROLLER_NOTE = (
+    "the controller's own poles had to decay too (stable_controller); a plant with an odd "
+    "number of real poles between two of its real zeros in the right half-plane (infinity "
+    "counted) has no stable stabilising controller at all (the parity interlacing "
+    "property): with stable_controller = false the controller may be unstable itself")
 
 
 @dataclass(frozen=True)
@@ -113,6 +121,11 @@ class SynthesisOptions:
     strictly_proper: bool = False
     """Keep ``Dk = 0`` (a strictly proper controller): no algebraic loop through a
     control-to-measurement feed-through at any operating point."""
+    stable_controller: bool = False
+    """Keep the controller's own poles stable too (in the H∞ phase at the rate ``decay``):
+    its state matrix ``Ak`` joins the stability plants (:func:`._plant.controller_only`),
+    so the loop stays stable when it is opened, e.g. by a sensor or actuator that drops
+    out."""
     zero_start: bool = True
     """Make the first of the ``starts`` the zero controller (the others are seeded random);
     ``False``: all random."""
@@ -708,6 +721,12 @@ def synthesize(plants, nmeas: int, ncon: int, order: int, *, starts: int = 3, se
         raise DimensionError("need at least one plant")
     stab_list = _as_plants(stability_plants)
     parts = [partition(P, nmeas, ncon) for P in sys_list]
+    if opts.stable_controller and order > 0:
+        nw, nz = parts[0].dims[:2]
+        own = controller_only(nmeas, ncon, nw, nz)
+        stab_list.append(control.ss(own.A, np.hstack([own.B1, own.B2]),
+                                    np.vstack([own.C1, own.C2]),
+                                    np.block([[own.D11, own.D12], [own.D21, own.D22]])))
     sparts = [partition(P, nmeas, ncon) for P in stab_list]
     if len({P.dims for P in parts + sparts}) != 1:
         raise DimensionError(f"plants differ in (nw, nz, nu, ny): "
@@ -808,7 +827,8 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
             f"no start stabilised the closed loop (order {order}, {len(records)} starts{why}); "
             f"best spectral abscissa {best_alpha:.4g}. Check that the unstable modes are "
             "controllable from u and observable from y, that the plant is scaled sensibly, or "
-            "try a higher order / more starts",
+            "try a higher order / more starts"
+            + (f"; {STABLE_CONTROLLER_NOTE}" if opts.stable_controller else ""),
             best_spectral_abscissa=float(best_alpha), starts=tuple(records))
     gammas = tuple(float(c[0]) for c in checks)
     gamma = max(gammas)

@@ -143,7 +143,8 @@ def multispeed_settings(cfg: RunConfig, objective: str) -> MultiSpeedSettings:
         decay=c.interval_decay, n_speeds=c.n_speeds, hinf_speeds=c.hinf_speeds,
         rate_weight=c.flap_rate_weight, rate_bandwidth=c.flap_rate_bandwidth,
         sensitivity=objective == "sensitivity",
-        strictly_proper=c.strictly_proper, random_starts=c.random_starts,
+        strictly_proper=c.strictly_proper, stable_controller=c.stable_controller,
+        random_starts=c.random_starts,
         full_order=c.full_order, reduction_orders=c.reduction_orders,
         synthesis=replace(settings_as(c, SynthesisOptions), ipopt={**cfg.solver.ipopt,
                                                                    **c.ipopt}))

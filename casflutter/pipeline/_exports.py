@@ -191,7 +191,8 @@ def controller_pole_check(K, *, dt: float | None, actuator_omega: float | None =
         out["warnings"].append(
             f"the controller itself is unstable (poles at {poles} rad per {time_unit}): the "
             "loop is stable only while it is closed; a sensor or actuator that drops out, or "
-            "the loop opened for a test, leaves the controller's states growing")
+            "the loop opened for a test, leaves the controller's states growing; "
+            "[controller] stable_controller = true asks the design for a stable one")
     return out
 
 
