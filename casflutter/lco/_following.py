@@ -122,16 +122,18 @@ class LcoComparison:
         dict
             ``speed_factor``, ``V``, ``rom_kind``, ``truth_kind``, ``rom_amplitude``,
             ``truth_amplitude``, ``amplitude_error_percent`` (per sensor), ``rom_freq_hz``,
-            ``truth_freq_hz``.
+            ``truth_freq_hz``.  A model's amplitudes and frequency are its cycle's: ``None``
+            where its response is a decay or a divergence.
         """
+        rom_cycle, truth_cycle = self.rom.sensors.kind == "lco", self.truth.kind == "lco"
         return {"speed_factor": self.speed_factor, "V": self.V,
                 "rom_kind": self.rom.sensors.kind, "truth_kind": self.truth.kind,
-                "rom_amplitude": self.rom_amplitude.tolist(),
-                "truth_amplitude": list(self.truth.amplitude),
+                "rom_amplitude": self.rom_amplitude.tolist() if rom_cycle else None,
+                "truth_amplitude": list(self.truth.amplitude) if truth_cycle else None,
                 "amplitude_error_percent": [None if not np.isfinite(e) else float(e)
                                             for e in self.amplitude_error_percent],
-                "rom_freq_hz": float(self.rom.sensors.frequency_hz),
-                "truth_freq_hz": float(self.truth.freq_hz)}
+                "rom_freq_hz": float(self.rom.sensors.frequency_hz) if rom_cycle else None,
+                "truth_freq_hz": float(self.truth.freq_hz) if truth_cycle else None}
 
 
 def compare_lco(rom: SpeedFollowingROM, truth, V_flutter: float, speed_factors, *,

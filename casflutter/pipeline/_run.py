@@ -471,8 +471,10 @@ def _lco(cfg: RunConfig, truth, model, structure, flutter, flutter_truth,
         # restart at zero, a small kick that the converging LCO forgets)
         xs0 = sim.xs[-1]
     loop = "" if V_loop is None else f"loop flutter {V_loop:.5g}, "
-    log.info("ROM LCO at V = %.5g (%scontinuous exact-order Hopf %.5g): %s, %.4g Hz", V_lco,
-             loop, V_hopf, sim.sensors.kind, sim.sensors.frequency_hz)
+    # a frequency is the cycle's; a decay or a divergence has none worth printing
+    cycle = (f", {sim.sensors.frequency_hz:.4g} Hz" if sim.sensors.kind == "lco" else "")
+    log.info("ROM LCO at V = %.5g (%scontinuous exact-order Hopf %.5g): %s%s", V_lco,
+             loop, V_hopf, sim.sensors.kind, cycle)
     # the truth's simulations and the two branches are independent: worker processes
     jobs = []
     if truth is not None:

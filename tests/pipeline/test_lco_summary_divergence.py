@@ -1,4 +1,4 @@
-"""summary.json's ``lco`` record gives a frequency and amplitudes only for a cycle.
+"""summary.json's ``lco`` record (and its speed-following comparisons) gives a frequency and amplitudes only for a cycle.
 
 A rig whose HWL ROM diverges above flutter printed ``freq_hz = 0.053`` and amplitudes of
 9e11 as its "LCO" (probe of a user's nata_wagner rig).  Truth used: the response analysis
@@ -13,6 +13,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from casflutter.data import analyze_response
+from casflutter.lco import LcoComparison
 from casflutter.pipeline import RunResult
 
 
@@ -42,3 +43,17 @@ def test_a_divergence_has_no_lco_frequency_or_amplitude():
     s = _summary(cycle, growing)
     assert s["freq_hz"] is not None and s["truth_freq_hz"] is None
     assert s["truth_amplitude"] is None
+
+
+def test_a_speed_following_comparison_gives_a_divergence_no_amplitude_or_frequency():
+    growing, cycle = _analysis(0.8), _analysis(0.0)
+    truth = SimpleNamespace(kind=cycle.kind, amplitude=cycle.amplitude,
+                            freq_hz=cycle.frequency_hz)
+    rec = LcoComparison(1.05, 1.1, SimpleNamespace(sensors=growing), truth).record()
+    assert rec["rom_kind"] == "divergence"
+    assert rec["rom_amplitude"] is None and rec["rom_freq_hz"] is None
+    assert rec["amplitude_error_percent"] == [None]
+    assert abs(rec["truth_freq_hz"] - 2.5) < 0.05 and abs(rec["truth_amplitude"][0] - 1) < 0.02
+    # two cycles: the error is the amplitudes' ratio, 0 % for the same record
+    rec = LcoComparison(1.05, 1.1, SimpleNamespace(sensors=cycle), truth).record()
+    assert abs(rec["rom_freq_hz"] - 2.5) < 0.05 and abs(rec["amplitude_error_percent"][0]) < 1e-9
