@@ -27,6 +27,42 @@ def seed_wing_sigma_f():
     return realize(rom.model).sigma_f
 
 
+#: a run on the goland_4flaps family file (50 states, 4 flaps, 8 sensors, 41 airspeeds): the
+#: order-2 multi-speed design over [60, 150] m/s without an H∞ phase, in seconds
+GOLAND_FAMILY_RUN = """
+seed = 0
+stages = ["controller"]
+[problem]
+name = "goland_4flaps"
+[controller]
+order = 2
+interval = [60.0, 150.0]
+hinf_speeds = 0
+"""
+
+
+@pytest.fixture(scope="session")
+def goland_family_run_toml() -> str:
+    """The run configuration of :func:`goland_family_run` (:data:`GOLAND_FAMILY_RUN`)."""
+    return GOLAND_FAMILY_RUN
+
+
+@pytest.fixture(scope="session")
+def goland_family_run(tmp_path_factory, goland_family_run_toml):
+    """``(folder, summary)`` of ``casflutter run`` on :data:`GOLAND_FAMILY_RUN`, shared by the
+    family-run and family-report tests."""
+    import json
+
+    from casflutter.cli import main
+
+    folder = tmp_path_factory.mktemp("goland_family_run")
+    cfg = folder / "run.toml"
+    cfg.write_text(goland_family_run_toml)
+    out = folder / "out"
+    assert main(["run", str(cfg), "--out", str(out), "--quiet"]) == 0
+    return out, json.loads((out / "summary.json").read_text())
+
+
 @pytest.fixture
 def numpy_global_seed():
     """Seed numpy's global random state for the test and restore it afterwards: python-control's

@@ -17,26 +17,10 @@ import pytest
 from casflutter.aeroelastic import load_family
 from casflutter.cli import main
 
-RUN = """
-seed = 0
-stages = ["controller"]
-[problem]
-name = "goland_4flaps"
-[controller]
-order = 2
-interval = [60.0, 150.0]
-hinf_speeds = 0
-"""
-
-
 @pytest.fixture(scope="module")
-def family_run(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("family")
-    cfg = folder / "run.toml"
-    cfg.write_text(RUN)
-    out = folder / "out"
-    assert main(["run", str(cfg), "--out", str(out), "--quiet"]) == 0
-    return out, json.loads((out / "summary.json").read_text())
+def family_run(goland_family_run):
+    """The order-2 design over [60, 150] m/s (tests/conftest.py)."""
+    return goland_family_run
 
 
 def test_the_design_holds_the_interval_and_is_certified(family_run):
@@ -88,7 +72,8 @@ def test_verify_accepts_the_run_controller_and_repeats_its_certificate(family_ru
         s["controller"]["absolute_flutter_speed"], rel=1e-9)
 
 
-def test_the_runs_margin_verdict_is_verifys_and_can_be_required(family_run, tmp_path, capsys):
+def test_the_runs_margin_verdict_is_verifys_and_can_be_required(family_run, goland_family_run_toml,
+                                                             tmp_path, capsys):
     """``verification.robust_ok`` is the verdict of ``casflutter verify --require-v`` on the
     same family, controller and interval (the margins 6 dB / 45 deg held from the range's
     start to its top, the interval covered); with ``verify.require_margins = true`` the run's
@@ -104,7 +89,7 @@ def test_the_runs_margin_verdict_is_verifys_and_can_be_required(family_run, tmp_
     assert v["covered"] is True
     assert ver["robust_ok"] is v["robust"] is v["passed"] is (rc == 0)
     cfg = tmp_path / "run.toml"
-    cfg.write_text(RUN + "[verify]\nrequire_margins = true\n")
+    cfg.write_text(goland_family_run_toml + "[verify]\nrequire_margins = true\n")
     again = tmp_path / "out"
     rc_run = main(["run", str(cfg), "--out", str(again), "--quiet"])
     s2 = json.loads((again / "summary.json").read_text())

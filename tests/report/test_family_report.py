@@ -20,32 +20,16 @@ from casflutter.cli import main
 from casflutter.report import html_report, write_html
 from casflutter.report._html import PAPER_TABLE_I, _family_warnings
 
-# goland_4flaps: 50 states, 4 flaps, 8 sensors, (60, 200) m/s; order 1 without an H∞ phase
-# designs in a few seconds
-RUN = """
-seed = 0
-stages = ["controller"]
-[problem]
-name = "goland_4flaps"
-[controller]
-order = 1
-interval = [60.0, 150.0]
-hinf_speeds = 0
-"""
-
 #: text of the paper's reproduction that a family report must not carry
 PAPER_TEXT = ("Reproduction of K.-Y. Lum", "ACC 2016", "Table I", "ROM loop", "paper",
               "this run (ROM)", "flutter speed index Vf", "LCO attenuation", "order of ΣAE")
 
 
 @pytest.fixture(scope="module")
-def family_run(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("family_report")
-    cfg = folder / "run.toml"
-    cfg.write_text(RUN)
-    out = folder / "out"
-    assert main(["run", str(cfg), "--out", str(out), "--quiet"]) == 0
-    summary = json.loads((out / "summary.json").read_text())
+def family_run(goland_family_run):
+    """The order-2 design on goland_4flaps over [60, 150] m/s without an H∞ phase
+    (tests/conftest.py) and its report."""
+    out, summary = goland_family_run
     return out, summary, (out / "report.html").read_text(encoding="utf-8")
 
 
@@ -98,7 +82,7 @@ def test_the_open_loop_flutter_speed_and_frequency_are_in_the_familys_units(fami
 def test_the_controller_and_its_certificate_are_reported(family_run):
     _, s, page = family_run
     c = s["controller"]
-    assert _row(page, "order") == "1"
+    assert _row(page, "order") == str(c["order"]) == "2"
     assert _row(page, "design interval").startswith("(60, 150) m/s")
     held = ("held: the whole interval" if c["held"]
             else f"not held: reached up to {sig(c['reach'], 4)} m/s")
