@@ -100,9 +100,10 @@ class MultiSpeedSettings:
 
     decay: float | None = None
     """Decay rate [rad per time unit] the closed loop needs at every speed of the interval.
-    ``None``: 0.05, or half the rate of the slowest mode that no controller moves where
-    that is slower (a warning says so); a rate given that such a mode does not allow is
-    refused before any work."""
+    ``None``: 0.05, or half the rate of the open loop's slowest decaying mode at the
+    interval's low end, or of the slowest mode that no controller moves, where that is
+    slower (the log says so); a rate given that a mode no controller moves does not allow
+    is refused before any work."""
     n_speeds: int = 16
     """Speeds of the stability objective on each interval tried (the dense check uses 8x,
     refined beside its highest local maxima)."""
@@ -784,7 +785,8 @@ def _reachable_decay(models: _Models, s: MultiSpeedSettings, lo: float, hi: floa
     of five speeds of the interval, no controller can meet that rate: a rate the settings
     give is refused, and where they leave it open the design asks for half the slowest such
     mode's rate instead of ``DEFAULT_DECAY``, and says so.  Where one does not decay at all,
-    no controller stabilises the family: refused before any work.
+    no controller stabilises the family: refused before any work.  A rate left open is then
+    lowered further where the open loop is slower still (:func:`_open_loop_decay`).
     """
     asked = DEFAULT_DECAY if s.decay is None else float(s.decay)
     slowest = None
@@ -794,7 +796,8 @@ def _reachable_decay(models: _Models, s: MultiSpeedSettings, lo: float, hi: floa
                 if slowest is None or mode.eigenvalue.real > slowest[1].eigenvalue.real:
                     slowest = (float(V), mode, fam)
     if slowest is None:
-        return replace(s, decay=asked)
+        return replace(s, decay=asked if s.decay is not None
+                       else _open_loop_decay(models, lo, asked))
     V, mode, fam = slowest
     where = f"{fam.name} at V = {V:.5g} {fam.speed_unit}"
     rate = -mode.eigenvalue.real
@@ -813,7 +816,40 @@ def _reachable_decay(models: _Models, s: MultiSpeedSettings, lo: float, hi: floa
         raise ConfigError(f"{what} asked; ask for a decay rate below {rate:.4g} (e.g. "
                           f"{0.5 * rate:.3g}), or leave it out to have it chosen")
     log.warning("%s; the design asks for %.4g (half that mode's rate)", what, 0.5 * rate)
-    return replace(s, decay=0.5 * rate)
+    return replace(s, decay=_open_loop_decay(models, lo, 0.5 * rate))
+
+
+def _open_loop_decay(models: _Models, lo: float, default: float) -> float:
+    """The decay rate asked where the settings leave it open: ``default``, or half the rate
+    of the open loop's slowest decaying mode at ``lo`` where that is slower.
+
+    A rate the open loop does not have is a requirement the controller must meet by moving
+    that mode, and a slow mode moved from far (an aircraft's phugoid, decaying at 0.001 /s,
+    asked to decay at 0.05 /s: 35 times its own rate) costs low-frequency gain and with it
+    the loop's margins (on a 65-state aircraft-like family, 0.1 dB and a controller that is
+    unstable itself).  The interval's low end is taken because there the open loop is
+    usually stable and a mode that crosses higher up (the flutter mode) is still well
+    damped; a mode that grows at ``lo`` is not counted (the loop must make it decay at the
+    rate asked).
+    """
+    slowest = None
+    for fam, P in zip(models.families, models.parts(lo)):
+        lam = np.linalg.eigvals(P.A) if P.A.size else np.zeros(0)
+        decaying = lam[lam.real < 0]
+        if decaying.size:
+            mode = decaying[int(np.argmax(decaying.real))]
+            if slowest is None or mode.real > slowest[1].real:
+                slowest = (fam, mode)
+    if slowest is None or -0.5 * slowest[1].real >= default:
+        return default
+    fam, mode = slowest
+    rate = -0.5 * float(mode.real)
+    log.info("%s at V = %.5g %s: its slowest mode decays at only %.4g per %s (at %.4g rad "
+             "per %s); the design asks the loop for %.4g (half that) rather than make the "
+             "controller move it to %g (give controller.interval_decay to ask for more)",
+             fam.name, lo, fam.speed_unit, -float(mode.real), fam.time_unit,
+             abs(float(mode.imag)), fam.time_unit, rate, default)
+    return rate
 
 
 def _fmt(reached: tuple) -> str:

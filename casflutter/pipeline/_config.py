@@ -280,8 +280,9 @@ class ControllerSettings(SynthesisOptions):
     family's speed unit (the speed index for a ROM loop)."""
     interval_decay: float | None = None
     """Decay rate [rad per time unit] required of the closed loop at every speed of
-    ``interval``; left out: 0.05, or half the rate of the family's slowest mode that no
-    controller moves where that is slower (:class:`casflutter.design.MultiSpeedSettings`)."""
+    ``interval``; left out: 0.05, or half the rate of the open loop's slowest decaying mode
+    at the interval's low end, or of the family's slowest mode that no controller moves,
+    where that is slower (:class:`casflutter.design.MultiSpeedSettings`)."""
     n_speeds: int = 16
     """Speeds of the stability objective on each interval the design tries (its dense
     check uses 8x as many)."""

@@ -141,6 +141,36 @@ def test_a_slow_mode_out_of_reach_sets_the_decay_rate_left_open(caplog):
         design_over_speeds(_with_hidden_mode(0.0), (0.0, 1.0), 1, settings=settings)
 
 
+def test_a_slow_open_loop_mode_sets_the_decay_rate_left_open(family, design, caplog):
+    """An aircraft's phugoid decays at 0.001-0.004 /s; a default rate of 0.05 would make the
+    controller move it from far (and cost the margins).  Here a slow oscillator (0.1 rad/s,
+    decaying at 0.002 /s) beside an unstable one (3 rad/s) the controller must stabilise,
+    both reached and seen: left open, the rate asked is half the open loop's slowest decay at
+    the interval's low end (numpy's eigenvalues of the plant are the check), and the loop
+    closed here with python-control decays at it.  A rate given is kept, and on
+    goland_4flaps, whose slowest mode at 60 m/s decays at 2.95 /s, the default stays 0.05."""
+    A = [[0.0, 1.0, 0.0, 0.0], [-0.01, -0.004, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0],
+         [0.0, 0.0, -9.0, 0.3]]
+    fam = _Constant(A, [[0.0], [1.0], [0.0], [1.0]], [[1.0, 0.0, 1.0, 0.0]], "slow mode")
+    lam = np.linalg.eigvals(np.asarray(fam.plant(0.0).A))
+    expected = -0.5 * np.max(lam.real[lam.real < 0])
+    settings = MultiSpeedSettings(hinf_speeds=0, random_starts=0, full_order=False)
+    with caplog.at_level("INFO", logger="casflutter.design"):
+        d = design_over_speeds(fam, (0.0, 1.0), 1, settings=settings, seed=0)
+    assert expected == pytest.approx(0.001, rel=1e-6)
+    assert d.decay == pytest.approx(expected, rel=1e-12) and d.held
+    assert "slowest mode decays at only 0.002" in caplog.text
+    for V in (0.0, 1.0):
+        loop = control.feedback(fam.plant(V), d.controller, sign=fam.feedback_sign)
+        assert np.max(loop.poles().real) <= -d.decay * (1 - 1e-6)
+    given = design_over_speeds(fam, (0.0, 1.0), 1, seed=0,
+                               settings=replace(settings, decay=0.05))
+    assert given.decay == 0.05 and given.held
+    lam = np.linalg.eigvals(family.state_matrix(INTERVAL[0]))
+    assert -np.max(lam.real) > 2 * 0.05
+    assert design.decay == 0.05
+
+
 @pytest.mark.parametrize("interval, order, match", [
     ((150.0, 60.0), 2, "interval"),
     ((10.0, 150.0), 2, "range"),

@@ -226,8 +226,9 @@ def register(subparsers) -> None:
     p.add_argument("--seeds", default="0,1,2", help="comma-separated seeds")
     p.add_argument("--decay", type=float, default=None,
                    help="decay rate required at every speed [rad per time unit] (default: "
-                        "0.05, or half the rate of the family's slowest mode that no "
-                        "controller moves where that is slower)")
+                        "0.05, or half the rate of the open loop's slowest decaying mode at "
+                        "LO, or of the family's slowest mode that no controller moves, where "
+                        "that is slower)")
     p.add_argument("--objective", choices=("auto", "sensors", "sensitivity"), default="auto",
                    help="H-infinity objective once the interval is held: the family's "
                         "disturbances to its sensors, or the loop's output and input "
