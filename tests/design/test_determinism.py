@@ -68,3 +68,37 @@ def test_default_run_controller_identical_with_one_and_two_blas_threads(tmp_path
         return json.loads(out.stdout.strip().splitlines()[-1])
 
     assert run(1) == run(2)
+
+
+def test_casadis_own_openblas_is_pinned_too():
+    """CasADi's bundled OpenBLAS (Ipopt's MUMPS) is invisible to threadpoolctl and takes its
+    thread count from the environment; inside ``single_threaded`` it runs on one thread,
+    and afterwards on as many as before."""
+    from casflutter._threads import casadi_openblas, single_threaded
+
+    lib = casadi_openblas()
+    if lib is None:
+        pytest.skip("this CasADi bundles no OpenBLAS of its own")
+    lib.openblas_set_num_threads(2)
+    with single_threaded():
+        assert lib.openblas_get_num_threads() == 1
+    assert lib.openblas_get_num_threads() == 2
+
+
+FAMILY = """
+import json
+from casflutter.aeroelastic import load_family
+from casflutter.design import design_over_speeds
+from casflutter.pipeline import RunConfig, multispeed_settings
+s = multispeed_settings(RunConfig(), "sensitivity")
+d = design_over_speeds(load_family("goland_4flaps"), (60.0, 150.0), 2, settings=s, seed=0)
+print(json.dumps({"gamma": d.gamma, "A": d.controller.A.tolist(), "C": d.controller.C.tolist()}))
+"""
+
+
+@pytest.mark.slow
+def test_family_design_identical_with_one_and_two_blas_threads():
+    """The multi-speed design on goland_4flaps (50 states): its H∞ QPs are large enough for
+    a two-thread OpenBLAS in CasADi's Ipopt to change γ's last bits (1.437425093679015
+    against 1.437425093664116 before CasADi's pool was pinned)."""
+    assert _run(FAMILY, 1, timeout=900) == _run(FAMILY, 2, timeout=900)
