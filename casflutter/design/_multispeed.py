@@ -829,13 +829,16 @@ def _open_loop_decay(models: _Models, lo: float, default: float) -> float:
     the loop's margins (on a 65-state aircraft-like family, 0.1 dB and a controller that is
     unstable itself).  The interval's low end is taken because there the open loop is
     usually stable and a mode that crosses higher up (the flutter mode) is still well
-    damped; a mode that grows at ``lo`` is not counted (the loop must make it decay at the
-    rate asked).
+    damped; a mode that grows at ``lo``, or sits on the imaginary axis, is not counted (the
+    loop must make it decay at the rate asked).
     """
     slowest = None
     for fam, P in zip(models.families, models.parts(lo)):
         lam = np.linalg.eigvals(P.A) if P.A.size else np.zeros(0)
-        decaying = lam[lam.real < 0]
+        # a pole on the axis that rounding puts at -1e-15 (a position, an integrator) does
+        # not decay: it would make the rate asked zero
+        axis = 1e-9 * max(1.0, float(np.max(np.abs(lam), initial=0.0)))
+        decaying = lam[lam.real < -axis]
         if decaying.size:
             mode = decaying[int(np.argmax(decaying.real))]
             if slowest is None or mode.real > slowest[1].real:
