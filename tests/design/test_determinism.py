@@ -79,10 +79,14 @@ def test_casadis_own_openblas_is_pinned_too():
     lib = casadi_openblas()
     if lib is None:
         pytest.skip("this CasADi bundles no OpenBLAS of its own")
-    lib.openblas_set_num_threads(2)
-    with single_threaded():
-        assert lib.openblas_get_num_threads() == 1
-    assert lib.openblas_get_num_threads() == 2
+    original = lib.openblas_get_num_threads()
+    try:
+        lib.openblas_set_num_threads(2)
+        with single_threaded():
+            assert lib.openblas_get_num_threads() == 1
+        assert lib.openblas_get_num_threads() == 2
+    finally:
+        lib.openblas_set_num_threads(original)
 
 
 FAMILY = """
