@@ -21,7 +21,6 @@ from casflutter.cli import main
 from casflutter.errors import ConfigError
 from casflutter.pipeline import load_config, run, start_controller
 
-from .test_family_run import RUN    # the goland_4flaps run whose controller starts the next
 
 WITNESS = Path(__file__).resolve().parents[1] / "witnesses" / \
     "truth_interval_controller_order4.json"
@@ -102,13 +101,13 @@ def test_names_that_match_nothing_are_named(tmp_path):
      r"controller.interval = \[60, 400\] leaves the speed range \[.*\] m/s of goland_4flaps"),
 ])
 def test_a_run_refuses_what_the_design_would_before_any_work(tmp_path, monkeypatch, what,
-                                                             match):
+                                                             match, goland_family_run_toml):
     """A start whose names match no signal and an interval outside the family's speeds are
     refused before the family's flutter analysis, not by the design after it."""
     doc = {"A": [[-1.0]], "B": [[1.0]], "C": [[1.0]], "D": [[0.0]],
            "inputs": ["gyro_05"], "outputs": ["flap_1"]}
     (tmp_path / "K.json").write_text(json.dumps(doc))
-    (tmp_path / "run.toml").write_text(RUN)
+    (tmp_path / "run.toml").write_text(goland_family_run_toml)
     updates = ({"controller.start": str(tmp_path / "K.json")} if what == "start"
                else {"controller.interval": [60.0, 400.0]})
     cfg = load_config(tmp_path / "run.toml", updates=updates)
@@ -121,14 +120,12 @@ def test_a_run_refuses_what_the_design_would_before_any_work(tmp_path, monkeypat
         run(cfg, quiet=True)
 
 
-def test_a_run_continues_the_start_first(tmp_path):
-    """The controller of a first run, written again in the other convention with its sensors
-    in another order, starts a second run: it holds the interval from the start, and with no
-    H-infinity phase nothing is left to change."""
-    cfg1 = tmp_path / "run.toml"
-    cfg1.write_text(RUN)
-    assert main(["run", str(cfg1), "--out", str(tmp_path / "first"), "--quiet"]) == 0
-    doc = json.loads((tmp_path / "first" / "controller.json").read_text())
+def test_a_run_continues_the_start_first(tmp_path, goland_family_run, goland_family_run_toml):
+    """The controller of a first run (tests/conftest.py), written again in the other
+    convention with its sensors in another order, starts a second run: it holds the interval
+    from the start, and with no H-infinity phase nothing is left to change."""
+    first, _ = goland_family_run
+    doc = json.loads((first / "controller.json").read_text())
     assert doc["feedback"] == "negative"
     K1 = control.ss(*(np.array(doc[k], dtype=float) for k in "ABCD"))
     names = [i["name"] for i in doc["inputs"]]
@@ -140,7 +137,7 @@ def test_a_run_continues_the_start_first(tmp_path):
                "outputs": [o["name"] for o in doc["outputs"]], "feedback": "positive"}
     (tmp_path / "K1.json").write_text(json.dumps(flipped))
     cfg2 = tmp_path / "run2.toml"
-    cfg2.write_text(RUN + 'start = "K1.json"\n')
+    cfg2.write_text(goland_family_run_toml + 'start = "K1.json"\n')
     assert main(["run", str(cfg2), "--out", str(tmp_path / "second"), "--quiet"]) == 0
     s = json.loads((tmp_path / "second" / "summary.json").read_text())["controller"]
     assert s["start"] == str(tmp_path / "K1.json")
