@@ -646,13 +646,11 @@ def _as_ss(P, nw: int = 0, nz: int = 0) -> control.StateSpace:
     sizes; zero channels leave the norm as it is)."""
     pw, pz = max(0, nw - P.B1.shape[1]), max(0, nz - P.C1.shape[0])
     nx, nu, ny = P.A.shape[0], P.B2.shape[1], P.C2.shape[0]
-    B1 = np.hstack([P.B1, np.zeros((nx, pw))])
-    C1 = np.vstack([P.C1, np.zeros((pz, nx))])
-    D11 = np.pad(P.D11, ((0, pz), (0, pw)))
-    D12 = np.vstack([P.D12, np.zeros((pz, nu))])
-    D21 = np.hstack([P.D21, np.zeros((ny, pw))])
-    return control.ss(P.A, np.hstack([B1, P.B2]), np.vstack([C1, P.C2]),
-                      np.block([[D11, D12], [D21, P.D22]]))
+    return replace(P, B1=np.hstack([P.B1, np.zeros((nx, pw))]),
+                   C1=np.vstack([P.C1, np.zeros((pz, nx))]),
+                   D11=np.pad(P.D11, ((0, pz), (0, pw))),
+                   D12=np.vstack([P.D12, np.zeros((pz, nu))]),
+                   D21=np.hstack([P.D21, np.zeros((ny, pw))])).statespace()
 
 
 def design_over_speeds(family, interval, order: int = 3, *,

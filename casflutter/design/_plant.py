@@ -121,6 +121,17 @@ class Partition:
         D = self.D11 + self.D12 @ Kt @ self.D21
         return A, B, C, D
 
+    def statespace(self) -> control.StateSpace:
+        """The plant as one ``StateSpace`` (the inverse of :func:`partition`).
+
+        Returns
+        -------
+        control.StateSpace
+            Inputs ``[w, u]``, outputs ``[z, y]``.
+        """
+        return control.ss(self.A, np.hstack([self.B1, self.B2]), np.vstack([self.C1, self.C2]),
+                          np.block([[self.D11, self.D12], [self.D21, self.D22]]))
+
     def transformed(self, T: np.ndarray, su: np.ndarray, sy: np.ndarray,
                     w0: float = 1.0) -> "Partition":
         """State similarity ``x = T x~``, input/output scaling ``u = su u~``, ``y~ = y / sy``

@@ -723,10 +723,7 @@ def synthesize(plants, nmeas: int, ncon: int, order: int, *, starts: int = 3, se
     parts = [partition(P, nmeas, ncon) for P in sys_list]
     if opts.stable_controller and order > 0:
         nw, nz = parts[0].dims[:2]
-        own = controller_only(nmeas, ncon, nw, nz)
-        stab_list.append(control.ss(own.A, np.hstack([own.B1, own.B2]),
-                                    np.vstack([own.C1, own.C2]),
-                                    np.block([[own.D11, own.D12], [own.D21, own.D22]])))
+        stab_list.append(controller_only(nmeas, ncon, nw, nz).statespace())
     sparts = [partition(P, nmeas, ncon) for P in stab_list]
     if len({P.dims for P in parts + sparts}) != 1:
         raise DimensionError(f"plants differ in (nw, nz, nu, ny): "

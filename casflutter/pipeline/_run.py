@@ -13,9 +13,9 @@ The model stages depend on the problem and are chosen in one place
 on a GAF file the rational-function approximation of ``Q(ik)`` with p–k beside it, and on a
 plant family file (``kind = "plant_family"``) the gridded family and its crossings.  Then the
 optional ``stages``, each run only where the problem offers what it needs (a skipped stage is
-logged once and listed in ``RunResult.skipped``; a stage list of the configuration's own
-that names one the problem cannot run is refused by :func:`casflutter.pipeline.load_config`
-before any work, :func:`check_requested_stages`):
+logged once and listed in ``RunResult.skipped``; ``casflutter run`` refuses, before any
+work, a stage list of the configuration's own that names one the problem cannot run,
+:func:`check_requested_stages`):
 
 - ``frozen`` — the flutter speed of the truth with its aerodynamics frozen at ``V0``
   (:func:`casflutter.truth.frozen_aero_truth`): the V²-scaling part of the ROM's error;

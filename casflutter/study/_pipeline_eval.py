@@ -263,8 +263,8 @@ def _rom_flutter_settings(settings: Mapping[str, Any]) -> dict:
     if "config" not in settings:
         settings["config"] = str(config_path(problem, "flutter"))
     if not parametric:
-        # the frozen-aero truth beside the ROM where there is a truth (a stage list of the
-        # configuration's own naming one the problem cannot run is refused)
+        # the frozen-aero truth beside the ROM where there is a truth (elsewhere the stage
+        # would only be skipped, with a note at every point)
         settings["stages"] = ["frozen"] if _has_truth(settings) else []
     return settings
 
