@@ -117,7 +117,7 @@ class SynthesisOptions:
     active_ratio: float = 0.6
     """Local maxima of σ_max above this fraction of γ enter the local model."""
     max_iter: int = 300
-    """Ipopt iterations per QP subproblem."""
+    """Ipopt iterations per QP subproblem that Ipopt solves (``qp_solver``)."""
     strictly_proper: bool = False
     """Keep ``Dk = 0`` (a strictly proper controller): no algebraic loop through a
     control-to-measurement feed-through at any operating point."""
@@ -150,8 +150,11 @@ class SynthesisOptions:
     full_order_gamma_factor: float = 1.1
     """The full-order controller is the central one at this factor times the optimal
     full-order level (``> 1``)."""
+    qp_solver: str = "qpoases"
+    """Solver of the trust-region QPs (:mod:`._qp`): ``"qpoases"`` (dense active set,
+    Ipopt only where it fails) or ``"ipopt"``."""
     ipopt: Mapping[str, Any] = field(default_factory=dict)
-    """Extra flat Ipopt options of the QP subproblems."""
+    """Extra flat Ipopt options of the QP subproblems Ipopt solves."""
 
     def __post_init__(self):
         checks = {"max_outer": (self.max_outer >= 1, "an integer >= 1"),
@@ -172,7 +175,9 @@ class SynthesisOptions:
                   "time_limit": (self.time_limit is None or self.time_limit > 0,
                                  "None or a number > 0"),
                   "full_order_gamma_factor": (self.full_order_gamma_factor > 1,
-                                              "a number > 1")}
+                                              "a number > 1"),
+                  "qp_solver": (self.qp_solver in CutQP.SOLVERS,
+                                " or ".join(f'"{v}"' for v in CutQP.SOLVERS))}
         bad = [f"{k} = {getattr(self, k)!r}: give {need}"
                for k, (ok, need) in checks.items() if not ok]
         if bad:
@@ -204,7 +209,7 @@ class StartRecord:
     model_decrease : float
         Relative decrease predicted by the last local model (small at a local optimum).
     statuses : tuple of str
-        Ipopt ``return_status`` of every QP subproblem, verbatim.
+        The solver's status of every QP subproblem, verbatim.
     stab_iterations, outer_iterations : int
         Iterations of the two phases.
     converged : bool
@@ -751,7 +756,7 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
     except _NUMERICAL_FAILURES as exc:
         raise SynthesisError(f"the plants could not be scaled for the synthesis "
                              f"({_reason(exc)}); check their entries' magnitudes") from exc
-    qp = CutQP(prob.n, {"ipopt.max_iter": opts.max_iter, **dict(opts.ipopt)})
+    qp = CutQP(prob.n, {"ipopt.max_iter": opts.max_iter, **dict(opts.ipopt)}, opts.qp_solver)
     deadline = t_start + opts.time_limit if opts.time_limit else np.inf
     rng = np.random.default_rng(seed)
     plan = [("given", g) for g in given]

@@ -95,12 +95,14 @@ def test_seed_determinism():
 
 
 def test_zero_start_option_and_iteration_budget():
-    # without a time limit the budget is counted in iterations: a tighter cap is visible
-    # in the Ipopt statuses, and zero_start=False makes every start a seeded random one
+    # without a time limit the budget is counted in iterations: a tighter cap on the QPs
+    # Ipopt solves is visible in their statuses, and zero_start=False makes every start a
+    # seeded random one
     P, nmeas, ncon, _ = load_compleib(COMPLEIB / "AC4.json")
     # (AC4 is a regular problem: without full_order_start it would also get the reduced
     # full-order starts, tested in test_fullorder.py)
-    opts = SynthesisOptions(max_outer=3, max_iter=2, zero_start=False, full_order_start=False)
+    opts = SynthesisOptions(max_outer=3, max_iter=2, zero_start=False, full_order_start=False,
+                            qp_solver="ipopt")
     r = synthesize(P, nmeas, ncon, 1, starts=2, seed=7, options=opts)
     assert [s.kind for s in r.starts] == ["random", "random"]
     assert all(s.outer_iterations <= 3 for s in r.starts)
