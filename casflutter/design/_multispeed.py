@@ -71,7 +71,8 @@ from ._bfgs import nonsmooth_bfgs
 from ._out_of_reach import modes_out_of_reach
 from ._plant import controller_only, partition
 from ._problem import verify_closed_loop
-from ._speeds import DesignChannels, Scaling, SpeedLoops, design_partition
+from ._speeds import (DesignChannels, Scaling, SpeedLoops, design_partition,
+                      unit_free_sensitivity)
 from ._synthesis import (STABLE_CONTROLLER_NOTE, SynthesisOptions, SynthesisResult,
                          synthesize)
 
@@ -117,7 +118,10 @@ class MultiSpeedSettings:
     sensitivity: bool = False
     """The H∞ plants' channels: at each speed the output and the input sensitivity of the
     loop (whose diagonal entries bound the loop-at-a-time margins) instead of the family's
-    disturbances to the measurements (:class:`._speeds.DesignChannels`)."""
+    disturbances to the measurements (:class:`._speeds.DesignChannels`); where the family
+    declares its measurements (or controls) in different units, in the design's scaled
+    signals, so that their norm does not depend on the units
+    (:func:`._speeds.unit_free_sensitivity`)."""
     strictly_proper: bool | None = None
     """Keep ``Dk = 0``; ``None``: strictly proper exactly when some model's controls reach its
     measurements directly (a feed-through would close an algebraic loop that can become
@@ -853,6 +857,17 @@ def _open_loop_decay(models: _Models, lo: float, default: float) -> float:
     return rate
 
 
+def _units(family, side: str) -> tuple:
+    """The units of the signals a sensitivity channel of ``side`` weighs: the family's
+    measurements' (``"output"``) or controls' (``"input"``); none for ``""``."""
+    sig = family.signals
+    if side == "output":
+        return tuple(sig.output_units[i] for i in sig.output_index())
+    if side == "input":
+        return tuple(sig.input_units[i] for i in sig.input_index())
+    return ()
+
+
 def _fmt(reached: tuple) -> str:
     return "nothing" if not reached else f"[{reached[0]:.5g}, {reached[1]:.5g}]"
 
@@ -963,7 +978,17 @@ def _finish(eng: _Engine, fams, K: np.ndarray, order: int, interval: tuple, reac
                 for side in (("output", "input") if s.sensitivity else ("",))]
     hv = tuple(float(v) for v in np.linspace(lo, e, s.hinf_speeds)) if s.hinf_speeds else ()
     if hinf_plants is None:
-        parts = [design_partition(f, V, ch) for V in hv for f in fams for ch in channels]
+        sc = models.scaling
+        for side in (ch.sensitivity for ch in channels if ch.sensitivity):
+            n = models.ny if side == "output" else models.nu
+            if n > 1 and not any(_units(fams[0], side)):
+                log.debug("H-infinity phase: the %s sensitivity weighs the %d %s as given, "
+                          "their units not declared (declare them, e.g. the family file's "
+                          "%s_units, to have signals in different units weighed alike)",
+                          side, n, "measurements" if side == "output" else "controls", side)
+        parts = [unit_free_sensitivity(design_partition(f, V, ch), ch, sc.su, sc.sy,
+                                       _units(f, ch.sensitivity))
+                 for V in hv for f in fams for ch in channels]
         nw = max((P.B1.shape[1] for P in parts), default=0)
         nz = max((P.C1.shape[0] for P in parts), default=0)
         hinf = [_as_ss(P, nw, nz) for P in parts]

@@ -46,7 +46,8 @@ from ..errors import ConfigError, DimensionError
 from ._plant import Partition
 from ._problem import _balance, _io_scales, _time_scale
 
-__all__ = ["DesignChannels", "design_partition", "SpeedLoops", "Scaling"]
+__all__ = ["DesignChannels", "design_partition", "unit_free_sensitivity", "SpeedLoops",
+           "Scaling"]
 
 
 @dataclass(frozen=True)
@@ -126,6 +127,55 @@ def design_partition(family, V: float, channels: DesignChannels = DesignChannels
         D11 = np.vstack([D11, np.zeros((nu, nw))])
         D12 = np.vstack([D12, w * a * np.eye(nu)])
     return Partition(A=A, B1=B1, B2=B2, C1=C1, C2=C2, D11=D11, D12=D12, D21=D21, D22=D22)
+
+
+def unit_free_sensitivity(P: Partition, channels: DesignChannels, su: np.ndarray,
+                          sy: np.ndarray, units: Sequence[str] = ()) -> Partition:
+    """The sensitivity channels of ``P`` in the design's scaled signals where the signals
+    are in different units, so that their norm does not depend on the units.
+
+    A loop's sensitivity ``S`` is a matrix: written in other units of its signals it becomes
+    ``D⁻¹ S D`` for a diagonal ``D``, whose norm differs (a gyro read in deg/s instead of
+    rad/s weighs its couplings into the other loops 57 times more), while the loop-at-a-time
+    margins, its diagonal, do not change.  Where every signal of the side is in one unit,
+    a change of that unit is ``D = c I``, which cancels: ``S`` is left as it is.  Where they
+    are in different units, ``w = D w~`` and ``z~ = D⁻¹ z`` with ``D`` the measurement scales
+    ``sy`` (output sensitivity) or the control scales ``su`` (input sensitivity) of
+    :func:`._problem._io_scales`, which balance the control-to-measurement gains to order
+    one and follow any change of units: the norm is the same in every unit.  ``D`` is
+    divided by its geometric mean, so that the control-rate outputs keep the weight they
+    are given.
+
+    Parameters
+    ----------
+    P : Partition
+        A design plant of :func:`design_partition` with ``channels``.
+    channels : DesignChannels
+        Its channels; ``P`` is returned unchanged unless they are a sensitivity.
+    su, sy : ndarray
+        The design's control and measurement scales (:class:`Scaling`).
+    units : sequence of str
+        The units of that side's signals (the measurements' for ``"output"``, the
+        controls' for ``"input"``; ``""`` where not declared).  All equal (all undeclared
+        included): ``P`` is returned unchanged.
+
+    Returns
+    -------
+    Partition
+        ``P``, or ``P`` with ``B1``, ``D11``, ``D21`` scaled by ``D`` on the right and the
+        sensitivity rows of ``C1``, ``D11``, ``D12`` by ``D⁻¹`` on the left.
+    """
+    if not channels.sensitivity or len(set(units)) < 2:
+        return P
+    d = np.asarray(sy if channels.sensitivity == "output" else su, dtype=float)
+    if d.size != len(units):
+        raise DimensionError(f"{len(units)} units for {d.size} signals")
+    d = np.exp(np.log(d) - np.mean(np.log(d)))
+    rows = np.ones(P.C1.shape[0])
+    rows[:d.size] = 1.0 / d                         # the sensitivity's rows; the rates follow
+    return Partition(A=P.A, B1=P.B1 * d[None, :], B2=P.B2, C1=P.C1 * rows[:, None], C2=P.C2,
+                     D11=rows[:, None] * P.D11 * d[None, :], D12=P.D12 * rows[:, None],
+                     D21=P.D21 * d[None, :], D22=P.D22)
 
 
 @dataclass(frozen=True)

@@ -274,8 +274,10 @@ f" Speeds as the speed index V with the airspeed U = {_fmt(scale)} V m/s beside 
 #: What the multi-speed design's H∞ plants are, per ``controller.hinf_objective``.
 _OBJECTIVES = {
     "sensors": "the family's disturbance inputs to its measurements",
-    "sensitivity": ("the loop's output and input sensitivities (in the signals' own "
-                    "units), which bound every loop-at-a-time gain and phase margin"),
+    "sensitivity": ("the loop's output and input sensitivities (in the design's scaled "
+                    "signals where the family declares them in different units, else in "
+                    "their own units), which bound every loop-at-a-time gain and phase "
+                    "margin"),
     "lft": "the LFTs at multiples of the flutter speed (eq. 14-16)",
 }
 
