@@ -151,7 +151,8 @@ class MultiSpeedSettings:
     synthesis: SynthesisOptions = field(default_factory=lambda: SynthesisOptions(
         max_outer=60, max_stab_rounds=100, full_order_start=False))
     """Settings of the H∞ phase (:func:`casflutter.design.synthesize`; its ``decay``,
-    ``strictly_proper``, ``stable_controller`` and ``zero_start`` are set by the design)."""
+    ``strictly_proper``, ``stable_controller`` and ``zero_start`` are set by the design, and
+    its ``qp_solver`` left open is qpOASES)."""
 
     def __post_init__(self):
         if isinstance(self.synthesis, Mapping):
@@ -934,7 +935,7 @@ def _hinf_phase(eng: _Engine, hinf: list, dims: tuple, K: np.ndarray, Kss, lo: f
     s, models = eng.settings, eng.models
     opts = replace(s.synthesis, decay=float(s.decay), strictly_proper=eng.strictly_proper,
                    stable_controller=s.stable_controller, zero_start=False,
-                   full_order_start=False)
+                   full_order_start=False, qp_solver=s.synthesis.qp_solver or "qpoases")
     speeds = np.linspace(lo, e, s.n_speeds)
     for k in range(rounds):
         stab = [_padded(P, dims) for V in speeds for P in models.parts(V)]

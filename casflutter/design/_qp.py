@@ -10,8 +10,8 @@ dimension: the plant enters only through the cut values and gradients computed i
 One solver per (parameters, cut slots) size is built through :mod:`casflutter._nlp` and
 reused; unused slots are free constraints.
 
-qpOASES (``solver="qpoases"``, the default) solves it as a dense QP by an active-set
-method: exact on the box (an interior point relaxes the bounds by 1e-8) and about ten
+qpOASES (``solver="qpoases"``, the multi-speed design's) solves it as a dense QP by an
+active-set method: exact on the box (an interior point relaxes the bounds by 1e-8) and about ten
 times faster than Ipopt where the σ cuts number hundreds (0.02 s against 0.26 s a step on
 goland_4flaps).  A QP it does not solve is solved again by Ipopt, whose status then joins
 qpOASES's.  With ``solver="ipopt"`` Ipopt solves every QP, built from MX symbols: the data
