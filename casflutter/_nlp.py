@@ -2,9 +2,9 @@
 
 ``problem dict -> nlpsol -> checked stats -> frozen NLPResult``.  Identification,
 synthesis and the parametric studies all go through :func:`make_solver` /
-:func:`solve_nlp`; nobody else calls ``casadi.nlpsol``.  The dense convex QPs of the
-synthesis's trust-region steps go through :func:`make_qp_solver` (``casadi.conic``,
-qpOASES by default).  Square nonlinear systems (the
+:func:`solve_nlp`; nobody else calls ``casadi.nlpsol``.  Dense convex QPs solved by an
+active-set method (the multi-speed design's trust-region steps) go through
+:func:`make_qp_solver` (``casadi.conic``, qpOASES).  Square nonlinear systems (the
 collocation of periodic orbits in :mod:`casflutter.lco`, built as CasADi functions) go
 through :func:`solve_newton`.
 """
