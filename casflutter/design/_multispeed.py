@@ -149,7 +149,7 @@ class MultiSpeedSettings:
     min_step: float = 0.001
     """Smallest continuation step, as a fraction of the interval's length."""
     synthesis: SynthesisOptions = field(default_factory=lambda: SynthesisOptions(
-        max_outer=60, max_stab_rounds=100, full_order_start=False))
+        max_outer=60, extra_outer=240, max_stab_rounds=100, full_order_start=False))
     """Settings of the H∞ phase (:func:`casflutter.design.synthesize`; its ``decay``,
     ``strictly_proper``, ``stable_controller`` and ``zero_start`` are set by the design, and
     its ``qp_solver`` left open is qpOASES)."""
@@ -1018,9 +1018,12 @@ def _finish(eng: _Engine, fams, K: np.ndarray, order: int, interval: tuple, reac
         message = (f"{what} at the decay rate {s.decay:g}, not the requested "
                    f"[{interval[0]:.5g}, {interval[1]:.5g}]: the farthest any start reached")
     if syn is not None and not syn.converged:
-        message += (f"; its H∞ phase stopped after {syn.best.outer_iterations} of "
-                    f"{s.synthesis.max_outer} iterations without converging ({syn.best.reason}): "
-                    "the objective is the best found, not a local minimum")
+        budget = (f"{s.synthesis.max_outer}, up to "
+                  f"{s.synthesis.max_outer + s.synthesis.extra_outer} while the objective "
+                  "kept falling" if s.synthesis.extra_outer else f"{s.synthesis.max_outer}")
+        message += (f"; its H∞ phase stopped after {syn.best.outer_iterations} iterations "
+                    f"({budget}) without converging ({syn.best.reason}): the objective is the "
+                    "best found, not a local minimum")
     if np.isfinite(gamma):
         log.info("multi-speed design: %s; worst H-infinity objective %.5g", message, gamma)
     else:

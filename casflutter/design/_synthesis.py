@@ -20,8 +20,9 @@ parameters only (:mod:`._qp`, through :mod:`casflutter._nlp`: Ipopt, or qpOASES 
 multi-speed design) with a BFGS model of the curvature gives the step; it is accepted only
 if the *exact* objective (eigenvalues, or the Hamiltonian norm of every plant) decreased
 and the constraints hold exactly; otherwise the region shrinks and the trial point's peak
-frequencies join the model.  The cost per iteration is a few eigenvalue problems of the
-plant size plus a QP of the controller size.
+frequencies join the model, or, where it broke a stability plant's decay rate, the
+eigenvalue cuts it broke (linearised there) join the constraints.  The cost per iteration
+is a few eigenvalue problems of the plant size plus a QP of the controller size.
 
 Several seeded starts are run and the best is kept; the controller is returned in a
 well-conditioned real-Schur, balanced realisation and re-checked on the original plants.
@@ -96,7 +97,16 @@ class SynthesisOptions:
     """Settings of :func:`synthesize` (checked on construction)."""
 
     max_outer: int = 600
-    """Maximum number of H∞ iterations (QP steps, accepted or not) per start."""
+    """Maximum number of H∞ iterations (QP steps, accepted or not) per start, before
+    ``extra_outer``."""
+    extra_outer: int = 0
+    """Further H∞ iterations past ``max_outer``, each spent only while γ is still falling:
+    by more than ``extra_rate`` (relative) over the last ``stall_window`` iterations.  A
+    phase that starts far from a minimum (a held controller whose loop barely decays has a
+    sensitivity in the thousands) is then not cut off while it still makes headway, and one
+    that creeps stops at ``max_outer`` as before (counted in iterations: deterministic)."""
+    extra_rate: float = 0.01
+    """See ``extra_outer``."""
     max_stab_rounds: int = 150
     """Maximum number of stabilisation iterations per start."""
     tol: float = 1e-5
@@ -164,6 +174,8 @@ class SynthesisOptions:
 
     def __post_init__(self):
         checks = {"max_outer": (self.max_outer >= 1, "an integer >= 1"),
+                  "extra_outer": (self.extra_outer >= 0, "an integer >= 0"),
+                  "extra_rate": (0 < self.extra_rate < 1, "a number in (0, 1)"),
                   "max_stab_rounds": (self.max_stab_rounds >= 1, "an integer >= 1"),
                   "max_iter": (self.max_iter >= 1, "an integer >= 1"),
                   "tol": (0 < self.tol < 1, "a number in (0, 1)"),
@@ -422,6 +434,10 @@ def _shrunk(prob: Problem, K0: np.ndarray) -> np.ndarray | None:
     return None
 
 
+_TRIAL_CUTS = 16
+"""Most decay-rate cuts kept from rejected trial points (:meth:`_Phase._trial_cuts`)."""
+
+
 @dataclass
 class _Phase:
     """One phase of the bundle iteration (module docstring)."""
@@ -538,6 +554,20 @@ class _Phase:
             sy = float(s @ y)
         return H - np.outer(Hs, Hs) / sHs + np.outer(y, y) / sy, True
 
+    def _trial_cuts(self, Kn: np.ndarray, d: np.ndarray) -> list[Cut]:
+        """The decay-rate cuts that a rejected trial point ``K + d`` violates, linearised
+        there and written in the step from ``K`` (``c(Kn) + gᵀ(d' − d)``): cutting planes for
+        the constraints, as the trial's peak frequencies are for the objective.  A step
+        that moved an eigenvalue farther than its linear model at ``K`` said is then kept
+        out of that direction by the next QPs at ``K``, instead of only by a smaller
+        radius."""
+        out = []
+        for c in self.prob.eig_cuts(Kn, 0.0, 0.0, 0.0, which="stab"):
+            if c.linear and c.value > 0.0:
+                out.append(Cut(c.value - float(c.grad @ d), c.grad, c.key))
+        out.sort(key=lambda c: -c.value)
+        return out[:_TRIAL_CUTS]
+
     def run(self, K: np.ndarray, label: str, max_iter: int) -> "_PhaseResult":
         """The trust-region bundle iteration from ``K`` (module docstring): at most
         ``max_iter`` QP steps, each accepted only when the exact objective decreased."""
@@ -552,11 +582,16 @@ class _Phase:
         history, history_at = [f], [0]
         memory: list[list[float]] = [[] for _ in prob.aug]
         delta0 = delta = opts.trust_region * max(1.0, float(np.max(np.abs(K))))
-        H, fresh, cuts = None, True, None
+        H, fresh, cuts, trial_cuts = None, True, None, []
         converged, collapsed, it, pred_rel = False, False, 0, np.inf
-        for it in range(1, max_iter + 1):
+        extra = opts.extra_outer if self.kind == "hinf" else 0
+        for it in range(1, max_iter + extra + 1):
             if self.done(f) or time.perf_counter() > self.deadline or \
                     self._stop(it, f, history, history_at, label):
+                break
+            if it > max_iter and not _falling(f, history, history_at, it, opts.extra_rate,
+                                              opts.stall_window):
+                it -= 1         # the budget's iterations, all of them taken
                 break
             if cuts is None:
                 cuts = self.cuts(K, f, info, delta, memory)
@@ -567,7 +602,7 @@ class _Phase:
             fv = np.array([c.value for c in obj]) - f
             if H is None:
                 H, fresh = self._curvature(fv, G, f, delta0), True
-            step = self._step(H, fv, G, con, delta * free)
+            step = self._step(H, fv, G, con + trial_cuts, delta * free)
             pred = -step.model
             scale = max(abs(f), 1e-12) if self.kind == "hinf" else max(abs(f), self.margin)
             pred_rel = pred / scale
@@ -596,7 +631,7 @@ class _Phase:
             if ratio > 1e-2:
                 H, changed = self._updated(H, step, obj, con, Kn)
                 fresh = fresh and not changed
-                K, f, info = Kn, fn, info_n
+                K, f, info, trial_cuts = Kn, fn, info_n, []
                 history.append(f)
                 history_at.append(it)
                 if ratio > 0.75 and dmax > 0.9 * delta:
@@ -612,6 +647,8 @@ class _Phase:
                 for j, (gj, w) in enumerate(zip(*info_n)):
                     if gj >= opts.active_ratio * f:
                         memory[j] = _merge([w], memory[j])
+            elif self.kind == "hinf":
+                trial_cuts = (self._trial_cuts(Kn, step.d) + trial_cuts)[:_TRIAL_CUTS]
             log.debug("%s %s it %d: rejected (ratio %.3g), radius %.3g", label, self.kind, it,
                       ratio, delta)
             if delta < 1e-10 * max(1.0, float(np.max(np.abs(K)))):
@@ -635,6 +672,13 @@ class _PhaseResult:
     iterations: int
     pred: float
     collapsed: bool = False
+
+
+def _falling(f: float, history: list, at: list, it: int, rate: float, window: int) -> bool:
+    """Whether the objective fell by more than ``rate`` (relative) over the last ``window``
+    iterations (the budget's extension, ``SynthesisOptions.extra_outer``)."""
+    past = [h for h, a in zip(history, at) if a < it - window]
+    return bool(past) and past[-1] - f > rate * abs(past[-1])
 
 
 def _stalled(history: list, at: list, it: int, window: int, tol: float) -> bool:

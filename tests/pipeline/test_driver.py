@@ -186,6 +186,7 @@ def test_every_field_of_a_stages_settings_is_a_configuration_key(section, stage_
     study = {RecordSettings: {"coupling_delay": 1},
              IdentificationSettings: {"regularization": 1e-6},
              SynthesisOptions: {"strictly_proper": True, "zero_start": False, "max_outer": 80,
+                                "extra_outer": 320,
                                 "max_stab_rounds": 300}}
     assert settings_as(section(), stage_class) == stage_class(**study[stage_class])
 

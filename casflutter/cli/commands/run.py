@@ -58,7 +58,8 @@ def _controller_lines(c: dict, res, unit: str) -> list[str]:
                      + ("held" if c["held"] else f"not held ({c['design_message']})"))
     if c.get("hinf_converged") is False:
         lines.append(f"  its H∞ optimisation stopped after {c['hinf_iterations']} iterations "
-                     f"(controller.max_outer = {res.config.controller.max_outer}) without "
+                     f"(controller.max_outer = {res.config.controller.max_outer}, "
+                     f"extra_outer = {res.config.controller.extra_outer}) without "
                      "converging: the controller is the best found; the certificates below "
                      "are its own")
     if c.get("gamma") is not None:
