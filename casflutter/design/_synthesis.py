@@ -629,6 +629,8 @@ class _Phase:
             dmax = float(np.max(np.abs(step.d)))
             cuts = None
             if ratio > 1e-2:
+                # (the trial points' cuts come last in the step's constraint multipliers and
+                # are left out of the curvature update: they are linearised elsewhere)
                 H, changed = self._updated(H, step, obj, con, Kn)
                 fresh = fresh and not changed
                 K, f, info, trial_cuts = Kn, fn, info_n, []
