@@ -26,8 +26,9 @@ from numpy.testing import assert_allclose
 from casflutter._resources import problems_dir
 from casflutter.aeroelastic import family_flutter, load_family
 from casflutter.data import read_family_file
-from casflutter.design import default_objective, design_over_speeds
+from casflutter.design import design_over_speeds
 from casflutter.pipeline import design_family, load_config, multispeed_settings
+from casflutter.pipeline._control import design_objective
 from casflutter.verify import verify_family
 
 INTERVAL = (120.0, 273.0)
@@ -81,8 +82,7 @@ def test_the_runs_design_holds_the_interval_with_a_sensitivity_below_2(tmp_path)
     c = cfg.controller
     assert (c.order, tuple(c.interval), cfg.seed) == (2, INTERVAL, 0)
     family = design_family(cfg)
-    objective = (c.hinf_objective if c.hinf_objective in ("sensors", "sensitivity")
-                 else default_objective(family))
+    objective = design_objective(cfg, family, has_lft=False)
     assert objective == "sensitivity"                      # no disturbance inputs
     d = design_over_speeds(family, INTERVAL, c.order,
                            settings=multispeed_settings(cfg, objective), seed=cfg.seed)
