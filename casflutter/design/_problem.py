@@ -319,25 +319,27 @@ class Problem:
         Kt, L, R = P.loop_gain(K)
         A = P.A + P.B2 @ Kt @ P.C2
         w, vl, vr = _eig_lr(A)
-        out = []
         sel = np.flatnonzero(w.imag >= -1e-12 * (1 + np.abs(w)))
-        for i in sel:
-            y, x = vl[:, i], vr[:, i]
-            yx = y.conj() @ x
-            if abs(yx) < 1e-300:
-                continue
-            a = (y.conj() @ P.B2) / yx
-            b = P.C2 @ x
-            g = (L.T @ np.real(np.outer(a, b)) @ R.T).ravel(order="F")
-            val = float(w[i].real) + offset
-            # condition number of the eigenvalue: beyond _KAPPA_MAX it sits in a (nearly)
-            # defective cluster, moves like a fractional power of the step and its first-order
-            # gradient (up to 1e60 on BDT2's Jordan blocks) would swamp the QP
-            kappa = np.linalg.norm(y) * np.linalg.norm(x) / abs(yx)
-            cut = Cut(val, g, tag + (complex(w[i]),), linear=bool(kappa <= _KAPPA_MAX))
-            if cut.reach(delta) >= threshold:
-                out.append(cut)
-        return out
+        Y, X = vl[:, sel], vr[:, sel]
+        yx = np.einsum("ij,ij->j", Y.conj(), X)
+        keep = np.abs(yx) >= 1e-300
+        sel, Y, X, yx = sel[keep], Y[:, keep], X[:, keep], yx[keep]
+        # dλ = (yᴴ B2 dKt C2 x) / (yᴴ x), dKt = L dK R: the gradient is Re((Lᵀa)(R b)ᵀ) with
+        # a = B2ᵀ ȳ / (yᴴx) and b = C2 x, for every eigenvalue at once
+        La = ((Y.conj().T @ P.B2) / yx[:, None]) @ L
+        Rb = (P.C2 @ X).T @ R.T
+        G = np.real(La[:, :, None] * Rb[:, None, :])
+        G = G.transpose(0, 2, 1).reshape(sel.size, -1)       # column-major vec per eigenvalue
+        vals = w[sel].real + offset
+        # condition number of the eigenvalue: beyond _KAPPA_MAX it sits in a (nearly)
+        # defective cluster, moves like a fractional power of the step and its first-order
+        # gradient (up to 1e60 on BDT2's Jordan blocks) would swamp the QP
+        kappa = np.linalg.norm(Y, axis=0) * np.linalg.norm(X, axis=0) / np.abs(yx)
+        linear = kappa <= _KAPPA_MAX
+        with np.errstate(over="ignore", invalid="ignore"):
+            reach = np.where(linear, vals + delta * np.sum(np.abs(G), axis=1), vals)
+        return [Cut(float(vals[i]), G[i], tag + (complex(w[sel[i]]),), linear=bool(linear[i]))
+                for i in np.flatnonzero(reach >= threshold)]
 
     def eig_cuts(self, K: np.ndarray, margin: float, threshold: float, delta: float,
                  which: str = "all") -> list[Cut]:
