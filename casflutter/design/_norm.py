@@ -5,11 +5,11 @@ singular value of ``T(jω) = C (jωI − A)⁻¹ B + D`` iff ``jω`` is an eigen
 Hamiltonian ``H(γ)`` (here the extended pencil of :func:`_level_pencil`).  Starting from a
 lower bound taken at the poles' frequencies, the level is raised to the local maximum of
 σ_max in the band between imaginary eigenvalues where σ_max is largest, until the pencil at
-``(1 + 2 tol) γ`` has none: quadratic convergence to the norm, with the peak frequency.  The
-band's maximum is found by a bounded 1-D search on the modal form (a few ``O(n (m + p))``
-evaluations), which saves most of the eigenvalue problems of the ``2n``-dimensional
-Hamiltonian, the cost of the whole iteration: usually one, to confirm the bound, instead of
-two or three with the band's midpoint.  The same level-set eigenvalues give every frequency
+``(1 + 2 tol) γ`` has none: quadratic convergence to the norm, with the peak frequency.  From
+30 states on, the band's maximum is found by a bounded 1-D search on the modal form (a few
+``O(n (m + p))`` evaluations), which saves most of the eigenvalue problems of the
+``2n``-dimensional Hamiltonian, the cost of the whole iteration: usually one, to confirm the
+bound, instead of two or three with the band's best midpoint (which smaller systems keep).  The same level-set eigenvalues give every frequency
 band in which ``σ_max > level``; a bounded 1-D maximisation in each band gives the *active
 frequencies* of the nonsmooth local model (Apkarian & Noll 2006).
 
