@@ -260,7 +260,7 @@ class Problem:
         """Well posed, and the stability plants decay at the required rate."""
         if not self.well_posed(K):
             return False
-        return bool(np.all(self.alphas(K)[1] <= -self.decay))
+        return all(_abscissa(P, K) <= -self.decay for P in self.stab)
 
     def gamma(self, K: np.ndarray) -> tuple[float, list[float], list[float]]:
         """Worst-case exact γ, per-plant γ and peak frequencies (γ = inf if unstable)."""
