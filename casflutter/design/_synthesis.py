@@ -589,7 +589,7 @@ class _Phase:
             if self.done(f) or time.perf_counter() > self.deadline or \
                     self._stop(it, f, history, history_at, label):
                 break
-            if it > max_iter and not _falling(f, history, history_at, it, opts.extra_rate,
+            if it > max_iter and not _falling(history, history_at, it, opts.extra_rate,
                                               opts.stall_window):
                 it -= 1         # the budget's iterations, all of them taken
                 break
@@ -676,20 +676,25 @@ class _PhaseResult:
     collapsed: bool = False
 
 
-def _falling(f: float, history: list, at: list, it: int, rate: float, window: int) -> bool:
+def _accepted_by(history: list, at: list, it: int) -> float | None:
+    """The last accepted objective at iteration ``it`` or before (``None`` before the
+    start)."""
+    old = [h for h, a in zip(history, at) if a <= it]
+    return old[-1] if old else None
+
+
+def _falling(history: list, at: list, it: int, rate: float, window: int) -> bool:
     """Whether the objective fell by more than ``rate`` (relative) over the last ``window``
     iterations (the budget's extension, ``SynthesisOptions.extra_outer``)."""
-    past = [h for h, a in zip(history, at) if a < it - window]
-    return bool(past) and past[-1] - f > rate * abs(past[-1])
+    old = _accepted_by(history, at, it - window - 1)
+    return old is not None and old - history[-1] > rate * abs(old)
 
 
 def _stalled(history: list, at: list, it: int, window: int, tol: float) -> bool:
     """Less than ``tol`` relative decrease of the accepted values over the last ``window``
     iterations."""
-    old = [h for h, a in zip(history, at) if a <= it - window]
-    if not old:
-        return False
-    return (old[-1] - history[-1]) < tol * abs(old[-1])
+    old = _accepted_by(history, at, it - window)
+    return old is not None and (old - history[-1]) < tol * abs(old)
 
 
 def _merge(new: Sequence[float], old: Sequence[float], keep: int = 12) -> list[float]:

@@ -332,7 +332,7 @@ class ControllerSettings(SynthesisOptions):
     """Further H∞ iterations, spent only while γ still falls by more than 1 % in thirty
     (:class:`casflutter.design.SynthesisOptions`): on two aircraft-like families whose held
     controller leaves a sensitivity in the hundreds, the worst sensitivity then fell to a
-    median of 1.6-1.7 where 80 iterations left 4.7-5.5 (docs/theory.rst)."""
+    median of 1.5-1.7 where 80 iterations left 4.7-5.5 (docs/theory.rst)."""
     max_stab_rounds: int = 300
     """Stabilisation rounds per start (:class:`casflutter.design.SynthesisOptions`)."""
     flap_rate_weight: float = 0.003
