@@ -156,8 +156,13 @@ class SynthesisOptions:
     """See ``abandon_after``."""
     full_order_start: bool = True
     """For a single H∞ plant without stability plants: also start from the full-order H∞
-    central controller reduced to the order (:mod:`._fullorder`; only regular problems,
-    ``D12`` full column rank and ``D21`` full row rank, and only with slycot installed)."""
+    central controller reduced to the order (:mod:`._fullorder`; only with slycot
+    installed).  A singular plant (``D12`` or ``D21`` rank deficient) is regularised first
+    (``full_order_regularization``)."""
+    full_order_regularization: float = 1e-3
+    """Relative size ``ε`` of the small channels that make a singular plant regular for its
+    full-order start (:func:`._fullorder.regularized`); ``0``: singular plants get no
+    full-order start."""
     full_order_gamma_factor: float = 1.1
     """The full-order controller is the central one at this factor times the optimal
     full-order level (``> 1``)."""
@@ -194,6 +199,8 @@ class SynthesisOptions:
                                  "None or a number > 0"),
                   "full_order_gamma_factor": (self.full_order_gamma_factor > 1,
                                               "a number > 1"),
+                  "full_order_regularization": (0 <= self.full_order_regularization < 1,
+                                                "a number in [0, 1)"),
                   "qp_solver": (self.qp_solver is None or self.qp_solver in CutQP.SOLVERS,
                                 "None, " + " or ".join(f'"{v}"' for v in CutQP.SOLVERS))}
         bad = [f"{k} = {getattr(self, k)!r}: give {need}"
@@ -829,7 +836,8 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
     # result is never worse than without them
     if opts.full_order_start and len(parts) == 1 and not sparts:
         try:
-            full = full_order_controller(parts[0], opts.full_order_gamma_factor)
+            full = full_order_controller(parts[0], opts.full_order_gamma_factor,
+                                         opts.full_order_regularization)
             reduced = [] if full is None else reduced_controllers(full[0], order)
         except _NUMERICAL_FAILURES as exc:
             log.debug("full-order start: failed (%s), skipped", _reason(exc))
