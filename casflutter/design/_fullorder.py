@@ -209,10 +209,10 @@ _LEVEL_TRIES = 12
 
 def _central(P: Partition, level: float) -> control.StateSpace | None:
     """SB10AD's central controller of ``P`` at ``level``, or ``None`` when SLICOT refuses it
-    or its closed loop is unstable or has a norm above ``level`` (to 1e-6 relative)."""
+    or its closed loop is not stable with a norm below ``level`` (:func:`_below`)."""
     from slycot import sb10ad  # noqa: PLC0415 - optional dependency, checked by the caller
 
-    nw, nz, nu, ny = P.dims
+    _, _, nu, ny = P.dims
     B = np.hstack([P.B1, P.B2])
     C = np.vstack([P.C1, P.C2])
     D = np.block([[P.D11, P.D12], [P.D21, P.D22]])
