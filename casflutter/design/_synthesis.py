@@ -834,6 +834,7 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
              for i in range(starts)]
     # last, so that they never make the abandon test stop one of the starts above early: the
     # result is never worse than without them
+    full = None
     if opts.full_order_start and len(parts) == 1 and not sparts:
         try:
             full = full_order_controller(parts[0], opts.full_order_gamma_factor,
@@ -891,11 +892,15 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
     if not ok:
         failed = [r for r in records if r.status == "failed"]
         why = f"; {len(failed)} failed numerically ({failed[0].reason})" if failed else ""
+        hint = ("Check that the unstable modes are controllable from u and observable from "
+                "y, that the plant is scaled sensibly, or try a higher order / more starts"
+                if full is None else
+                f"The plant can be stabilised: the full-order H-inf controller (order "
+                f"{full[0].nstates}) does, but its reductions to order {order} did not lead "
+                "to a stable loop; try a higher order or more starts")
         raise SynthesisError(
             f"no start stabilised the closed loop (order {order}, {len(records)} starts{why}); "
-            f"best spectral abscissa {best_alpha:.4g}. Check that the unstable modes are "
-            "controllable from u and observable from y, that the plant is scaled sensibly, or "
-            "try a higher order / more starts"
+            f"best spectral abscissa {best_alpha:.4g}. {hint}"
             + (f"; {STABLE_CONTROLLER_NOTE}" if opts.stable_controller else ""),
             best_spectral_abscissa=float(best_alpha), starts=tuple(records))
     gammas = tuple(float(c[0]) for c in checks)

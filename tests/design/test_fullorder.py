@@ -19,6 +19,7 @@ from casflutter.design import load_compleib, partition, synthesize
 from casflutter.design._fullorder import (full_order_controller, is_regular, reduced_controllers,
                                          regularized)
 from casflutter.design._norm import active_frequencies, hinf_norm
+from casflutter.errors import SynthesisError
 from casflutter.verify import hinf_norm as verify_norm
 from casflutter.verify import lft_closed_loop
 
@@ -185,3 +186,20 @@ def test_failed_random_start_is_retried_from_a_shrunk_gain():
     res = synthesize(P, nmeas, ncon, 0, starts=3, seed=0,
                      options=dict(max_outer=1, full_order_start=False))
     assert all(s.stabilized and s.spectral_abscissa < 0 for s in res.starts)
+
+
+def test_a_plant_no_static_gain_stabilises_is_said_to_need_a_higher_order():
+    """The double integrator measured in position (1/s²): a static gain k leaves the poles
+    at ±√k, never both in the open left half-plane, so order 0 must fail; the regularised
+    full-order controller (order 2) stabilises it, and the error says so instead of
+    suggesting that the modes are uncontrollable.  Order 1 (a lead) does stabilise it."""
+    A = np.array([[0.0, 1.0], [0.0, 0.0]])
+    B = np.array([[0.0, 0.0], [1.0, 1.0]])                  # [w, u]
+    C = np.array([[1.0, 0.0], [0.0, 0.0], [1.0, 0.0]])      # [z1, z2, y]
+    D = np.array([[0.0, 0.0], [0.0, 1.0], [0.0, 0.0]])      # D21 = 0: singular
+    P = control.ss(A, B, C, D)
+    with pytest.raises(SynthesisError, match=r"can be stabilised: the full-order H-inf "
+                                             r"controller \(order 2\) does"):
+        synthesize(P, 1, 1, 0, starts=2, seed=0)
+    res = synthesize(P, 1, 1, 1, starts=2, seed=0)
+    assert res.success and np.isfinite(_verified_gamma(P, res.controller, 1, 1))
