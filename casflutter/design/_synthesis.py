@@ -221,7 +221,9 @@ class StartRecord:
         ``"given"`` (an initial controller passed in), ``"given-perturbed"`` (the same padded
         to the order with small random couplings of the new states),
         ``"full-order-reduced"`` (the full-order H∞ controller reduced to the order,
-        :mod:`._fullorder`), ``"zero"`` or ``"random"``.
+        :mod:`._fullorder`), ``"zero"``, ``"random"`` or ``"order-descent"`` (when no other
+        start stabilised: a stabilising controller continued down from the full-order one,
+        :func:`_order_descent`).
     stabilized : bool
         Whether the stabilisation phase ended with a stable, well-posed loop (the decay
         rates met, or at least a negative spectral abscissa).
@@ -850,7 +852,10 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
     best_alpha = np.inf
     log.debug("synthesis: order %d, %d H-inf plant(s) (%d states), %d stability plant(s), "
               "%d start(s)", order, len(parts), parts[0].nx, len(sparts), len(plan))
-    for s, (kind, g) in enumerate(plan):
+    descended = False
+    while len(records) < len(plan):
+        s = len(records)
+        kind, g = plan[s]
         t0 = time.perf_counter()
         K0 = _initial_gain(prob, kind, rng, g)
         statuses: list[str] = []
@@ -872,6 +877,15 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
         best_alpha = min(best_alpha, alpha)
         if time.perf_counter() > deadline and any(r.stabilized for r in records):
             break
+        if len(records) == len(plan) and not descended and full is not None and \
+                order < full[0].nstates and not any(r.stabilized for r in records):
+            # every start failed to stabilise, though the full-order controller does: come
+            # down to the order from it a few states at a time, for one last start
+            descended = True
+            Kd = _order_descent(parts, sparts, sys_list, stab_list, nmeas, ncon, order,
+                                full[0], opts)
+            if Kd is not None:
+                plan.append(("order-descent", Kd))
     ok = [r for r in records if r.stabilized and np.isfinite(r.gamma)]
     while ok:
         best = _best_start(ok)
@@ -896,8 +910,9 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
                 "y, that the plant is scaled sensibly, or try a higher order / more starts"
                 if full is None else
                 f"The plant can be stabilised: the full-order H-inf controller (order "
-                f"{full[0].nstates}) does, but its reductions to order {order} did not lead "
-                "to a stable loop; try a higher order or more starts")
+                f"{full[0].nstates}) does, but neither its reductions to order {order} nor "
+                "a descent to that order a few states at a time led to a stable loop; try a "
+                "higher order or more starts")
         raise SynthesisError(
             f"no start stabilised the closed loop (order {order}, {len(records)} starts{why}); "
             f"best spectral abscissa {best_alpha:.4g}. {hint}"
@@ -918,6 +933,43 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
         success=bool(alpha_v < 0 and np.isfinite(gamma) and alpha_s <= -opts.decay * (1 - 1e-6)),
         wall_time=time.perf_counter() - t_start,
         norm_method="casflutter.design Hamiltonian level iteration")
+
+
+_DESCENT_OUTER = 5
+"""H∞ iterations at each intermediate order of :func:`_order_descent` (its aim there is a
+stable loop to reduce further, not a low γ)."""
+
+
+def _order_descent(parts, sparts, sys_list, stab_list, nmeas, ncon, order: int,
+                   K: control.StateSpace, opts: SynthesisOptions
+                   ) -> control.StateSpace | None:
+    """A controller of ``order`` that stabilises the plants, continued down from the
+    stabilising controller ``K`` of higher order, or ``None``.
+
+    The order falls by a quarter of the states (at least one) at a time; at each order the
+    reductions of the last controller (:func:`._fullorder.reduced_controllers`) are tried
+    as starts of a synthesis at that order until one stabilises (a few H∞ iterations at the
+    orders between, the caller's options at ``order``).  A reduction that leaves the loop
+    slightly unstable is close to one that does not, where a random start may be far from
+    any.  Deterministic: no random choice.
+    """
+    sub = replace(opts, max_outer=_DESCENT_OUTER, extra_outer=0, full_order_start=False)
+    m = K.nstates
+    while m > order:
+        m = max(order, m - max(1, m // 4))
+        for Kr in reduced_controllers(K, m):
+            try:
+                res = _synthesize(parts, sparts, sys_list, stab_list, nmeas, ncon, m, 0, 0,
+                                  [Kr], sub, time.perf_counter())
+            except SynthesisError:
+                continue
+            K = res.controller
+            break
+        else:
+            log.debug("order descent: no reduction to order %d stabilises", m)
+            return None
+    log.debug("order descent: a stabilising controller of order %d", order)
+    return K
 
 
 def _run_start(prob: Problem, qp: CutQP, opts: SynthesisOptions, s: int, kind: str,
