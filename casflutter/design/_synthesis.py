@@ -878,7 +878,8 @@ def _synthesize(parts: list[Partition], sparts: list[Partition], sys_list, stab_
         if time.perf_counter() > deadline and any(r.stabilized for r in records):
             break
         if len(records) == len(plan) and not descended and full is not None and \
-                order < full[0].nstates and not any(r.stabilized for r in records):
+                order < full[0].nstates and not any(r.stabilized for r in records) and \
+                time.perf_counter() < deadline:
             # every start failed to stabilise, though the full-order controller does: come
             # down to the order from it a few states at a time, for one last start
             descended = True
@@ -948,10 +949,10 @@ def _order_descent(parts, sparts, sys_list, stab_list, nmeas, ncon, order: int,
 
     The order falls by a quarter of the states (at least one) at a time; at each order the
     reductions of the last controller (:func:`._fullorder.reduced_controllers`) are tried
-    as starts of a synthesis at that order until one stabilises (a few H∞ iterations at the
-    orders between, the caller's options at ``order``).  A reduction that leaves the loop
-    slightly unstable is close to one that does not, where a random start may be far from
-    any.  Deterministic: no random choice.
+    as starts of a synthesis at that order (with ``_DESCENT_OUTER`` H∞ iterations) until
+    one stabilises.  A reduction that leaves the loop slightly unstable is close to one
+    that does not, where a random start may be far from any.  The caller runs the result
+    as its last start, with its own options.  Deterministic: no random choice.
     """
     sub = replace(opts, max_outer=_DESCENT_OUTER, extra_outer=0, full_order_start=False)
     m = K.nstates
