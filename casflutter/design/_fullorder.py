@@ -170,20 +170,14 @@ def _full_order(P: Partition, gamma_factor: float, regularization: float
                   "regularised with eps = %g", regularization)
         P = regularized(P, regularization)
     try:
-        from slycot import sb10ad  # noqa: PLC0415 - optional dependency
+        import slycot  # noqa: F401, PLC0415 - optional dependency
     except ImportError:
         log.info("full-order start: slycot not installed, skipped")
         return None
-    nw, nz, nu, ny = P.dims
-    A = P.A
-    B = np.hstack([P.B1, P.B2])
-    C = np.vstack([P.C1, P.C2])
-    D = np.block([[P.D11, P.D12], [P.D21, P.D22]])
-    n, m, p = A.shape[0], B.shape[1], C.shape[0]
     try:
         # job=1: bisection on γ (no scan), from a level far above any plausible norm
-        g_opt = float(sb10ad(n, m, p, nu, ny, 1e8 * max(1.0, float(np.max(np.abs(D)))),
-                             A, B, C, D, job=1)[0])
+        top = 1e8 * max(1.0, float(np.max(np.abs(P.statespace().D))))
+        g_opt = float(_sb10ad(P, top, job=1)[0])
     except Exception as exc:  # noqa: BLE001 - SLICOT refuses with several exception types
         # the whole reason on one line (SLICOT's messages span several)
         log.info("full-order start: SLICOT refused the problem (%s), skipped",
@@ -207,17 +201,21 @@ _LEVEL_TRIES = 12
 """Levels tried by :func:`full_order_controller`, doubling from SB10AD's optimum."""
 
 
+def _sb10ad(P: Partition, level: float, job: int) -> tuple:
+    """SLICOT SB10AD on ``P`` at ``level`` (``job=1``: bisection down from it; ``job=4``:
+    the central controller at it); raises what SLICOT raises."""
+    from slycot import sb10ad  # noqa: PLC0415 - optional dependency, checked by the caller
+
+    S = P.statespace()
+    _, _, nu, ny = P.dims
+    return sb10ad(P.nx, S.ninputs, S.noutputs, nu, ny, level, S.A, S.B, S.C, S.D, job=job)
+
+
 def _central(P: Partition, level: float) -> control.StateSpace | None:
     """SB10AD's central controller of ``P`` at ``level``, or ``None`` when SLICOT refuses it
     or its closed loop is not stable with a norm below ``level`` (:func:`_below`)."""
-    from slycot import sb10ad  # noqa: PLC0415 - optional dependency, checked by the caller
-
-    _, _, nu, ny = P.dims
-    B = np.hstack([P.B1, P.B2])
-    C = np.vstack([P.C1, P.C2])
-    D = np.block([[P.D11, P.D12], [P.D21, P.D22]])
     try:
-        out = sb10ad(P.nx, B.shape[1], C.shape[0], nu, ny, level, P.A, B, C, D, job=4)
+        out = _sb10ad(P, level, job=4)
     except Exception:  # noqa: BLE001 - SLICOT refuses with several exception types
         return None
     Ak, Bk, Ck, Dk = (np.asarray(M, float) for M in out[1:5])
